@@ -1,0 +1,51 @@
+// Interpolation of a body between its rest pose and its current pose
+// (Hajkova & Kohout, sec. 4.1, eq. 1; and a rigid mode beyond the paper).
+#pragma once
+
+#include "MeshTypes.h"
+#include "RigidMotion.h"
+
+#include <optional>
+
+namespace md
+{
+enum class InterpolationMode
+{
+  Linear = 0, ///< x_i(s) = (1 - s) rp_i + s cp_i: the paper's eq. 1
+  Rigid = 1,  ///< screw motion of the fitted rigid transform (keeps the bone congruent)
+};
+
+/// Largest |cp_i - rp_i|.
+double MaximumDisplacement(const Points& rest, const Points& current);
+
+/// Steps needed so that no point moves more than maximumStepDisplacement in one
+/// step: ceil(maximumDisplacement / maximumStepDisplacement), at least 1.
+int AutomaticNumberOfSteps(double maximumDisplacement, double maximumStepDisplacement);
+
+class PoseInterpolator
+{
+public:
+  /// rest and current must have the same number of points (InputError otherwise).
+  PoseInterpolator(const Points& rest, const Points& current, InterpolationMode mode);
+
+  /// Positions at step `step` of `numberOfSteps`: step 0 is the rest pose and
+  /// step numberOfSteps the current pose, both exactly.
+  Points AtStep(int step, int numberOfSteps) const;
+  /// Positions at fraction s in [0, 1] of the way.
+  Points AtFraction(double s) const;
+
+  InterpolationMode Mode() const { return this->Mode_; }
+  /// The least-squares rigid fit of the RP -> CP motion (computed in Rigid mode only).
+  const std::optional<RigidFit>& Fit() const { return this->Fit_; }
+  /// Rotation angle of the fitted motion (Rigid mode), in radians.
+  double RotationAngle() const;
+
+private:
+  Points Rest;
+  Points Current;
+  InterpolationMode Mode_;
+  std::optional<RigidFit> Fit_;
+  std::optional<ScrewInterpolation> Screw;
+  Points Residual; // CP minus the fitted rigid motion of the RP, blended in linearly
+};
+}

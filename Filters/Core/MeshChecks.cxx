@@ -1,0 +1,98 @@
+#include "MeshChecks.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+namespace md
+{
+EdgeReport CheckEdges(const Triangles& triangles)
+{
+  struct EdgeUse
+  {
+    int forward = 0;  // walked from the smaller to the larger index
+    int backward = 0; // walked from the larger to the smaller index
+  };
+  std::unordered_map<std::uint64_t, EdgeUse> edges;
+  edges.reserve(static_cast<size_t>(triangles.rows()) * 2);
+  EdgeReport report;
+  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
+  {
+    const auto a = triangles(t, 0), b = triangles(t, 1), c = triangles(t, 2);
+    if (a == b || b == c || a == c)
+    {
+      ++report.degenerateTriangles;
+      continue;
+    }
+    for (int k = 0; k < 3; ++k)
+    {
+      const std::int64_t from = triangles(t, k);
+      const std::int64_t to = triangles(t, (k + 1) % 3);
+      const auto lo = static_cast<std::uint64_t>(std::min(from, to));
+      const auto hi = static_cast<std::uint64_t>(std::max(from, to));
+      EdgeUse& use = edges[(lo << 32) | hi];
+      (from < to ? use.forward : use.backward)++;
+    }
+  }
+  for (const auto& entry : edges)
+  {
+    const int uses = entry.second.forward + entry.second.backward;
+    if (uses == 1)
+    {
+      ++report.boundaryEdges;
+    }
+    else if (uses > 2)
+    {
+      ++report.nonManifoldEdges;
+    }
+    else if (entry.second.forward != 1)
+    {
+      ++report.inconsistentEdges;
+    }
+  }
+  return report;
+}
+
+double SignedVolume(const Points& points, const Triangles& triangles)
+{
+  double sixTimesVolume = 0;
+  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
+  {
+    const Eigen::Vector3d a = points.row(triangles(t, 0));
+    const Eigen::Vector3d b = points.row(triangles(t, 1));
+    const Eigen::Vector3d c = points.row(triangles(t, 2));
+    sixTimesVolume += a.cross(b).dot(c);
+  }
+  return sixTimesVolume / 6.0;
+}
+
+double WindingNumber(const Points& points, const Triangles& triangles, const Eigen::Vector3d& query)
+{
+  // Solid angle of each triangle (Van Oosterom & Strackee 1983).
+  double total = 0;
+  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
+  {
+    const Eigen::Vector3d a = points.row(triangles(t, 0)).transpose() - query;
+    const Eigen::Vector3d b = points.row(triangles(t, 1)).transpose() - query;
+    const Eigen::Vector3d c = points.row(triangles(t, 2)).transpose() - query;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    const double numerator = a.dot(b.cross(c));
+    const double denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    total += 2.0 * std::atan2(numerator, denominator);
+  }
+  return total / (4.0 * M_PI);
+}
+
+std::int64_t CountInside(const Points& points, const Triangles& triangles, const Points& queries)
+{
+  std::int64_t inside = 0;
+  for (Eigen::Index i = 0; i < queries.rows(); ++i)
+  {
+    if (WindingNumber(points, triangles, queries.row(i).transpose()) > 0.5)
+    {
+      ++inside;
+    }
+  }
+  return inside;
+}
+}

@@ -1,0 +1,39 @@
+// Checks and measures on closed triangle surfaces.
+#pragma once
+
+#include "MeshTypes.h"
+
+namespace md
+{
+struct EdgeReport
+{
+  std::int64_t boundaryEdges = 0;     ///< edges used by one triangle (holes)
+  std::int64_t nonManifoldEdges = 0;  ///< edges used by more than two triangles
+  std::int64_t inconsistentEdges = 0; ///< edges walked the same way by both triangles
+  std::int64_t degenerateTriangles = 0; ///< triangles repeating a point index
+
+  bool Closed() const { return this->boundaryEdges == 0; }
+  bool Manifold() const { return this->nonManifoldEdges == 0; }
+  bool ConsistentlyOriented() const { return this->inconsistentEdges == 0; }
+  bool IsClosedOrientedManifold() const
+  {
+    return this->Closed() && this->Manifold() && this->ConsistentlyOriented() &&
+      this->degenerateTriangles == 0;
+  }
+};
+
+/// Counts the edge defects of a triangle mesh (topology only).
+EdgeReport CheckEdges(const Triangles& triangles);
+
+/// Signed volume enclosed by a closed triangle surface: positive when the
+/// triangles are oriented with normals pointing outwards.
+double SignedVolume(const Points& points, const Triangles& triangles);
+
+/// Generalised winding number of a closed surface about `query`
+/// (Jacobson et al. 2013): about 1 inside, 0 outside. O(triangles) per query;
+/// meant for checks and tests, not for hot loops.
+double WindingNumber(const Points& points, const Triangles& triangles, const Eigen::Vector3d& query);
+
+/// Number of `queries` inside the closed surface (winding number > 0.5).
+std::int64_t CountInside(const Points& points, const Triangles& triangles, const Points& queries);
+}

@@ -1,0 +1,37 @@
+// Plain data types shared by the algorithm core (no VTK here).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+namespace md
+{
+/// n x 3 point coordinates, one point per row.
+using Points = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+/// m x 3 point indices, one triangle per row.
+using Triangles = Eigen::Matrix<std::int64_t, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+struct TriangleMesh
+{
+  Points points;
+  Triangles triangles;
+};
+
+/// Thrown when input data cannot be used; the message says what is wrong so
+/// that the VTK adapters can report it together with the name of the input.
+class InputError : public std::runtime_error
+{
+public:
+  using std::runtime_error::runtime_error;
+};
+
+/// True when every coordinate is finite (no NaN, no infinity).
+inline bool AllFinite(const Points& points)
+{
+  return points.allFinite();
+}
+}

@@ -1,0 +1,58 @@
+// Rigid motions: least-squares fit (Kabsch) and constant-velocity interpolation.
+#pragma once
+
+#include "MeshTypes.h"
+
+#include <Eigen/Geometry>
+
+namespace md
+{
+/// x -> rotation * x + translation
+struct RigidTransform
+{
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  Eigen::Vector3d Apply(const Eigen::Vector3d& x) const { return rotation * x + translation; }
+  Points Apply(const Points& points) const;
+  /// Rotation about `centre` by `angleRadians` around `axis` (normalised here).
+  static RigidTransform AboutPoint(
+    const Eigen::Vector3d& axis, double angleRadians, const Eigen::Vector3d& centre);
+};
+
+struct RigidFit
+{
+  RigidTransform transform;
+  double rmsResidual = 0; ///< root mean square of |to_i - T(from_i)|
+  double maxResidual = 0; ///< largest |to_i - T(from_i)|
+};
+
+/// Proper rotation and translation minimising sum |to_i - (R from_i + t)|^2
+/// (Kabsch / Horn). Both sets must have the same number of points (>= 1).
+RigidFit FitRigidTransform(const Points& from, const Points& to);
+
+/// The screw motion of a rigid transform, to move a body a fraction of the way:
+/// rotation about the screw axis by quaternion slerp, slide along it linearly.
+/// A rotation about a fixed centre (a joint) keeps that centre fixed at every
+/// fraction; with no rotation it is a straight translation.
+class ScrewInterpolation
+{
+public:
+  /// `centroid` is any point of the moving body (used for numerical conditioning).
+  ScrewInterpolation(const RigidTransform& motion, const Eigen::Vector3d& centroid);
+
+  /// The transform that moves the body the fraction s in [0, 1] of the way.
+  RigidTransform At(double s) const;
+
+  double AngleRadians() const { return this->Angle; }
+
+private:
+  Eigen::Quaterniond Rotation;
+  Eigen::Vector3d Axis;
+  double Angle = 0;
+  Eigen::Vector3d Centroid;
+  Eigen::Vector3d CentroidOffset;  // b = component of the centroid's motion normal to the axis
+  Eigen::Vector3d FixedPointOffset; // q: (I - R) q = b, q normal to the axis
+  double Slide = 0;                 // d: motion along the axis
+};
+}

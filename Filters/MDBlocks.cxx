@@ -1,0 +1,263 @@
+#include "MDBlocks.h"
+
+#include <vtkCellArray.h>
+#include <vtkCellArrayIterator.h>
+#include <vtkCompositeDataSet.h>
+#include <vtkDataObjectTreeIterator.h>
+#include <vtkDoubleArray.h>
+#include <vtkIdList.h>
+#include <vtkInformation.h>
+#include <vtkMultiBlockDataSet.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkAlgorithm.h>
+
+#include <map>
+#include <set>
+
+namespace mdvtk
+{
+using md::Points;
+using md::Triangles;
+using md::TriangleMesh;
+namespace
+{
+template <typename Visitor>
+void ForEachLeaf(vtkMultiBlockDataSet* tree, Visitor&& visit)
+{
+  vtkSmartPointer<vtkDataObjectTreeIterator> it;
+  it.TakeReference(tree->NewTreeIterator());
+  it->VisitOnlyLeavesOn();
+  it->SkipEmptyNodesOff();
+  it->TraverseSubTreeOn();
+  for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+  {
+    visit(it.Get());
+  }
+}
+}
+
+void AcceptPolyDataOrMultiBlock(vtkInformation* info)
+{
+  info->Remove(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE());
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkMultiBlockDataSet");
+}
+
+bool CollectLeaves(
+  vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves, std::string& error)
+{
+  leaves.clear();
+  if (!input)
+  {
+    error = inputName + " is missing";
+    return false;
+  }
+  if (auto* polyData = vtkPolyData::SafeDownCast(input))
+  {
+    leaves.push_back(Leaf{ "", polyData, inputName });
+    return true;
+  }
+  auto* tree = vtkMultiBlockDataSet::SafeDownCast(input);
+  if (!tree)
+  {
+    error = inputName + " is a " + input->GetClassName() +
+      "; it must be a vtkPolyData or a vtkMultiBlockDataSet of them";
+    return false;
+  }
+  bool ok = true;
+  ForEachLeaf(tree, [&](vtkDataObjectTreeIterator* it) {
+    std::string name;
+    if (it->HasCurrentMetaData() && it->GetCurrentMetaData()->Has(vtkCompositeDataSet::NAME()))
+    {
+      name = it->GetCurrentMetaData()->Get(vtkCompositeDataSet::NAME());
+    }
+    const std::string label = inputName + " block " +
+      (name.empty() ? "#" + std::to_string(leaves.size()) : "'" + name + "'");
+    vtkDataObject* leaf = it->GetCurrentDataObject();
+    auto* polyData = vtkPolyData::SafeDownCast(leaf);
+    if (leaf && !polyData && ok)
+    {
+      error = label + " is a " + leaf->GetClassName() + ", not a vtkPolyData";
+      ok = false;
+    }
+    leaves.push_back(Leaf{ name, polyData, label });
+  });
+  if (ok && leaves.empty())
+  {
+    error = inputName + " is a multiblock with no blocks";
+    ok = false;
+  }
+  return ok;
+}
+
+bool PairLeaves(const std::vector<Leaf>& a, const std::string& nameA, const std::vector<Leaf>& b,
+  const std::string& nameB, std::vector<size_t>& partner, std::string& error)
+{
+  partner.assign(a.size(), 0);
+  auto uniquelyNamed = [](const std::vector<Leaf>& leaves) {
+    std::set<std::string> names;
+    for (const Leaf& leaf : leaves)
+    {
+      if (leaf.name.empty() || !names.insert(leaf.name).second)
+      {
+        return false;
+      }
+    }
+    return true;
+  };
+  if (uniquelyNamed(a) && uniquelyNamed(b))
+  {
+    std::map<std::string, size_t> indexOfName;
+    for (size_t j = 0; j < b.size(); ++j)
+    {
+      indexOfName[b[j].name] = j;
+    }
+    for (size_t i = 0; i < a.size(); ++i)
+    {
+      auto found = indexOfName.find(a[i].name);
+      if (found == indexOfName.end())
+      {
+        error = a[i].label + " has no block of the same name in " + nameB;
+        return false;
+      }
+      partner[i] = found->second;
+      indexOfName.erase(found);
+    }
+    if (!indexOfName.empty())
+    {
+      error = b[indexOfName.begin()->second].label + " has no block of the same name in " + nameA;
+      return false;
+    }
+    return true;
+  }
+  if (a.size() != b.size())
+  {
+    error = nameA + " has " + std::to_string(a.size()) + " block(s) but " + nameB + " has " +
+      std::to_string(b.size()) + "; blocks pair by name (when every block is uniquely named) or else by order";
+    return false;
+  }
+  for (size_t i = 0; i < a.size(); ++i)
+  {
+    partner[i] = i;
+  }
+  return true;
+}
+
+void AssignLeaves(
+  vtkDataObject* input, vtkDataObject* output, const std::vector<vtkSmartPointer<vtkPolyData>>& results)
+{
+  if (auto* polyData = vtkPolyData::SafeDownCast(output))
+  {
+    if (!results.empty() && results.front())
+    {
+      polyData->ShallowCopy(results.front());
+    }
+    return;
+  }
+  auto* inTree = vtkMultiBlockDataSet::SafeDownCast(input);
+  auto* outTree = vtkMultiBlockDataSet::SafeDownCast(output);
+  if (!inTree || !outTree)
+  {
+    return;
+  }
+  outTree->CopyStructure(inTree);
+  size_t index = 0;
+  ForEachLeaf(inTree, [&](vtkDataObjectTreeIterator* it) {
+    if (index < results.size())
+    {
+      outTree->SetDataSet(it, results[index]);
+    }
+    ++index;
+  });
+}
+
+Points ToPoints(vtkPoints* points)
+{
+  const vtkIdType n = points ? points->GetNumberOfPoints() : 0;
+  Points out(n, 3);
+  if (n == 0)
+  {
+    return out;
+  }
+  // One call into VTK per array rather than per point: VTK here is built -O0.
+  auto* doubles = vtkDoubleArray::SafeDownCast(points->GetData());
+  if (doubles && doubles->GetNumberOfComponents() == 3)
+  {
+    std::copy(doubles->GetPointer(0), doubles->GetPointer(0) + 3 * n, out.data());
+    return out;
+  }
+  vtkNew<vtkDoubleArray> converted;
+  converted->DeepCopy(points->GetData());
+  std::copy(converted->GetPointer(0), converted->GetPointer(0) + 3 * n, out.data());
+  return out;
+}
+
+vtkSmartPointer<vtkPoints> ToVtkPoints(const Points& points)
+{
+  vtkNew<vtkDoubleArray> array;
+  array->SetNumberOfComponents(3);
+  array->SetNumberOfTuples(points.rows());
+  std::copy(points.data(), points.data() + points.size(), array->GetPointer(0));
+  auto out = vtkSmartPointer<vtkPoints>::New();
+  out->SetData(array);
+  return out;
+}
+
+bool ToTriangles(vtkCellArray* polys, Triangles& triangles)
+{
+  const vtkIdType n = polys ? polys->GetNumberOfCells() : 0;
+  triangles.resize(n, 3);
+  if (n == 0)
+  {
+    return true;
+  }
+  if (polys->IsHomogeneous() != 3)
+  {
+    return false;
+  }
+  vtkNew<vtkIdTypeArray> connectivity;
+  connectivity->DeepCopy(polys->GetConnectivityArray());
+  std::copy(connectivity->GetPointer(0), connectivity->GetPointer(0) + 3 * n, triangles.data());
+  return true;
+}
+
+vtkSmartPointer<vtkPolyData> ToPolyData(const TriangleMesh& mesh)
+{
+  auto polyData = vtkSmartPointer<vtkPolyData>::New();
+  polyData->SetPoints(ToVtkPoints(mesh.points));
+  vtkNew<vtkIdTypeArray> connectivity;
+  connectivity->SetNumberOfValues(mesh.triangles.size());
+  std::copy(mesh.triangles.data(), mesh.triangles.data() + mesh.triangles.size(),
+    connectivity->GetPointer(0));
+  vtkNew<vtkCellArray> polys;
+  polys->SetData(3, connectivity);
+  polyData->SetPolys(polys);
+  return polyData;
+}
+
+std::vector<Points> ToPolylines(vtkPolyData* polyData)
+{
+  std::vector<Points> lines;
+  vtkCellArray* cells = polyData ? polyData->GetLines() : nullptr;
+  if (!cells || cells->GetNumberOfCells() == 0)
+  {
+    return lines;
+  }
+  const Points all = ToPoints(polyData->GetPoints());
+  auto it = vtk::TakeSmartPointer(cells->NewIterator());
+  for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
+  {
+    vtkIdType size;
+    const vtkIdType* ids;
+    it->GetCurrentCell(size, ids);
+    Points line(size, 3);
+    for (vtkIdType k = 0; k < size; ++k)
+    {
+      line.row(k) = all.row(ids[k]);
+    }
+    lines.push_back(std::move(line));
+  }
+  return lines;
+}
+}

@@ -1,0 +1,62 @@
+// Helpers shared by the MuscleDeformation filters: walking and pairing the
+// leaves of polydata / multiblock inputs, and moving geometry between VTK and
+// the Eigen-based core. Not part of the public API.
+#pragma once
+
+#include "MeshTypes.h"
+
+#include <vtkSmartPointer.h>
+
+#include <string>
+#include <vector>
+
+class vtkCellArray;
+class vtkDataObject;
+class vtkInformation;
+class vtkInformationVector;
+class vtkPoints;
+class vtkPolyData;
+
+namespace mdvtk
+{
+using md::Points;
+using md::Triangles;
+using md::TriangleMesh;
+/// One polydata of an input: the input itself, or a leaf of a multiblock.
+struct Leaf
+{
+  std::string name; ///< block name; empty when unnamed or not a multiblock
+  vtkPolyData* data = nullptr;
+  std::string label; ///< how messages name it, e.g. "CurrentPose block 'Femur'"
+};
+
+/// The polydata leaves of `input` (a vtkPolyData or a vtkMultiBlockDataSet),
+/// in iteration order. Fails, with a message in `error`, when a leaf is not a
+/// vtkPolyData or when the input is missing or has no leaves.
+bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves,
+  std::string& error);
+
+/// partner[i] = index in `b` of the leaf paired with a[i]: by name when every
+/// leaf of both inputs has a unique name, otherwise by order. Fails, naming
+/// the unmatched block, when the pairing cannot be made.
+bool PairLeaves(const std::vector<Leaf>& a, const std::string& nameA, const std::vector<Leaf>& b,
+  const std::string& nameB, std::vector<size_t>& partner, std::string& error);
+
+/// Puts one result per leaf of `input` into `output`, which is of the same
+/// type as `input` (see vtkPassInputTypeAlgorithm): for a multiblock input the
+/// output gets the input's structure and block names.
+void AssignLeaves(vtkDataObject* input, vtkDataObject* output,
+  const std::vector<vtkSmartPointer<vtkPolyData>>& results);
+
+/// Accept vtkPolyData or vtkMultiBlockDataSet on an input port.
+void AcceptPolyDataOrMultiBlock(vtkInformation* info);
+
+/// Point coordinates in double precision.
+Points ToPoints(vtkPoints* points);
+vtkSmartPointer<vtkPoints> ToVtkPoints(const Points& points);
+/// Triangles of a polydata's polygons; fails when a polygon is not a triangle.
+bool ToTriangles(vtkCellArray* polys, Triangles& triangles);
+vtkSmartPointer<vtkPolyData> ToPolyData(const TriangleMesh& mesh);
+/// The polylines of a polydata, each as its point coordinates.
+std::vector<Points> ToPolylines(vtkPolyData* polyData);
+}

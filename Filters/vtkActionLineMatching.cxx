@@ -1,0 +1,191 @@
+#include "vtkActionLineMatching.h"
+
+#include "ActionLineMatching.h"
+#include "MDBlocks.h"
+
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
+#include <vtkObjectFactory.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+#include <vtkUnsignedCharArray.h>
+
+#include <algorithm>
+
+vtkStandardNewMacro(vtkActionLineMatching);
+
+namespace
+{
+/// A polydata of polylines with the point arrays ArcLength and Inserted.
+struct LineBuilder
+{
+  std::vector<md::Points> lines;
+  std::vector<std::vector<double>> parameters;
+  std::vector<std::vector<bool>> inserted;
+
+  vtkSmartPointer<vtkPolyData> Build(vtkPolyData* source) const
+  {
+    vtkIdType total = 0;
+    for (const auto& line : this->lines)
+    {
+      total += line.rows();
+    }
+    md::Points all(total, 3);
+    auto arcLength = vtkSmartPointer<vtkDoubleArray>::New();
+    arcLength->SetName("ArcLength");
+    arcLength->SetNumberOfValues(total);
+    auto insertedFlag = vtkSmartPointer<vtkUnsignedCharArray>::New();
+    insertedFlag->SetName("Inserted");
+    insertedFlag->SetNumberOfValues(total);
+    vtkNew<vtkCellArray> cells;
+    vtkIdType next = 0;
+    for (size_t l = 0; l < this->lines.size(); ++l)
+    {
+      const vtkIdType n = this->lines[l].rows();
+      all.middleRows(next, n) = this->lines[l];
+      cells->InsertNextCell(n);
+      for (vtkIdType k = 0; k < n; ++k)
+      {
+        cells->InsertCellPoint(next + k);
+        arcLength->SetValue(next + k, this->parameters[l][k]);
+        insertedFlag->SetValue(next + k, this->inserted[l][k] ? 1 : 0);
+      }
+      next += n;
+    }
+    auto output = vtkSmartPointer<vtkPolyData>::New();
+    output->SetPoints(mdvtk::ToVtkPoints(all));
+    output->SetLines(cells);
+    output->GetPointData()->AddArray(arcLength);
+    output->GetPointData()->AddArray(insertedFlag);
+    // Line cell data carries over: line l of the output is line l of the source,
+    // whose cell id comes after the source's vertices.
+    vtkCellData* sourceCells = source->GetCellData();
+    if (sourceCells->GetNumberOfArrays() > 0)
+    {
+      vtkCellData* outCells = output->GetCellData();
+      outCells->CopyAllocate(sourceCells, static_cast<vtkIdType>(this->lines.size()));
+      const vtkIdType firstLine = source->GetNumberOfVerts();
+      for (size_t l = 0; l < this->lines.size(); ++l)
+      {
+        outCells->CopyData(sourceCells, firstLine + static_cast<vtkIdType>(l), static_cast<vtkIdType>(l));
+      }
+    }
+    output->GetFieldData()->PassData(source->GetFieldData());
+    return output;
+  }
+};
+}
+
+vtkActionLineMatching::vtkActionLineMatching()
+{
+  this->SetNumberOfInputPorts(2);
+  this->SetNumberOfOutputPorts(2);
+}
+
+int vtkActionLineMatching::FillInputPortInformation(int, vtkInformation* info)
+{
+  mdvtk::AcceptPolyDataOrMultiBlock(info);
+  return 1;
+}
+
+int vtkActionLineMatching::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkDataObject* restInput = vtkDataObject::GetData(inputVector[0], 0);
+  vtkDataObject* currentInput = vtkDataObject::GetData(inputVector[1], 0);
+  std::vector<mdvtk::Leaf> restLeaves, currentLeaves;
+  std::vector<size_t> partner;
+  std::string error;
+  if (!mdvtk::CollectLeaves(restInput, "Input", restLeaves, error) ||
+    !mdvtk::CollectLeaves(currentInput, "CurrentPose", currentLeaves, error) ||
+    !mdvtk::PairLeaves(restLeaves, "Input", currentLeaves, "CurrentPose", partner, error))
+  {
+    vtkErrorMacro(<< error);
+    return 0;
+  }
+
+  std::vector<vtkSmartPointer<vtkPolyData>> restResults(restLeaves.size());
+  std::vector<vtkSmartPointer<vtkPolyData>> currentResults(currentLeaves.size());
+  for (size_t b = 0; b < restLeaves.size(); ++b)
+  {
+    this->UpdateProgress(static_cast<double>(b) / restLeaves.size());
+    const mdvtk::Leaf& rest = restLeaves[b];
+    const mdvtk::Leaf& current = currentLeaves[partner[b]];
+    if (!rest.data || !current.data)
+    {
+      if (rest.data || current.data)
+      {
+        vtkErrorMacro(<< (rest.data ? current.label : rest.label)
+                      << " is empty but its partner is not");
+        return 0;
+      }
+      continue;
+    }
+    const std::vector<md::Points> restLines = mdvtk::ToPolylines(rest.data);
+    const std::vector<md::Points> currentLines = mdvtk::ToPolylines(current.data);
+    if (restLines.empty())
+    {
+      vtkErrorMacro(<< rest.label << " has no polylines; action lines must be polyline cells");
+      return 0;
+    }
+    if (restLines.size() != currentLines.size())
+    {
+      vtkErrorMacro(<< rest.label << " has " << restLines.size() << " polyline(s) but "
+                    << current.label << " has " << currentLines.size()
+                    << "; the polylines of a block pair by order");
+      return 0;
+    }
+    LineBuilder restBuilder, currentBuilder;
+    std::vector<md::Points> partnerPositions;
+    for (size_t l = 0; l < restLines.size(); ++l)
+    {
+      md::MatchedActionLines matched;
+      try
+      {
+        matched = md::MatchActionLines(restLines[l], currentLines[l], this->Tolerance);
+      }
+      catch (const md::InputError& e)
+      {
+        vtkErrorMacro(<< "polyline " << l << " of " << rest.label << " / " << current.label << ": "
+                      << e.what());
+        return 0;
+      }
+      restBuilder.lines.push_back(matched.rest);
+      restBuilder.parameters.push_back(matched.restParameters);
+      restBuilder.inserted.push_back(matched.restInserted);
+      currentBuilder.lines.push_back(matched.current);
+      currentBuilder.parameters.push_back(matched.currentParameters);
+      currentBuilder.inserted.push_back(matched.currentInserted);
+      partnerPositions.push_back(matched.current);
+    }
+    vtkSmartPointer<vtkPolyData> restOut = restBuilder.Build(rest.data);
+    vtkSmartPointer<vtkPolyData> currentOut = currentBuilder.Build(current.data);
+    // CurrentPosition: the matched CP point of every RP point, in the same order.
+    auto currentPosition = vtkSmartPointer<vtkDoubleArray>::New();
+    currentPosition->SetName("CurrentPosition");
+    currentPosition->SetNumberOfComponents(3);
+    currentPosition->SetNumberOfTuples(restOut->GetNumberOfPoints());
+    double* out = currentPosition->GetPointer(0);
+    for (const md::Points& line : partnerPositions)
+    {
+      out = std::copy(line.data(), line.data() + line.size(), out);
+    }
+    restOut->GetPointData()->AddArray(currentPosition);
+    restResults[b] = restOut;
+    currentResults[partner[b]] = currentOut;
+  }
+
+  mdvtk::AssignLeaves(restInput, vtkDataObject::GetData(outputVector, 0), restResults);
+  mdvtk::AssignLeaves(currentInput, vtkDataObject::GetData(outputVector, 1), currentResults);
+  return 1;
+}
+
+void vtkActionLineMatching::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Tolerance: " << this->Tolerance << "\n";
+}

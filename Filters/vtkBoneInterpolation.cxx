@@ -1,0 +1,326 @@
+#include "vtkBoneInterpolation.h"
+
+#include "BoneInterpolation.h"
+#include "MDBlocks.h"
+
+#include <vtkAlgorithmOutput.h>
+#include <vtkCellArray.h>
+#include <vtkDataArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkIdTypeArray.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
+#include <vtkIntArray.h>
+#include <vtkMath.h>
+#include <vtkObjectFactory.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
+
+#include <array>
+#include <cmath>
+
+vtkStandardNewMacro(vtkBoneInterpolation);
+
+struct vtkBoneInterpolation::Pose
+{
+  vtkPolyData* restData = nullptr;
+  std::string label;
+  md::Points rest;
+  md::Points current;
+};
+
+namespace
+{
+/// Same cells in the same order (compared only when the CP has cells at all).
+bool SameCells(vtkCellArray* a, vtkCellArray* b)
+{
+  vtkNew<vtkIdTypeArray> legacyA, legacyB;
+  a->ExportLegacyFormat(legacyA);
+  b->ExportLegacyFormat(legacyB);
+  return legacyA->GetNumberOfValues() == legacyB->GetNumberOfValues() &&
+    std::equal(legacyA->GetPointer(0), legacyA->GetPointer(0) + legacyA->GetNumberOfValues(),
+      legacyB->GetPointer(0));
+}
+
+bool SameTopology(vtkPolyData* rest, vtkPolyData* current)
+{
+  if (current->GetNumberOfCells() == 0)
+  {
+    return true;
+  }
+  return SameCells(rest->GetVerts(), current->GetVerts()) &&
+    SameCells(rest->GetLines(), current->GetLines()) &&
+    SameCells(rest->GetPolys(), current->GetPolys()) &&
+    SameCells(rest->GetStrips(), current->GetStrips());
+}
+
+void AddValue(vtkFieldData* fieldData, const char* name, double value)
+{
+  vtkNew<vtkDoubleArray> array;
+  array->SetName(name);
+  array->InsertNextValue(value);
+  fieldData->AddArray(array);
+}
+
+void AddValue(vtkFieldData* fieldData, const char* name, int value)
+{
+  vtkNew<vtkIntArray> array;
+  array->SetName(name);
+  array->InsertNextValue(value);
+  fieldData->AddArray(array);
+}
+}
+
+vtkBoneInterpolation::vtkBoneInterpolation()
+{
+  this->SetNumberOfInputPorts(2);
+  this->SetNumberOfOutputPorts(1);
+}
+
+int vtkBoneInterpolation::FillInputPortInformation(int port, vtkInformation* info)
+{
+  mdvtk::AcceptPolyDataOrMultiBlock(info);
+  if (port == 1)
+  {
+    info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  }
+  return 1;
+}
+
+bool vtkBoneInterpolation::ReadPoses(
+  vtkDataObject* restInput, vtkDataObject* currentInput, std::vector<Pose>& poses)
+{
+  std::vector<mdvtk::Leaf> restLeaves, currentLeaves;
+  std::vector<size_t> partner;
+  std::string error;
+  if (!mdvtk::CollectLeaves(restInput, "Input", restLeaves, error) ||
+    (currentInput &&
+      (!mdvtk::CollectLeaves(currentInput, "CurrentPose", currentLeaves, error) ||
+        !mdvtk::PairLeaves(restLeaves, "Input", currentLeaves, "CurrentPose", partner, error))))
+  {
+    vtkErrorMacro(<< error);
+    return false;
+  }
+  poses.clear();
+  poses.resize(restLeaves.size());
+  for (size_t b = 0; b < restLeaves.size(); ++b)
+  {
+    Pose& pose = poses[b];
+    const mdvtk::Leaf& rest = restLeaves[b];
+    pose.restData = rest.data;
+    pose.label = rest.label;
+    vtkPolyData* current = currentInput ? currentLeaves[partner[b]].data : nullptr;
+    if (!rest.data)
+    {
+      continue; // an empty block stays empty
+    }
+    if (rest.data->GetNumberOfPoints() == 0)
+    {
+      vtkErrorMacro(<< rest.label << " has no points");
+      return false;
+    }
+    pose.rest = mdvtk::ToPoints(rest.data->GetPoints());
+    if (currentInput)
+    {
+      const std::string& currentLabel = currentLeaves[partner[b]].label;
+      if (!current || current->GetNumberOfPoints() != rest.data->GetNumberOfPoints())
+      {
+        vtkErrorMacro(<< rest.label << " has " << rest.data->GetNumberOfPoints() << " points but "
+                      << currentLabel << " has " << (current ? current->GetNumberOfPoints() : 0)
+                      << "; the current pose must have the same points in the same order");
+        return false;
+      }
+      if (!SameTopology(rest.data, current))
+      {
+        vtkErrorMacro(<< rest.label << " and " << currentLabel
+                      << " have different cells; the two poses must share one topology");
+        return false;
+      }
+      pose.current = mdvtk::ToPoints(current->GetPoints());
+    }
+    else
+    {
+      vtkDataArray* position = rest.data->GetPointData()->GetArray("CurrentPosition");
+      if (!position || position->GetNumberOfComponents() != 3)
+      {
+        vtkErrorMacro(<< "CurrentPose is not connected and " << rest.label
+                      << " has no 3-component point array CurrentPosition; connect the current "
+                         "pose, or use port 0 of ActionLineMatching");
+        return false;
+      }
+      vtkNew<vtkDoubleArray> asDouble;
+      asDouble->DeepCopy(position);
+      pose.current.resize(asDouble->GetNumberOfTuples(), 3);
+      std::copy(asDouble->GetPointer(0), asDouble->GetPointer(0) + pose.current.size(),
+        pose.current.data());
+    }
+    if (!md::AllFinite(pose.rest))
+    {
+      vtkErrorMacro(<< rest.label << " has NaN or infinite coordinates");
+      return false;
+    }
+    if (!md::AllFinite(pose.current))
+    {
+      vtkErrorMacro(<< (currentInput ? currentLeaves[partner[b]].label : rest.label + " CurrentPosition")
+                    << " has NaN or infinite coordinates");
+      return false;
+    }
+  }
+  return true;
+}
+
+int vtkBoneInterpolation::RequestInformation(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  int steps = this->NumberOfSteps;
+  if (steps == 0)
+  {
+    // The automatic count depends on the data, which the pipeline only
+    // produces after this pass: bring the inputs up to date first.
+    for (int port = 0; port < 2; ++port)
+    {
+      if (this->GetNumberOfInputConnections(port) > 0)
+      {
+        this->GetInputAlgorithm(port, 0)->Update(this->GetInputConnection(port, 0)->GetIndex());
+      }
+    }
+    std::vector<Pose> poses;
+    if (!this->ReadPoses(vtkDataObject::GetData(inputVector[0], 0),
+          this->GetNumberOfInputConnections(1) ? vtkDataObject::GetData(inputVector[1], 0) : nullptr,
+          poses))
+    {
+      return 0;
+    }
+    double largest = 0;
+    for (const Pose& pose : poses)
+    {
+      largest = std::max(largest, md::MaximumDisplacement(pose.rest, pose.current));
+    }
+    try
+    {
+      steps = md::AutomaticNumberOfSteps(largest, this->MaximumStepDisplacement);
+    }
+    catch (const md::InputError& e)
+    {
+      vtkErrorMacro(<< e.what());
+      return 0;
+    }
+  }
+  this->ResolvedNumberOfSteps = steps;
+
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  std::vector<double> times(static_cast<size_t>(steps) + 1);
+  for (int j = 0; j <= steps; ++j)
+  {
+    times[j] = j;
+  }
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), steps + 1);
+  const double range[2] = { 0.0, static_cast<double>(steps) };
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+  return 1;
+}
+
+int vtkBoneInterpolation::RequestUpdateExtent(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
+{
+  // Our time is the interpolation step, not a time of the inputs: ask them for
+  // their default.
+  for (int port = 0; port < 2; ++port)
+  {
+    for (int i = 0; i < inputVector[port]->GetNumberOfInformationObjects(); ++i)
+    {
+      inputVector[port]->GetInformationObject(i)->Remove(
+        vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+    }
+  }
+  return 1;
+}
+
+int vtkBoneInterpolation::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkDataObject* restInput = vtkDataObject::GetData(inputVector[0], 0);
+  vtkDataObject* currentInput =
+    this->GetNumberOfInputConnections(1) ? vtkDataObject::GetData(inputVector[1], 0) : nullptr;
+  std::vector<Pose> poses;
+  if (!this->ReadPoses(restInput, currentInput, poses))
+  {
+    return 0;
+  }
+  const int steps = this->ResolvedNumberOfSteps;
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  int step = 0;
+  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
+  {
+    const double time = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+    step = static_cast<int>(std::lround(std::clamp(time, 0.0, static_cast<double>(steps))));
+  }
+  const auto mode = static_cast<md::InterpolationMode>(this->InterpolationMode);
+
+  std::vector<vtkSmartPointer<vtkPolyData>> results(poses.size());
+  for (size_t b = 0; b < poses.size(); ++b)
+  {
+    this->UpdateProgress(static_cast<double>(b) / poses.size());
+    const Pose& pose = poses[b];
+    if (!pose.restData)
+    {
+      continue;
+    }
+    md::Points positions;
+    auto output = vtkSmartPointer<vtkPolyData>::New();
+    output->ShallowCopy(pose.restData);
+    output->GetFieldData()->DeepCopy(pose.restData->GetFieldData());
+    vtkFieldData* fieldData = output->GetFieldData();
+    try
+    {
+      const md::PoseInterpolator interpolator(pose.rest, pose.current, mode);
+      positions = interpolator.AtStep(step, steps);
+      if (interpolator.Fit())
+      {
+        const md::RigidFit& fit = *interpolator.Fit();
+        AddValue(fieldData, "RigidFitRMSResidual", fit.rmsResidual);
+        AddValue(fieldData, "RigidFitMaxResidual", fit.maxResidual);
+        AddValue(fieldData, "RotationAngleDegrees", vtkMath::DegreesFromRadians(interpolator.RotationAngle()));
+        double bounds[6];
+        pose.restData->GetBounds(bounds);
+        const double diagonal = std::sqrt(vtkMath::Distance2BetweenPoints(
+          std::array<double, 3>{ bounds[0], bounds[2], bounds[4] }.data(),
+          std::array<double, 3>{ bounds[1], bounds[3], bounds[5] }.data()));
+        if (fit.maxResidual > 1e-3 * diagonal)
+        {
+          vtkWarningMacro(<< "the motion of " << pose.label << " is not rigid: the best rigid fit "
+                          << "misses the current pose by up to " << fit.maxResidual << " ("
+                          << 100.0 * fit.maxResidual / diagonal
+                          << " % of its size); Rigid mode blends that residual in linearly, "
+                             "Linear mode may suit this motion better");
+        }
+      }
+    }
+    catch (const md::InputError& e)
+    {
+      vtkErrorMacro(<< pose.label << ": " << e.what());
+      return 0;
+    }
+    output->SetPoints(mdvtk::ToVtkPoints(positions));
+    AddValue(fieldData, "InterpolationStep", step);
+    AddValue(fieldData, "NumberOfSteps", steps);
+    AddValue(fieldData, "InterpolationFraction", static_cast<double>(step) / steps);
+    results[b] = output;
+  }
+  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
+  mdvtk::AssignLeaves(restInput, output, results);
+  output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), static_cast<double>(step));
+  return 1;
+}
+
+void vtkBoneInterpolation::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "NumberOfSteps: " << this->NumberOfSteps << "\n";
+  os << indent << "MaximumStepDisplacement: " << this->MaximumStepDisplacement << "\n";
+  os << indent << "InterpolationMode: " << (this->InterpolationMode == LINEAR ? "Linear" : "Rigid")
+     << "\n";
+  os << indent << "ResolvedNumberOfSteps: " << this->ResolvedNumberOfSteps << "\n";
+}
