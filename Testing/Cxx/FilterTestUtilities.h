@@ -1,0 +1,73 @@
+// Helpers for the VTK filter tests.
+#pragma once
+
+#include <vtkCellArray.h>
+#include <vtkCompositeDataSet.h>
+#include <vtkDoubleArray.h>
+#include <vtkInformation.h>
+#include <vtkMultiBlockDataSet.h>
+#include <vtkNew.h>
+#include <vtkOutputWindow.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+#include <vtkStringOutputWindow.h>
+
+#include <string>
+#include <vector>
+
+/// Collects everything VTK reports (errors, warnings) while it lives.
+class CapturedMessages
+{
+public:
+  CapturedMessages()
+    : Previous(vtkOutputWindow::GetInstance())
+  {
+    vtkOutputWindow::SetInstance(this->Window);
+  }
+  ~CapturedMessages() { vtkOutputWindow::SetInstance(this->Previous); }
+  std::string Text() { return this->Window->GetOutput(); }
+  bool Contains(const std::string& s) { return this->Text().find(s) != std::string::npos; }
+
+private:
+  vtkSmartPointer<vtkOutputWindow> Previous;
+  vtkNew<vtkStringOutputWindow> Window;
+};
+
+/// A polydata of polylines, one per entry of `lines` (each a flat x,y,z list).
+inline vtkSmartPointer<vtkPolyData> MakePolylines(const std::vector<std::vector<double>>& lines)
+{
+  auto polyData = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> cells;
+  for (const auto& line : lines)
+  {
+    cells->InsertNextCell(static_cast<int>(line.size() / 3));
+    for (size_t k = 0; k < line.size(); k += 3)
+    {
+      cells->InsertCellPoint(points->InsertNextPoint(line[k], line[k + 1], line[k + 2]));
+    }
+  }
+  polyData->SetPoints(points);
+  polyData->SetLines(cells);
+  return polyData;
+}
+
+inline vtkSmartPointer<vtkMultiBlockDataSet> MakeBlocks(
+  const std::vector<std::pair<std::string, vtkSmartPointer<vtkPolyData>>>& blocks)
+{
+  auto tree = vtkSmartPointer<vtkMultiBlockDataSet>::New();
+  for (const auto& block : blocks)
+  {
+    const unsigned int index = tree->GetNumberOfBlocks();
+    tree->SetBlock(index, block.second);
+    tree->GetMetaData(index)->Set(vtkCompositeDataSet::NAME(), block.first.c_str());
+  }
+  return tree;
+}
+
+inline std::string BlockName(vtkMultiBlockDataSet* tree, unsigned int index)
+{
+  return tree->GetMetaData(index)->Get(vtkCompositeDataSet::NAME());
+}

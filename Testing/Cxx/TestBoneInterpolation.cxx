@@ -1,0 +1,187 @@
+#include "BoneInterpolation.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+using md::Points;
+
+namespace
+{
+Points RandomCloud(int n, unsigned seed, double size)
+{
+  std::mt19937 generator(seed);
+  std::uniform_real_distribution<double> coordinate(-size, size);
+  Points p(n, 3);
+  for (int i = 0; i < n; ++i)
+  {
+    p.row(i) << coordinate(generator), coordinate(generator), 3 * coordinate(generator);
+  }
+  return p;
+}
+
+double LargestRelativeDistanceChange(const Points& a, const Points& b)
+{
+  double worst = 0;
+  for (Eigen::Index i = 0; i < a.rows(); ++i)
+  {
+    for (Eigen::Index j = i + 1; j < a.rows(); ++j)
+    {
+      const double da = (a.row(i) - a.row(j)).norm();
+      const double db = (b.row(i) - b.row(j)).norm();
+      worst = std::max(worst, std::abs(db - da) / da);
+    }
+  }
+  return worst;
+}
+
+const Eigen::Vector3d joint(143.5, 243.4, -432.7);
+const Eigen::Vector3d axis = Eigen::Vector3d(1, 0.1, -0.05).normalized();
+}
+
+TEST(RigidMotion, KabschRecoversAKnownTransform)
+{
+  const Points rest = RandomCloud(200, 1, 50);
+  md::RigidTransform truth = md::RigidTransform::AboutPoint(axis, 1.1, joint);
+  truth.translation += Eigen::Vector3d(3, -4, 5);
+  const md::RigidFit fit = md::FitRigidTransform(rest, truth.Apply(rest));
+  EXPECT_TRUE(fit.transform.rotation.isApprox(truth.rotation, 1e-12));
+  EXPECT_TRUE(fit.transform.translation.isApprox(truth.translation, 1e-10));
+  EXPECT_LT(fit.maxResidual, 1e-10);
+  EXPECT_NEAR(fit.transform.rotation.determinant(), 1.0, 1e-12);
+}
+
+TEST(RigidMotion, ScrewInterpolationKeepsTheJointCentreFixed)
+{
+  const Points rest = RandomCloud(50, 2, 40);
+  const md::RigidTransform motion = md::RigidTransform::AboutPoint(axis, M_PI / 3, joint);
+  const md::ScrewInterpolation screw(motion, rest.colwise().mean().transpose());
+  for (double s : { 0.0, 0.1, 0.25, 0.5, 0.9, 1.0 })
+  {
+    const md::RigidTransform at = screw.At(s);
+    EXPECT_LT((at.Apply(joint) - joint).norm(), 1e-9) << "s = " << s;
+    EXPECT_NEAR(Eigen::AngleAxisd(at.rotation).angle(), s * M_PI / 3, 1e-12);
+  }
+  EXPECT_TRUE(screw.At(1.0).rotation.isApprox(motion.rotation, 1e-12));
+  EXPECT_TRUE(screw.At(1.0).translation.isApprox(motion.translation, 1e-9));
+}
+
+TEST(RigidMotion, ScrewInterpolationSlidesAlongItsAxisLinearly)
+{
+  md::RigidTransform motion = md::RigidTransform::AboutPoint(axis, 0.8, joint);
+  motion.translation += 12.0 * axis; // a screw: rotate and slide along the axis
+  const md::ScrewInterpolation screw(motion, joint + Eigen::Vector3d(30, 0, 0));
+  const Eigen::Vector3d half = screw.At(0.5).Apply(joint);
+  EXPECT_LT((half - (joint + 6.0 * axis)).norm(), 1e-9);
+}
+
+TEST(RigidMotion, TinyRotationsStayAccurate)
+{
+  const Eigen::Vector3d shift(10, 20, -30);
+  md::RigidTransform motion = md::RigidTransform::AboutPoint(axis, 1e-11, joint);
+  motion.translation += shift;
+  const Eigen::Vector3d centroid(5, 5, 5);
+  const md::ScrewInterpolation screw(motion, centroid);
+  const Eigen::Vector3d x(100, -50, 20);
+  const Eigen::Vector3d expected = x + 0.5 * (motion.Apply(x) - x);
+  EXPECT_LT((screw.At(0.5).Apply(x) - expected).norm(), 1e-8);
+  const md::ScrewInterpolation none(md::RigidTransform{}, centroid);
+  EXPECT_LT((none.At(0.5).Apply(x) - x).norm(), 1e-12);
+}
+
+TEST(BoneInterpolation, EndStepsReproduceBothPosesExactly)
+{
+  const Points rest = RandomCloud(300, 3, 100);
+  const Points current = md::RigidTransform::AboutPoint(axis, 1.0, joint).Apply(rest);
+  for (auto mode : { md::InterpolationMode::Linear, md::InterpolationMode::Rigid })
+  {
+    const md::PoseInterpolator interpolator(rest, current, mode);
+    EXPECT_TRUE((interpolator.AtStep(0, 5).array() == rest.array()).all());
+    EXPECT_TRUE((interpolator.AtStep(5, 5).array() == current.array()).all());
+  }
+}
+
+TEST(BoneInterpolation, LinearIsThePapersEquationOne)
+{
+  const Points rest = RandomCloud(40, 4, 100);
+  const Points current = RandomCloud(40, 5, 100);
+  const md::PoseInterpolator linear(rest, current, md::InterpolationMode::Linear);
+  const Points step = linear.AtStep(1, 3);
+  EXPECT_TRUE(step.isApprox(rest + (current - rest) / 3.0, 1e-14));
+}
+
+TEST(BoneInterpolation, RigidKeepsTheBoneCongruentWhileLinearShrinksItAsPredicted)
+{
+  const Points rest = RandomCloud(150, 6, 80);
+  const double angle = M_PI / 3; // 60 degrees
+  const Points current = md::RigidTransform::AboutPoint(axis, angle, joint).Apply(rest);
+  const md::PoseInterpolator rigid(rest, current, md::InterpolationMode::Rigid);
+  const md::PoseInterpolator linear(rest, current, md::InterpolationMode::Linear);
+  constexpr int steps = 4;
+  for (int j = 0; j <= steps; ++j)
+  {
+    EXPECT_LT(LargestRelativeDistanceChange(rest, rigid.AtStep(j, steps)), 1e-12) << "step " << j;
+  }
+  // Linear: a difference vector d keeps its axial part and its normal part
+  // shrinks by f(s) = sqrt((1-s)^2 + s^2 + 2 s (1-s) cos(angle)); at s = 1/2
+  // that is cos(angle / 2), 13.4 % short for 60 degrees.
+  const Points middle = linear.AtStep(2, steps);
+  const double f = std::cos(angle / 2);
+  double smallestRatio = 1;
+  for (Eigen::Index i = 0; i + 1 < rest.rows(); ++i)
+  {
+    const Eigen::Vector3d d = (rest.row(i + 1) - rest.row(i)).transpose();
+    const double axial = d.dot(axis);
+    const double predicted = std::sqrt(axial * axial + f * f * (d.squaredNorm() - axial * axial));
+    const double measured = (middle.row(i + 1) - middle.row(i)).norm();
+    EXPECT_NEAR(measured / predicted, 1.0, 1e-12);
+    smallestRatio = std::min(smallestRatio, measured / d.norm());
+  }
+  EXPECT_LT(smallestRatio, 0.88);
+  EXPECT_GE(smallestRatio, f - 1e-12);
+  EXPECT_NEAR(rigid.RotationAngle(), angle, 1e-12);
+}
+
+TEST(BoneInterpolation, RigidBlendsANonRigidResidualAndReportsIt)
+{
+  const Points rest = RandomCloud(100, 7, 50);
+  Points current = md::RigidTransform::AboutPoint(axis, 0.5, joint).Apply(rest);
+  current(0, 0) += 5.0; // one point does not follow the bone
+  const md::PoseInterpolator rigid(rest, current, md::InterpolationMode::Rigid);
+  ASSERT_TRUE(rigid.Fit().has_value());
+  EXPECT_GT(rigid.Fit()->maxResidual, 4.0);
+  EXPECT_GT(rigid.Fit()->rmsResidual, 0.1);
+  EXPECT_TRUE((rigid.AtStep(3, 3).array() == current.array()).all());
+  const Points half = rigid.AtFraction(0.5);
+  EXPECT_TRUE(half.allFinite());
+}
+
+TEST(BoneInterpolation, AutomaticNumberOfSteps)
+{
+  EXPECT_EQ(md::AutomaticNumberOfSteps(0.0, 10.0), 1);
+  EXPECT_EQ(md::AutomaticNumberOfSteps(10.0, 10.0), 1);
+  EXPECT_EQ(md::AutomaticNumberOfSteps(10.5, 10.0), 2);
+  EXPECT_EQ(md::AutomaticNumberOfSteps(95.0, 10.0), 10);
+  EXPECT_THROW(md::AutomaticNumberOfSteps(10.0, 0.0), md::InputError);
+  EXPECT_THROW(md::AutomaticNumberOfSteps(1e9, 1e-3), md::InputError);
+  const Points rest = RandomCloud(10, 8, 10);
+  Points current = rest;
+  current(3, 2) += 7.5;
+  EXPECT_DOUBLE_EQ(md::MaximumDisplacement(rest, current), 7.5);
+}
+
+TEST(BoneInterpolation, RejectsUnusableInput)
+{
+  const Points rest = RandomCloud(10, 9, 10);
+  const Points fewer = RandomCloud(9, 9, 10);
+  Points withNaN = rest;
+  withNaN(4, 0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(md::PoseInterpolator(rest, fewer, md::InterpolationMode::Linear), md::InputError);
+  EXPECT_THROW(md::PoseInterpolator(rest, withNaN, md::InterpolationMode::Rigid), md::InputError);
+  EXPECT_THROW(md::PoseInterpolator(Points(0, 3), Points(0, 3), md::InterpolationMode::Rigid),
+    md::InputError);
+  const md::PoseInterpolator ok(rest, rest, md::InterpolationMode::Rigid);
+  EXPECT_THROW(ok.AtStep(0, 0), md::InputError);
+}
