@@ -1,0 +1,237 @@
+"""Helpers shared by the MuscleDeformation example scripts and image tests (pvpython).
+
+Finding and loading the plugin, a fixed render view, screenshots, and writing
+every block of an output as a .vtp file.
+"""
+import glob
+import os
+import sys
+
+from paraview import simple
+from paraview import servermanager
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SOURCE_DIR = os.path.dirname(HERE)
+
+BONE_COLOUR = [0.89, 0.85, 0.79]
+MUSCLE_COLOURS = [[0.80, 0.25, 0.22], [0.70, 0.35, 0.55], [0.85, 0.50, 0.20], [0.60, 0.20, 0.30]]
+LINE_COLOUR = [0.10, 0.25, 0.75]
+CURRENT_LINE_COLOUR = [0.05, 0.55, 0.30]
+
+
+def find_plugin(explicit=None):
+    """Path of MuscleDeformation.so: the argument, $MUSCLEDEFORMATION_PLUGIN, or the build folder."""
+    candidates = [explicit, os.environ.get("MUSCLEDEFORMATION_PLUGIN")]
+    candidates += sorted(glob.glob(os.path.join(SOURCE_DIR, "build*", "lib", "**", "MuscleDeformation.so"),
+                                   recursive=True))
+    for candidate in candidates:
+        if candidate and os.path.isfile(candidate):
+            return os.path.abspath(candidate)
+    sys.exit("MuscleDeformation.so not found: build the project first (see README.md), "
+             "or pass --plugin / set MUSCLEDEFORMATION_PLUGIN")
+
+
+def load_plugin(namespace=None, explicit=None):
+    """Loads the plugin; its filters become functions of paraview.simple (and of `namespace`)."""
+    path = find_plugin(explicit)
+    simple.LoadPlugin(path, remote=False, ns=vars(simple))
+    if namespace is not None:
+        simple.LoadPlugin(path, remote=False, ns=namespace)
+    return path
+
+
+def data_dir(explicit=None):
+    """The real data folder (holding lhdl_hip_r), or None when it is absent."""
+    for candidate in (explicit, os.environ.get("MUSCLEDEFORMATION_DATA_DIR"),
+                      os.path.join(SOURCE_DIR, "..", "shared", "data")):
+        if candidate and os.path.isdir(os.path.join(candidate, "lhdl_hip_r")):
+            return os.path.abspath(candidate)
+    return None
+
+
+def make_view(size=(900, 900)):
+    """A render view with a white background and no orientation axes."""
+    view = simple.CreateView("RenderView")
+    view.ViewSize = list(size)
+    view.OrientationAxesVisibility = 0
+    if hasattr(view, "UseColorPaletteForBackground"):
+        view.UseColorPaletteForBackground = 0
+    view.Background = [1.0, 1.0, 1.0]
+    view.EnableRenderOnInteraction = 0
+    return view
+
+
+def show_surface(source, view, colour, opacity=1.0, port=0):
+    display = simple.Show(simple.OutputPort(source, port), view)
+    display.Representation = "Surface"
+    display.ColorArrayName = ['POINTS', '']
+    display.AmbientColor = colour
+    display.DiffuseColor = colour
+    display.Opacity = opacity
+    display.Specular = 0.2
+    return display
+
+
+def show_lines(source, view, colour, port=0, width=4.0):
+    display = simple.Show(simple.OutputPort(source, port), view)
+    display.Representation = "Surface"
+    display.ColorArrayName = ['POINTS', '']
+    display.AmbientColor = colour
+    display.DiffuseColor = colour
+    display.LineWidth = width
+    display.RenderLinesAsTubes = 1
+    return display
+
+
+def hide_all(view):
+    for representation in view.Representations:
+        representation.Visibility = 0
+
+
+def close_view(view):
+    """Deletes the view while the display is still there (at interpreter exit it is not)."""
+    simple.Delete(view)
+
+
+def set_camera(view, direction=(1.0, 0.0, 0.0), up=(0.0, 0.0, 1.0), zoom=1.0, focal=None, distance=None):
+    """Looks from the side `direction` points to: at `focal` from `distance` when given (the
+    same framing for every picture of a series), else fitted to what is shown."""
+    length = sum(c * c for c in direction) ** 0.5
+    unit = [c / length for c in direction]
+    view.CameraViewUp = list(up)
+    view.CameraViewAngle = 30
+    if focal is not None and distance is not None:
+        view.CameraFocalPoint = list(focal)
+        view.CameraPosition = [focal[i] + distance * unit[i] for i in range(3)]
+        return
+    view.CameraPosition = unit
+    view.CameraFocalPoint = [0.0, 0.0, 0.0]
+    view.ResetCamera(False)
+    view.GetActiveCamera().Zoom(zoom)
+
+
+def screenshot(view, path, time=None):
+    if time is not None:
+        view.ViewTime = time
+    simple.Render(view)
+    simple.SaveScreenshot(path, view, ImageResolution=list(view.ViewSize))
+    return path
+
+
+def write_blocks(source, folder, prefix, port=None, time=None):
+    """Writes every polydata block of an output as <prefix>_<block>.vtp; returns the paths."""
+    from vtkmodules.vtkCommonDataModel import vtkMultiBlockDataSet, vtkPolyData, vtkCompositeDataSet
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter
+
+    # simple.OutputPort(proxy, k) is a proxy whose Port is k.
+    port = getattr(source, "Port", 0) if port is None else port
+    if time is not None:
+        source.UpdatePipeline(time)
+    data = servermanager.Fetch(source, idx=port)
+    os.makedirs(folder, exist_ok=True)
+    written = []
+
+    def write(polydata, name):
+        writer = vtkXMLPolyDataWriter()
+        path = os.path.join(folder, "%s_%s.vtp" % (prefix, name) if name else "%s.vtp" % prefix)
+        writer.SetFileName(path)
+        writer.SetInputData(polydata)
+        writer.SetDataModeToBinary()
+        writer.Write()
+        written.append(path)
+
+    if isinstance(data, vtkPolyData):
+        write(data, "")
+    elif isinstance(data, vtkMultiBlockDataSet):
+        for index in range(data.GetNumberOfBlocks()):
+            block = data.GetBlock(index)
+            name = data.GetMetaData(index).Get(vtkCompositeDataSet.NAME()) if data.HasMetaData(index) else None
+            if isinstance(block, vtkPolyData):
+                write(block, name or str(index))
+    return written
+
+
+def interpolation_pipeline(inputs, steps=4, mode="Rigid"):
+    """ActionLineMatching and BoneInterpolation (bones, and matched action lines) on `inputs`, a
+    dict of output ports: muscles, bones_rest, bones_current, lines_rest, lines_current."""
+    pipeline = dict(inputs)
+    pipeline["matching"] = simple.ActionLineMatching(Input=inputs["lines_rest"],
+                                                     CurrentPose=inputs["lines_current"])
+    pipeline["bones"] = simple.BoneInterpolation(Input=inputs["bones_rest"],
+                                                 CurrentPose=inputs["bones_current"],
+                                                 NumberOfSteps=steps, InterpolationMode=mode)
+    # Matched action lines carry their current position: no CurrentPose needed. Their points
+    # move with different bodies, so they are interpolated linearly.
+    pipeline["lines"] = simple.BoneInterpolation(Input=simple.OutputPort(pipeline["matching"], 0),
+                                                 NumberOfSteps=steps, InterpolationMode="Linear")
+    return pipeline
+
+
+def show_pose(view, pipeline, pose):
+    """Bones, muscles (rest pose) and action lines in pose 'rest' or 'current'."""
+    hide_all(view)
+    show_surface(pipeline["bones_" + pose], view, BONE_COLOUR)
+    show_surface(pipeline["muscles"], view, MUSCLE_COLOURS[0], opacity=0.45)
+    show_lines(pipeline["lines_" + pose], view, LINE_COLOUR if pose == "rest" else CURRENT_LINE_COLOUR)
+
+
+def show_steps(view, pipeline):
+    """Interpolated bones and action lines (their time is the step) over the rest-pose muscles."""
+    hide_all(view)
+    show_surface(pipeline["bones"], view, BONE_COLOUR)
+    show_surface(pipeline["muscles"], view, MUSCLE_COLOURS[0], opacity=0.3)
+    show_lines(pipeline["lines"], view, LINE_COLOUR)
+
+
+def _field_value(data, name):
+    """{block name: value} of a one-value field-data array, for the blocks that have it."""
+    from vtkmodules.vtkCommonDataModel import vtkCompositeDataSet, vtkMultiBlockDataSet
+
+    if isinstance(data, vtkMultiBlockDataSet):
+        blocks = [(data.GetMetaData(i).Get(vtkCompositeDataSet.NAME()) if data.HasMetaData(i) else str(i),
+                   data.GetBlock(i)) for i in range(data.GetNumberOfBlocks())]
+    else:
+        blocks = [("", data)]
+    values = {}
+    for block_name, block in blocks:
+        array = block.GetFieldData().GetArray(name) if block is not None else None
+        if array is not None:
+            values[block_name] = array.GetValue(0)
+    return values
+
+
+def run(pipeline, view, camera, output, prefix):
+    """Pictures of both poses and of every step, the meshes as .vtp, and figures.json."""
+    os.makedirs(output, exist_ok=True)
+    bones, lines, matching = pipeline["bones"], pipeline["lines"], pipeline["matching"]
+    bones.UpdatePipelineInformation()
+    steps = int(list(bones.TimestepValues)[-1])
+    images = []
+    for pose in ("rest", "current"):
+        show_pose(view, pipeline, pose)
+        camera(view)
+        images.append(screenshot(view, os.path.join(output, "%s_%s.png" % (prefix, pose))))
+    show_steps(view, pipeline)
+    camera(view)
+    figures = {"number_of_steps": steps, "steps": []}
+    for step in range(steps + 1):
+        images.append(screenshot(view, os.path.join(output, "%s_step_%d.png" % (prefix, step)), time=step))
+        bones.UpdatePipeline(step)
+        data = servermanager.Fetch(bones)
+        figures["steps"].append({
+            "step": step,
+            "rotation_degrees_of_rigid_fit_per_block": _field_value(data, "RotationAngleDegrees"),
+            "rigid_fit_max_residual_per_block": _field_value(data, "RigidFitMaxResidual"),
+        })
+        write_blocks(bones, output, "bones_step_%d" % step, time=step)
+        write_blocks(lines, output, "action_lines_step_%d" % step, time=step)
+    write_blocks(pipeline["muscles"], output, "muscles_rest")
+    write_blocks(pipeline["bones_rest"], output, "bones_rest")
+    write_blocks(pipeline["bones_current"], output, "bones_current")
+    write_blocks(matching, output, "action_lines_matched_rest", port=0)
+    write_blocks(matching, output, "action_lines_matched_current", port=1)
+    matched = servermanager.Fetch(matching, idx=0)
+    figures["matched_action_line_points"] = {
+        matched.GetMetaData(b).Get(matched.NAME()): matched.GetBlock(b).GetNumberOfPoints()
+        for b in range(matched.GetNumberOfBlocks())}
+    return images, figures
