@@ -41,12 +41,11 @@ def load_plugin(namespace=None, explicit=None):
 
 
 def data_dir(explicit=None):
-    """The real data folder (holding lhdl_hip_r), or None when it is absent."""
-    for candidate in (explicit, os.environ.get("MUSCLEDEFORMATION_DATA_DIR"),
-                      os.path.join(SOURCE_DIR, "..", "shared", "data")):
-        if candidate and os.path.isdir(os.path.join(candidate, "lhdl_hip_r")):
-            return os.path.abspath(candidate)
-    return None
+    """The real data folder (holding lhdl_hip_r), or None when it is absent: the argument, else
+    $MUSCLEDEFORMATION_DATA_DIR, else ../shared/data beside the source tree."""
+    folder = explicit or os.environ.get("MUSCLEDEFORMATION_DATA_DIR") or \
+        os.path.join(SOURCE_DIR, "..", "shared", "data")
+    return os.path.abspath(folder) if os.path.isdir(os.path.join(folder, "lhdl_hip_r")) else None
 
 
 def make_view(size=(900, 900)):
@@ -61,8 +60,13 @@ def make_view(size=(900, 900)):
     return view
 
 
-def show_surface(source, view, colour, opacity=1.0, port=0):
-    display = simple.Show(simple.OutputPort(source, port), view)
+def _show(source, view, port):
+    """Shows `source` (a proxy, or simple.OutputPort(proxy, k), whose Port is k) or its `port`."""
+    return simple.Show(source if port is None else simple.OutputPort(source, port), view)
+
+
+def show_surface(source, view, colour, opacity=1.0, port=None):
+    display = _show(source, view, port)
     display.Representation = "Surface"
     display.ColorArrayName = ['POINTS', '']
     display.AmbientColor = colour
@@ -72,8 +76,8 @@ def show_surface(source, view, colour, opacity=1.0, port=0):
     return display
 
 
-def show_lines(source, view, colour, port=0, width=4.0):
-    display = simple.Show(simple.OutputPort(source, port), view)
+def show_lines(source, view, colour, port=None, width=4.0):
+    display = _show(source, view, port)
     display.Representation = "Surface"
     display.ColorArrayName = ['POINTS', '']
     display.AmbientColor = colour
@@ -230,8 +234,10 @@ def run(pipeline, view, camera, output, prefix):
     write_blocks(pipeline["bones_current"], output, "bones_current")
     write_blocks(matching, output, "action_lines_matched_rest", port=0)
     write_blocks(matching, output, "action_lines_matched_current", port=1)
-    matched = servermanager.Fetch(matching, idx=0)
-    figures["matched_action_line_points"] = {
-        matched.GetMetaData(b).Get(matched.NAME()): matched.GetBlock(b).GetNumberOfPoints()
-        for b in range(matched.GetNumberOfBlocks())}
+    for key, source, port in (("action_line_points_rest", pipeline["lines_rest"], None),
+                              ("action_line_points_current", pipeline["lines_current"], None),
+                              ("matched_action_line_points", matching, 0)):
+        data = servermanager.Fetch(source, idx=getattr(source, "Port", 0) if port is None else port)
+        figures[key] = {data.GetMetaData(b).Get(data.NAME()): data.GetBlock(b).GetNumberOfPoints()
+                        for b in range(data.GetNumberOfBlocks())}
     return images, figures

@@ -1,0 +1,54 @@
+"""Shared set-up of the pvpython tests: paths, the plugin, captured VTK messages, skipping."""
+import os
+import sys
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SOURCE_DIR = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(SOURCE_DIR, "Examples"))
+
+import mdexamples  # noqa: E402
+from paraview import simple  # noqa: E402
+from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow  # noqa: E402
+
+SKIPPED = 77  # ctest SKIP_RETURN_CODE
+BASELINE_DIR = os.path.join(SOURCE_DIR, "Testing", "Baseline")
+
+
+def output_dir(name):
+    """A fresh folder for what a test writes (never the baseline folder)."""
+    root = os.environ.get("MUSCLEDEFORMATION_TEST_OUTPUT") or os.path.join(os.getcwd(), "test-output")
+    path = os.path.join(root, name)
+    os.makedirs(path, exist_ok=True)
+    return path
+
+
+def load_plugin():
+    return mdexamples.load_plugin(explicit=os.environ.get("MUSCLEDEFORMATION_PLUGIN"))
+
+
+class CapturedMessages:
+    """Collects VTK's errors and warnings while in a `with` block."""
+
+    def __enter__(self):
+        self.previous = vtkOutputWindow.GetInstance()
+        self.window = vtkStringOutputWindow()
+        vtkOutputWindow.SetInstance(self.window)
+        return self
+
+    def __exit__(self, *exc):
+        vtkOutputWindow.SetInstance(self.previous)
+        return False
+
+    @property
+    def text(self):
+        return self.window.GetOutput()
+
+
+def main():
+    """Runs the tests of the calling module; exit code 0 only when all passed."""
+    program = unittest.main(exit=False, verbosity=2)
+    result = program.result
+    if result.testsRun == 0:
+        sys.exit(1)
+    sys.exit(0 if result.wasSuccessful() else 1)

@@ -1,0 +1,56 @@
+"""The example scripts run as a user runs them, and write what they promise."""
+import glob
+import json
+import os
+import shutil
+import subprocess
+import unittest
+
+import mdtesting
+from vtkmodules.vtkIOImage import vtkPNGReader
+from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+
+EXAMPLES = os.path.join(mdtesting.SOURCE_DIR, "Examples")
+
+
+def run_example(script, output, *arguments):
+    # Inside pvpython, sys.executable is not pvpython.
+    pvpython = os.environ.get("MUSCLEDEFORMATION_PVPYTHON") or shutil.which("pvpython")
+    command = [pvpython, os.path.join(EXAMPLES, script), "--output", output] + list(arguments)
+    plugin = os.environ.get("MUSCLEDEFORMATION_PLUGIN")
+    if plugin:
+        command += ["--plugin", plugin]
+    return subprocess.run(command, capture_output=True, text=True)
+
+
+def non_white_fraction(png):
+    reader = vtkPNGReader()
+    reader.SetFileName(png)
+    reader.Update()
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    pixels = vtk_to_numpy(reader.GetOutput().GetPointData().GetScalars())
+    return float((pixels[:, :3].min(axis=1) < 250).mean())
+
+
+class PhantomExample(unittest.TestCase):
+    def test_writes_pictures_of_every_step_meshes_and_figures(self):
+        output = mdtesting.output_dir("example-phantom")
+        result = run_example("phantom_interpolation.py", output, "--steps", "3", "--flexion", "45")
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        self.assertIn(os.path.abspath(output), result.stdout)
+        pictures = sorted(glob.glob(os.path.join(output, "phantom_*.png")))
+        self.assertEqual(len(pictures), 2 + 4, pictures)
+        for picture in pictures:
+            self.assertGreater(non_white_fraction(picture), 0.02, picture)
+        with open(os.path.join(output, "figures.json")) as f:
+            figures = json.load(f)
+        self.assertEqual(figures["number_of_steps"], 3)
+        self.assertAlmostEqual(figures["steps"][3]["rotation_degrees_of_rigid_fit_per_block"]["Femur"], 45.0)
+        reader = vtkXMLPolyDataReader()
+        reader.SetFileName(os.path.join(output, "bones_step_3_Femur.vtp"))
+        reader.Update()
+        self.assertGreater(reader.GetOutput().GetNumberOfPolys(), 1000)
+
+
+if __name__ == "__main__":
+    mdtesting.main()

@@ -1,0 +1,67 @@
+"""Rendered views of the phantom compared with committed baselines (made with Mesa llvmpipe).
+
+Set MUSCLEDEFORMATION_UPDATE_BASELINES=1 to write new baselines after a deliberate change.
+"""
+import os
+import shutil
+import unittest
+
+import mdtesting
+import mdexamples
+import phantom_interpolation
+from paraview import simple
+from vtkmodules.vtkTestingRendering import vtkTesting
+
+mdtesting.load_plugin()
+THRESHOLD = 10.0
+SIZE = (600, 600)
+
+
+class Images(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.output = mdtesting.output_dir("images")
+        cls.pipeline = mdexamples.interpolation_pipeline(phantom_interpolation.phantom_inputs(60.0), 4, "Rigid")
+        cls.view = mdexamples.make_view(SIZE)
+
+    @classmethod
+    def tearDownClass(cls):
+        mdexamples.close_view(cls.view)
+
+    def compare(self, name, time=None):
+        fresh = mdexamples.screenshot(self.view, os.path.join(self.output, name), time=time)
+        baseline = os.path.join(mdtesting.BASELINE_DIR, name)
+        if os.environ.get("MUSCLEDEFORMATION_UPDATE_BASELINES") == "1":
+            shutil.copyfile(fresh, baseline)
+        self.assertTrue(os.path.isfile(baseline), "no baseline %s" % baseline)
+        testing = vtkTesting()
+        for argument in ("-V", os.path.abspath(baseline), "-T", os.path.abspath(self.output)):
+            testing.AddArgument(argument)
+        self.assertEqual(testing.RegressionTest(os.path.abspath(fresh), THRESHOLD), vtkTesting.PASSED,
+                         "%s differs from its baseline; see %s" % (name, self.output))
+
+    def test_rest_pose(self):
+        mdexamples.show_pose(self.view, self.pipeline, "rest")
+        phantom_interpolation.lateral_camera(self.view)
+        self.compare("PhantomRestPose.png")
+
+    def test_current_pose_femur_sweeps_into_the_rectus_femoris(self):
+        mdexamples.show_pose(self.view, self.pipeline, "current")
+        phantom_interpolation.lateral_camera(self.view)
+        self.compare("PhantomCurrentPose60.png")
+
+    def test_middle_step_rigid_against_linear(self):
+        """Step 2 of 4: the rigid femur (bone colour) and the linear one (red), shorter by 13 %."""
+        mdexamples.show_steps(self.view, self.pipeline)
+        linear = simple.BoneInterpolation(Input=self.pipeline["bones_rest"],
+                                          CurrentPose=self.pipeline["bones_current"],
+                                          NumberOfSteps=4, InterpolationMode="Linear")
+        mdexamples.show_surface(linear, self.view, [0.85, 0.2, 0.2], opacity=0.5)
+        phantom_interpolation.lateral_camera(self.view)
+        self.compare("PhantomStep2RigidAndLinear.png", time=2)
+        simple.Hide(linear, self.view)
+        simple.Delete(linear)
+
+
+if __name__ == "__main__":
+    mdtesting.main()

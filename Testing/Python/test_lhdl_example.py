@@ -1,0 +1,47 @@
+"""The LHDL example on the real right-hip data; skipped (exit 77) when the data is absent."""
+import glob
+import json
+import os
+import sys
+import unittest
+
+import mdtesting
+import mdexamples
+from test_examples import run_example, non_white_fraction
+
+DATA = mdexamples.data_dir()
+
+
+class LhdlExample(unittest.TestCase):
+    def test_sixty_degrees_of_hip_flexion(self):
+        output = mdtesting.output_dir("example-lhdl")
+        result = run_example("lhdl_hip_interpolation.py", output, "--motion", "hip_flexion", "--frame", "35")
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        pictures = sorted(glob.glob(os.path.join(output, "lhdl_*.png")))
+        self.assertEqual(len(pictures), 2 + 5)
+        for picture in pictures:
+            self.assertGreater(non_white_fraction(picture), 0.02, picture)
+        with open(os.path.join(output, "figures.json")) as f:
+            figures = json.load(f)
+        self.assertEqual(figures["hip_flexion_degrees"], 60.0)
+        last = figures["steps"][-1]
+        self.assertAlmostEqual(last["rotation_degrees_of_rigid_fit_per_block"]["femur_r"], 58.598, places=2)
+        self.assertLess(last["rotation_degrees_of_rigid_fit_per_block"]["iliac_r"], 1e-9)
+        # psoas and iliacus lose their conditional via point beyond 40 and 54 degrees of flexion.
+        rest, current = figures["action_line_points_rest"], figures["action_line_points_current"]
+        matched = figures["matched_action_line_points"]
+        self.assertEqual((rest["psoas_r"], current["psoas_r"]), (5, 4))
+        self.assertEqual((rest["iliacus_r"], current["iliacus_r"]), (5, 4))
+        self.assertEqual((rest["gluteus_maximus_r"], current["gluteus_maximus_r"]), (12, 12))
+        for muscle, count in matched.items():
+            # Every point kept, the two ends of every line shared.
+            lines = 3 if muscle.startswith("gluteus") else 1
+            self.assertGreaterEqual(count, max(rest[muscle], current[muscle]), muscle)
+            self.assertLessEqual(count, rest[muscle] + current[muscle] - 2 * lines, muscle)
+
+
+if __name__ == "__main__":
+    if DATA is None:
+        print("SKIPPED: the LHDL data was not found (set MUSCLEDEFORMATION_DATA_DIR)")
+        sys.exit(mdtesting.SKIPPED)
+    mdtesting.main()

@@ -1,0 +1,122 @@
+"""The plugin as a pvpython user drives it: proxies, documentation, pipelines, time steps, errors."""
+import os
+import unittest
+import xml.etree.ElementTree as ElementTree
+
+import numpy
+import mdtesting
+from paraview import servermanager, simple
+from vtkmodules.util.numpy_support import vtk_to_numpy
+
+mdtesting.load_plugin()
+
+
+def points(data):
+    return vtk_to_numpy(data.GetPoints().GetData()).astype(numpy.float64)
+
+
+def block(data, name):
+    for index in range(data.GetNumberOfBlocks()):
+        if data.GetMetaData(index).Get(data.NAME()) == name:
+            return data.GetBlock(index)
+    raise KeyError(name)
+
+
+class ServerManagerXML(unittest.TestCase):
+    def test_every_proxy_and_property_is_documented_and_in_the_menu(self):
+        root = ElementTree.parse(os.path.join(mdtesting.SOURCE_DIR, "ServerManagerXML",
+                                              "MuscleDeformation.xml")).getroot()
+        proxies = root.findall("./ProxyGroup/SourceProxy")
+        self.assertGreaterEqual(len(proxies), 3)
+        for proxy in proxies:
+            name = proxy.get("name")
+            self.assertTrue((proxy.findtext("Documentation") or "").strip(), name)
+            menu = proxy.find("./Hints/ShowInMenu")
+            self.assertIsNotNone(menu, name)
+            self.assertEqual(menu.get("category"), "Musculoskeletal", name)
+            for prop in proxy:
+                if prop.tag.endswith("Property"):
+                    self.assertTrue((prop.findtext("Documentation") or "").strip(),
+                                    "%s.%s has no documentation" % (name, prop.get("name")))
+
+    def test_proxies_have_the_names_users_rely_on(self):
+        for name in ("MusculoskeletalPhantom", "ActionLineMatching", "BoneInterpolation"):
+            self.assertTrue(hasattr(simple, name), name)
+        matching = simple.ActionLineMatching()
+        self.assertAlmostEqual(matching.Tolerance, 0.01)
+        interpolation = simple.BoneInterpolation()
+        self.assertEqual(interpolation.NumberOfSteps, 4)
+        self.assertEqual(interpolation.InterpolationMode, "Rigid")
+        simple.Delete(interpolation)
+        simple.Delete(matching)
+
+
+class Pipeline(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.phantom = simple.MusculoskeletalPhantom(Flexion=60)
+        cls.phantom.UpdatePipeline()
+
+    def test_phantom_outputs(self):
+        muscles = servermanager.Fetch(self.phantom, idx=0)
+        self.assertEqual(muscles.GetNumberOfBlocks(), 3)
+        for port in range(5):
+            self.assertGreater(self.phantom.GetDataInformation(port).GetNumberOfPoints(), 0, port)
+        rest = servermanager.Fetch(self.phantom, idx=1)
+        current = servermanager.Fetch(self.phantom, idx=2)
+        self.assertTrue(numpy.array_equal(points(block(rest, "Pelvis")), points(block(current, "Pelvis"))))
+        self.assertFalse(numpy.allclose(points(block(rest, "Femur")), points(block(current, "Femur"))))
+
+    def test_matching_gives_equal_counts_and_the_current_position(self):
+        matching = simple.ActionLineMatching(Input=simple.OutputPort(self.phantom, 3),
+                                             CurrentPose=simple.OutputPort(self.phantom, 4))
+        matching.UpdatePipeline()
+        rest = servermanager.Fetch(matching, idx=0)
+        current = servermanager.Fetch(matching, idx=1)
+        for name in ("Iliopsoas", "GluteusMaximus", "RectusFemoris"):
+            r, c = block(rest, name), block(current, name)
+            self.assertEqual(r.GetNumberOfPoints(), c.GetNumberOfPoints(), name)
+            position = vtk_to_numpy(r.GetPointData().GetArray("CurrentPosition"))
+            self.assertTrue(numpy.array_equal(position, points(c)), name)
+        simple.Delete(matching)
+
+    def test_interpolation_time_steps_and_exact_ends(self):
+        bones = simple.BoneInterpolation(Input=simple.OutputPort(self.phantom, 1),
+                                         CurrentPose=simple.OutputPort(self.phantom, 2), NumberOfSteps=5)
+        bones.UpdatePipelineInformation()
+        self.assertEqual(list(bones.TimestepValues), [0.0, 1.0, 2.0, 3.0, 4.0, 5.0])
+        scene = simple.GetAnimationScene()
+        scene.UpdateAnimationUsingDataTimeSteps()
+        self.assertEqual(list(simple.GetTimeKeeper().TimestepValues)[-1], 5.0)
+        rest = servermanager.Fetch(self.phantom, idx=1)
+        current = servermanager.Fetch(self.phantom, idx=2)
+        bones.UpdatePipeline(0)
+        self.assertTrue(numpy.array_equal(points(block(servermanager.Fetch(bones), "Femur")),
+                                          points(block(rest, "Femur"))))
+        bones.UpdatePipeline(5)
+        at_end = servermanager.Fetch(bones)
+        self.assertTrue(numpy.array_equal(points(block(at_end, "Femur")), points(block(current, "Femur"))))
+        self.assertAlmostEqual(block(at_end, "Femur").GetFieldData().GetArray("RotationAngleDegrees")
+                               .GetValue(0), 60.0, places=9)
+        bones.NumberOfSteps = 0
+        bones.MaximumStepDisplacement = 50.0
+        bones.UpdatePipelineInformation()
+        self.assertGreater(len(bones.TimestepValues), 6)
+        simple.Delete(bones)
+
+    def test_bad_input_reports_the_block_and_recovers(self):
+        bones = simple.BoneInterpolation(Input=simple.OutputPort(self.phantom, 1),
+                                         CurrentPose=simple.OutputPort(self.phantom, 0))
+        with mdtesting.CapturedMessages() as messages:
+            bones.UpdatePipeline(1)
+        self.assertIn("Input block 'Pelvis' has no block of the same name in CurrentPose", messages.text)
+        bones.CurrentPose = simple.OutputPort(self.phantom, 2)
+        with mdtesting.CapturedMessages() as messages:
+            bones.UpdatePipeline(1)
+        self.assertEqual(messages.text, "")
+        self.assertEqual(servermanager.Fetch(bones).GetNumberOfBlocks(), 2)
+        simple.Delete(bones)
+
+
+if __name__ == "__main__":
+    mdtesting.main()
