@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Installs what is missing (Debian 12), builds, and runs the whole test suite headless.
+#   bash Testing/run_test_suite.sh [extra ctest arguments]
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/bootstrap.sh"
+
+md_install_dependencies
+md_build
+if [ ! -d "$MD_DATA_DIR/lhdl_hip_r" ]; then
+  echo "== Real data not found in $MD_DATA_DIR: the real-data tests will be reported as skipped"
+fi
+echo "== Running the tests"
+ctest --test-dir "$MD_BUILD_DIR" --output-on-failure --parallel "$(nproc)" "$@"
