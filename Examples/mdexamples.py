@@ -65,23 +65,25 @@ def _show(source, view, port):
     return simple.Show(source if port is None else simple.OutputPort(source, port), view)
 
 
-def show_surface(source, view, colour, opacity=1.0, port=None):
+def _show_in_colour(source, view, colour, port):
+    """Shows `source` as a surface in one colour (no colour map)."""
     display = _show(source, view, port)
     display.Representation = "Surface"
     display.ColorArrayName = ['POINTS', '']
     display.AmbientColor = colour
     display.DiffuseColor = colour
+    return display
+
+
+def show_surface(source, view, colour, opacity=1.0, port=None):
+    display = _show_in_colour(source, view, colour, port)
     display.Opacity = opacity
     display.Specular = 0.2
     return display
 
 
 def show_lines(source, view, colour, port=None, width=4.0):
-    display = _show(source, view, port)
-    display.Representation = "Surface"
-    display.ColorArrayName = ['POINTS', '']
-    display.AmbientColor = colour
-    display.DiffuseColor = colour
+    display = _show_in_colour(source, view, colour, port)
     display.LineWidth = width
     display.RenderLinesAsTubes = 1
     return display

@@ -181,15 +181,13 @@ Points ToPoints(vtkPoints* points)
     return out;
   }
   // One call into VTK per array rather than per point: VTK here is built -O0.
-  auto* doubles = vtkDoubleArray::SafeDownCast(points->GetData());
-  if (doubles && doubles->GetNumberOfComponents() == 3)
+  vtkSmartPointer<vtkDoubleArray> doubles = vtkDoubleArray::SafeDownCast(points->GetData());
+  if (!doubles)
   {
-    std::copy(doubles->GetPointer(0), doubles->GetPointer(0) + 3 * n, out.data());
-    return out;
+    doubles = vtkSmartPointer<vtkDoubleArray>::New();
+    doubles->DeepCopy(points->GetData());
   }
-  vtkNew<vtkDoubleArray> converted;
-  converted->DeepCopy(points->GetData());
-  std::copy(converted->GetPointer(0), converted->GetPointer(0) + 3 * n, out.data());
+  std::copy(doubles->GetPointer(0), doubles->GetPointer(0) + 3 * n, out.data());
   return out;
 }
 
@@ -202,24 +200,6 @@ vtkSmartPointer<vtkPoints> ToVtkPoints(const Points& points)
   auto out = vtkSmartPointer<vtkPoints>::New();
   out->SetData(array);
   return out;
-}
-
-bool ToTriangles(vtkCellArray* polys, Triangles& triangles)
-{
-  const vtkIdType n = polys ? polys->GetNumberOfCells() : 0;
-  triangles.resize(n, 3);
-  if (n == 0)
-  {
-    return true;
-  }
-  if (polys->IsHomogeneous() != 3)
-  {
-    return false;
-  }
-  vtkNew<vtkIdTypeArray> connectivity;
-  connectivity->DeepCopy(polys->GetConnectivityArray());
-  std::copy(connectivity->GetPointer(0), connectivity->GetPointer(0) + 3 * n, triangles.data());
-  return true;
 }
 
 vtkSmartPointer<vtkPolyData> ToPolyData(const TriangleMesh& mesh)

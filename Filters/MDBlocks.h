@@ -10,7 +10,6 @@
 #include <string>
 #include <vector>
 
-class vtkCellArray;
 class vtkDataObject;
 class vtkInformation;
 class vtkInformationVector;
@@ -20,7 +19,6 @@ class vtkPolyData;
 namespace mdvtk
 {
 using md::Points;
-using md::Triangles;
 using md::TriangleMesh;
 /// One polydata of an input: the input itself, or a leaf of a multiblock.
 struct Leaf
@@ -54,8 +52,6 @@ void AcceptPolyDataOrMultiBlock(vtkInformation* info);
 /// Point coordinates in double precision.
 Points ToPoints(vtkPoints* points);
 vtkSmartPointer<vtkPoints> ToVtkPoints(const Points& points);
-/// Triangles of a polydata's polygons; fails when a polygon is not a triangle.
-bool ToTriangles(vtkCellArray* polys, Triangles& triangles);
 vtkSmartPointer<vtkPolyData> ToPolyData(const TriangleMesh& mesh);
 /// The polylines of a polydata, each as its point coordinates.
 std::vector<Points> ToPolylines(vtkPolyData* polyData);
