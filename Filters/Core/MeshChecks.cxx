@@ -1,5 +1,7 @@
 #include "MeshChecks.h"
 
+#include "TriangleIntersection.h"
+
 #include <algorithm>
 #include <cmath>
 #include <unordered_map>
@@ -94,5 +96,75 @@ std::int64_t CountInside(const Points& points, const Triangles& triangles, const
     }
   }
   return inside;
+}
+
+double PointTriangleDistance(
+  const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c)
+{
+  // Closest point by regions (Ericson, Real-Time Collision Detection, 5.1.5).
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0)
+  {
+    return ap.norm();
+  }
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3)
+  {
+    return bp.norm();
+  }
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0)
+  {
+    return (p - (a + d1 / (d1 - d3) * ab)).norm();
+  }
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6)
+  {
+    return cp.norm();
+  }
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0)
+  {
+    return (p - (a + d2 / (d2 - d6) * ac)).norm();
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+  {
+    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
+  }
+  const double denominator = 1.0 / (va + vb + vc);
+  return (p - (a + ab * (vb * denominator) + ac * (vc * denominator))).norm();
+}
+
+std::int64_t CountOutside(const TriangleMesh& surface, const Points& points, double tolerance)
+{
+  std::int64_t outside = 0;
+  const auto n = static_cast<long>(points.rows());
+#pragma omp parallel for schedule(static) reduction(+ : outside)
+  for (long i = 0; i < n; ++i)
+  {
+    const Eigen::Vector3d p = points.row(i).transpose();
+    if (WindingNumber(surface.points, surface.triangles, p) > 0.5)
+    {
+      continue;
+    }
+    bool near = false;
+    for (Eigen::Index t = 0; t < surface.triangles.rows() && !near; ++t)
+    {
+      near = PointTriangleDistance(p, surface.points.row(surface.triangles(t, 0)).transpose(),
+               surface.points.row(surface.triangles(t, 1)).transpose(),
+               surface.points.row(surface.triangles(t, 2)).transpose()) <= tolerance;
+    }
+    outside += near ? 0 : 1;
+  }
+  return outside;
+}
+
+std::int64_t CountSelfIntersections(const TriangleMesh& surface)
+{
+  return static_cast<std::int64_t>(FindSelfIntersections(surface.points, surface.triangles).size());
 }
 }

@@ -36,4 +36,15 @@ double WindingNumber(const Points& points, const Triangles& triangles, const Eig
 
 /// Number of `queries` inside the closed surface (winding number > 0.5).
 std::int64_t CountInside(const Points& points, const Triangles& triangles, const Points& queries);
+
+/// Distance from `p` to the triangle abc.
+double PointTriangleDistance(
+  const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c);
+
+/// Number of `points` outside the closed surface: winding number below 1/2
+/// and farther than `tolerance` from every triangle. Every point is tested.
+std::int64_t CountOutside(const TriangleMesh& surface, const Points& points, double tolerance);
+
+/// Number of pairs of triangles that intersect other than at what they share.
+std::int64_t CountSelfIntersections(const TriangleMesh& surface);
 }

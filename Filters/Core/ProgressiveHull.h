@@ -1,0 +1,48 @@
+// Coarse outer hull of a closed surface by progressive-hull edge collapse
+// (Sander et al. 2000, "Silhouette clipping"; Platis & Theoharis 2003).
+#pragma once
+
+#include "MeshTypes.h"
+
+namespace md
+{
+struct HullParameters
+{
+  int targetNumberOfPoints = 250;
+  /// A collapse may not create a triangle with an angle below this (degrees),
+  /// unless the triangles it replaces already had a smaller one.
+  double minimumAngleDegrees = 10.0;
+  /// Largest turn of a triangle's normal in one collapse (degrees).
+  double maximumNormalDeviationDegrees = 90.0;
+  /// Largest angle between the normals of two neighbouring triangles after a
+  /// collapse (degrees); above it the surface would fold onto itself.
+  double maximumFoldAngleDegrees = 150.0;
+};
+
+struct HullResult
+{
+  TriangleMesh hull;
+  int collapses = 0;
+  int rejectedCollapses = 0; ///< collapses refused by a quality or intersection check
+  int pointsBumpedIn = 0;     ///< points to enclose that had to be made hull points first
+  std::int64_t pointsLeftOutside = 0; ///< points to enclose still outside at the end (0 expected)
+  bool reachedTarget = false;
+};
+
+/// Collapses edges of `surface` (closed, manifold, outward-oriented, free of
+/// self-intersections: see RepairClosedSurface) until `targetNumberOfPoints`
+/// remain or no collapse is allowed. Each collapse places its point by the
+/// least volume added, subject to lying outside the plane of every triangle
+/// around the collapsed edge (with a small pull towards the edge's middle so
+/// that flat regions have one answer): every hull encloses the previous one,
+/// hence the surface. Collapses are taken in order of added volume and refused
+/// when they would break manifoldness, make slivers, fold the surface or make
+/// it intersect itself.
+///
+/// `enclose` (optional): points that must end inside the hull besides the
+/// surface, such as RepairReport::originalPositionsOfMovedPoints. Each one the
+/// surface leaves out first becomes a surface point (a small fan replaces the
+/// nearest triangles facing it) and decimation keeps it inside from then on.
+HullResult BuildProgressiveHull(
+  const TriangleMesh& surface, const HullParameters& parameters, const Points* enclose = nullptr);
+}

@@ -1,0 +1,816 @@
+#include "SurfaceRepair.h"
+
+#include "MeshChecks.h"
+#include "TriangleIntersection.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <queue>
+#include <sstream>
+#include <unordered_map>
+
+namespace md
+{
+namespace
+{
+using Triangle = std::array<std::int64_t, 3>;
+
+std::uint64_t EdgeKey(std::int64_t a, std::int64_t b)
+{
+  const auto lo = static_cast<std::uint64_t>(std::min(a, b));
+  const auto hi = static_cast<std::uint64_t>(std::max(a, b));
+  return (lo << 32) | hi;
+}
+
+/// Triangles incident to each undirected edge.
+std::unordered_map<std::uint64_t, std::vector<int>> EdgeFaces(const std::vector<Triangle>& triangles)
+{
+  std::unordered_map<std::uint64_t, std::vector<int>> edges;
+  edges.reserve(triangles.size() * 2);
+  for (int t = 0; t < static_cast<int>(triangles.size()); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      edges[EdgeKey(triangles[t][k], triangles[t][(k + 1) % 3])].push_back(t);
+    }
+  }
+  return edges;
+}
+
+/// Does triangle t walk its edge from a to b?
+bool WalksFrom(const Triangle& t, std::int64_t a, std::int64_t b)
+{
+  for (int k = 0; k < 3; ++k)
+  {
+    if (t[k] == a && t[(k + 1) % 3] == b)
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+void AppendRows(Points& points, const std::vector<Eigen::RowVector3d>& rows)
+{
+  const Eigen::Index old = points.rows();
+  points.conservativeResize(old + static_cast<Eigen::Index>(rows.size()), 3);
+  for (size_t i = 0; i < rows.size(); ++i)
+  {
+    points.row(old + static_cast<Eigen::Index>(i)) = rows[i];
+  }
+}
+
+std::int64_t ThirdPoint(const Triangle& t, std::int64_t a, std::int64_t b)
+{
+  for (std::int64_t p : t)
+  {
+    if (p != a && p != b)
+    {
+      return p;
+    }
+  }
+  return -1;
+}
+}
+
+namespace
+{
+std::vector<std::vector<std::int64_t>> PointNeighbours(const TriangleMesh& mesh)
+{
+  std::vector<std::vector<std::int64_t>> neighbours(static_cast<size_t>(mesh.points.rows()));
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      neighbours[mesh.triangles(t, k)].push_back(mesh.triangles(t, (k + 1) % 3));
+      neighbours[mesh.triangles(t, (k + 1) % 3)].push_back(mesh.triangles(t, k));
+    }
+  }
+  for (auto& list : neighbours)
+  {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return neighbours;
+}
+
+/// Moves smoothed points back towards where they were (all the way, half,
+/// a quarter), wherever that makes no triangle cross another.
+void RestoreTowardsOriginal(TriangleMesh& mesh, const Points& original, const std::vector<std::int64_t>& moved)
+{
+  std::vector<std::vector<Eigen::Index>> facesOf(static_cast<size_t>(mesh.points.rows()));
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      facesOf[mesh.triangles(t, k)].push_back(t);
+    }
+  }
+  // A grid of triangle bounds, those of the moved points' triangles widened
+  // by the largest move, so that a query finds every triangle a move can meet.
+  double reach = 0, edge = 0;
+  std::vector<char> movable(static_cast<size_t>(mesh.points.rows()), 0);
+  for (std::int64_t p : moved)
+  {
+    reach = std::max(reach, (mesh.points.row(p) - original.row(p)).norm());
+    movable[p] = 1;
+  }
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
+  {
+    edge += (mesh.points.row(mesh.triangles(t, 0)) - mesh.points.row(mesh.triangles(t, 1))).norm();
+  }
+  const double cell = 2.0 * edge / static_cast<double>(mesh.triangles.rows());
+  auto cellOf = [cell](double x) { return static_cast<long>(std::floor(x / cell)); };
+  auto key = [](long i, long j, long k) {
+    return (static_cast<std::uint64_t>(i & 0x1fffff) << 42) | (static_cast<std::uint64_t>(j & 0x1fffff) << 21) |
+      static_cast<std::uint64_t>(k & 0x1fffff);
+  };
+  auto bounds = [&](Eigen::Index t, Eigen::Vector3d& low, Eigen::Vector3d& high) {
+    low = high = mesh.points.row(mesh.triangles(t, 0)).transpose();
+    bool widen = false;
+    for (int k = 0; k < 3; ++k)
+    {
+      low = low.cwiseMin(mesh.points.row(mesh.triangles(t, k)).transpose());
+      high = high.cwiseMax(mesh.points.row(mesh.triangles(t, k)).transpose());
+      widen = widen || movable[mesh.triangles(t, k)];
+    }
+    if (widen)
+    {
+      low.array() -= reach;
+      high.array() += reach;
+    }
+  };
+  std::unordered_map<std::uint64_t, std::vector<Eigen::Index>> grid;
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
+  {
+    Eigen::Vector3d low, high;
+    bounds(t, low, high);
+    for (long i = cellOf(low[0]); i <= cellOf(high[0]); ++i)
+      for (long j = cellOf(low[1]); j <= cellOf(high[1]); ++j)
+        for (long k = cellOf(low[2]); k <= cellOf(high[2]); ++k)
+          grid[key(i, j, k)].push_back(t);
+  }
+  auto corners = [&](Eigen::Index t) {
+    return std::array<Eigen::Vector3d, 3>{ mesh.points.row(mesh.triangles(t, 0)).transpose(),
+      mesh.points.row(mesh.triangles(t, 1)).transpose(), mesh.points.row(mesh.triangles(t, 2)).transpose() };
+  };
+  auto ids = [&](Eigen::Index t) {
+    return std::array<int, 3>{ static_cast<int>(mesh.triangles(t, 0)), static_cast<int>(mesh.triangles(t, 1)),
+      static_cast<int>(mesh.triangles(t, 2)) };
+  };
+  auto exactBounds = [&](Eigen::Index t, Eigen::Vector3d& low, Eigen::Vector3d& high) {
+    low = high = mesh.points.row(mesh.triangles(t, 0)).transpose();
+    for (int k = 1; k < 3; ++k)
+    {
+      low = low.cwiseMin(mesh.points.row(mesh.triangles(t, k)).transpose());
+      high = high.cwiseMax(mesh.points.row(mesh.triangles(t, k)).transpose());
+    }
+  };
+  auto crossesNothing = [&](std::int64_t p) {
+    for (Eigen::Index t : facesOf[p])
+    {
+      Eigen::Vector3d low, high;
+      exactBounds(t, low, high);
+      for (long i = cellOf(low[0]); i <= cellOf(high[0]); ++i)
+        for (long j = cellOf(low[1]); j <= cellOf(high[1]); ++j)
+          for (long k = cellOf(low[2]); k <= cellOf(high[2]); ++k)
+          {
+            auto found = grid.find(key(i, j, k));
+            if (found == grid.end())
+            {
+              continue;
+            }
+            for (Eigen::Index u : found->second)
+            {
+              if (u == t)
+              {
+                continue;
+              }
+              Eigen::Vector3d otherLow, otherHigh;
+              exactBounds(u, otherLow, otherHigh);
+              if ((otherLow.array() > high.array()).any() || (otherHigh.array() < low.array()).any())
+              {
+                continue;
+              }
+              if (TrianglesIntersect(corners(t), ids(t), corners(u), ids(u)))
+              {
+                return false;
+              }
+            }
+          }
+    }
+    return true;
+  };
+  for (int sweep = 0; sweep < 3; ++sweep)
+  {
+    for (std::int64_t p : moved)
+    {
+      const Eigen::RowVector3d smoothed = mesh.points.row(p);
+      for (double fraction : { 1.0, 0.5, 0.25 })
+      {
+        mesh.points.row(p) = smoothed + fraction * (original.row(p) - smoothed);
+        if (crossesNothing(p))
+        {
+          break;
+        }
+        mesh.points.row(p) = smoothed;
+      }
+    }
+  }
+}
+
+/// Smooths the points around crossing triangles until nothing crosses,
+/// widening the smoothed region ring by ring when that is not enough.
+void UntangleSelfIntersections(TriangleMesh& mesh, RepairReport& report)
+{
+  auto pairs = FindSelfIntersections(mesh.points, mesh.triangles);
+  if (pairs.empty())
+  {
+    return;
+  }
+  const auto initialPairs = static_cast<std::int64_t>(pairs.size());
+  const auto neighbours = PointNeighbours(mesh);
+  const Points original = mesh.points;
+  std::vector<char> inRegion(static_cast<size_t>(mesh.points.rows()), 0);
+  std::vector<std::int64_t> region;
+  auto add = [&](std::int64_t p) {
+    if (!inRegion[p])
+    {
+      inRegion[p] = 1;
+      region.push_back(p);
+    }
+  };
+  constexpr int rounds = 12;
+  for (int round = 0; round < rounds && !pairs.empty(); ++round)
+  {
+    for (const auto& [s, t] : pairs)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        add(mesh.triangles(s, k));
+        add(mesh.triangles(t, k));
+      }
+    }
+    if (round > 0)
+    {
+      const std::vector<std::int64_t> current = region;
+      for (std::int64_t p : current)
+      {
+        for (std::int64_t q : neighbours[p])
+        {
+          add(q);
+        }
+      }
+    }
+    for (int iteration = 0; iteration < 10; ++iteration)
+    {
+      Points next = mesh.points;
+      for (std::int64_t p : region)
+      {
+        Eigen::RowVector3d mean = Eigen::RowVector3d::Zero();
+        for (std::int64_t q : neighbours[p])
+        {
+          mean += mesh.points.row(q);
+        }
+        next.row(p) = 0.5 * mesh.points.row(p) + 0.5 * mean / static_cast<double>(neighbours[p].size());
+      }
+      mesh.points = next;
+    }
+    pairs = FindSelfIntersections(mesh.points, mesh.triangles);
+  }
+  report.selfIntersectionsLeft = static_cast<std::int64_t>(pairs.size());
+  report.selfIntersectionsUntangled = initialPairs - std::min(initialPairs, report.selfIntersectionsLeft);
+  if (pairs.empty())
+  {
+    RestoreTowardsOriginal(mesh, original, region);
+  }
+  std::vector<Eigen::RowVector3d> movedFrom;
+  for (std::int64_t p : region)
+  {
+    const double shift = (mesh.points.row(p) - original.row(p)).norm();
+    if (shift > 0)
+    {
+      ++report.pointsSmoothed;
+      movedFrom.push_back(original.row(p));
+    }
+    report.largestSmoothingShift = std::max(report.largestSmoothingShift, shift);
+  }
+  AppendRows(report.originalPositionsOfMovedPoints, movedFrom);
+}
+
+/// Removes the connected pieces whose every point lies inside another piece.
+void RemoveEnclosedPieces(TriangleMesh& mesh, RepairReport& report)
+{
+  const auto neighbours = PointNeighbours(mesh);
+  std::vector<int> piece(static_cast<size_t>(mesh.points.rows()), -1);
+  int pieces = 0;
+  for (std::int64_t seed = 0; seed < mesh.points.rows(); ++seed)
+  {
+    if (piece[seed] >= 0)
+    {
+      continue;
+    }
+    std::queue<std::int64_t> queue;
+    queue.push(seed);
+    piece[seed] = pieces;
+    while (!queue.empty())
+    {
+      const std::int64_t p = queue.front();
+      queue.pop();
+      for (std::int64_t q : neighbours[p])
+      {
+        if (piece[q] < 0)
+        {
+          piece[q] = pieces;
+          queue.push(q);
+        }
+      }
+    }
+    ++pieces;
+  }
+  if (pieces < 2)
+  {
+    return;
+  }
+  std::vector<Triangles> trianglesOf(static_cast<size_t>(pieces));
+  std::vector<std::vector<Eigen::Index>> rows(static_cast<size_t>(pieces));
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
+  {
+    rows[piece[mesh.triangles(t, 0)]].push_back(t);
+  }
+  for (int k = 0; k < pieces; ++k)
+  {
+    trianglesOf[k].resize(static_cast<Eigen::Index>(rows[k].size()), 3);
+    for (size_t i = 0; i < rows[k].size(); ++i)
+    {
+      trianglesOf[k].row(static_cast<Eigen::Index>(i)) = mesh.triangles.row(rows[k][i]);
+    }
+  }
+  std::vector<char> removed(static_cast<size_t>(pieces), 0);
+  for (int k = 0; k < pieces; ++k)
+  {
+    for (int host = 0; host < pieces && !removed[k]; ++host)
+    {
+      if (host == k || removed[host])
+      {
+        continue;
+      }
+      bool inside = true;
+      for (std::int64_t p = 0; p < mesh.points.rows() && inside; ++p)
+      {
+        if (piece[p] == k)
+        {
+          inside = WindingNumber(mesh.points, trianglesOf[host], mesh.points.row(p).transpose()) > 0.5;
+        }
+      }
+      removed[k] = inside ? 1 : 0;
+    }
+  }
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
+  {
+    if (!removed[piece[mesh.triangles(t, 0)]])
+    {
+      keep.push_back(t);
+    }
+  }
+  for (int k = 0; k < pieces; ++k)
+  {
+    report.enclosedPiecesRemoved += removed[k];
+  }
+  if (keep.size() == static_cast<size_t>(mesh.triangles.rows()))
+  {
+    return;
+  }
+  // Compact the points of the kept triangles.
+  std::vector<std::int64_t> newIndex(static_cast<size_t>(mesh.points.rows()), -1);
+  std::int64_t next = 0;
+  Triangles kept(static_cast<Eigen::Index>(keep.size()), 3);
+  for (size_t i = 0; i < keep.size(); ++i)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      std::int64_t& index = newIndex[mesh.triangles(keep[i], c)];
+      if (index < 0)
+      {
+        index = next++;
+      }
+      kept(static_cast<Eigen::Index>(i), c) = index;
+    }
+  }
+  Points points(next, 3);
+  for (std::int64_t p = 0; p < mesh.points.rows(); ++p)
+  {
+    if (newIndex[p] >= 0)
+    {
+      points.row(newIndex[p]) = mesh.points.row(p);
+    }
+  }
+  mesh.points = points;
+  mesh.triangles = kept;
+}
+}
+
+std::string RepairReport::Describe() const
+{
+  std::ostringstream out;
+  const char* separator = "";
+  auto say = [&](std::int64_t count, const char* what) {
+    if (count > 0)
+    {
+      out << separator << what << " " << count;
+      separator = ", ";
+    }
+  };
+  say(unusedPointsRemoved, "removed unused points:");
+  say(duplicatePointsMerged, "merged duplicate points:");
+  say(degenerateTrianglesRemoved, "removed degenerate triangles:");
+  say(duplicateTrianglesRemoved, "removed duplicate triangles:");
+  say(finTrianglesRemoved, "removed back-to-back triangles (fins of no thickness):");
+  say(trianglesReoriented, "reoriented triangles:");
+  say(nonManifoldEdgesSplit, "split non-manifold edges:");
+  say(pointsDuplicatedAtPinches, "points duplicated at those pinches:");
+  say(selfIntersectionsUntangled, "self-intersecting triangle pairs undone:");
+  if (pointsSmoothed > 0)
+  {
+    out << separator << "by smoothing " << pointsSmoothed << " points (moved at most " << largestSmoothingShift << ")";
+    separator = ", ";
+  }
+  say(selfIntersectionsLeft, "self-intersecting triangle pairs left:");
+  say(enclosedPiecesRemoved, "removed pieces lying inside another:");
+  return out.str();
+}
+
+TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& report)
+{
+  report = RepairReport{};
+  report.originalPositionsOfMovedPoints.resize(0, 3);
+  if (!AllFinite(surface.points))
+  {
+    throw InputError("the surface has non-finite (NaN or infinite) coordinates");
+  }
+  const auto pointCount = static_cast<std::int64_t>(surface.points.rows());
+  for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      if (surface.triangles(t, k) < 0 || surface.triangles(t, k) >= pointCount)
+      {
+        throw InputError("a triangle refers to a point that does not exist");
+      }
+    }
+  }
+
+  // Merge points at identical coordinates.
+  std::vector<std::int64_t> representative(static_cast<size_t>(pointCount));
+  {
+    std::map<std::array<double, 3>, std::int64_t> first;
+    for (std::int64_t i = 0; i < pointCount; ++i)
+    {
+      const std::array<double, 3> key{ surface.points(i, 0), surface.points(i, 1), surface.points(i, 2) };
+      auto inserted = first.emplace(key, i);
+      representative[i] = inserted.first->second;
+    }
+  }
+  std::vector<bool> used(static_cast<size_t>(pointCount), false);
+  std::vector<bool> mergedAway(static_cast<size_t>(pointCount), false);
+  std::vector<Triangle> triangles;
+  // Degenerate triangles go; of two triangles on the same points, a copy goes,
+  // and a back-to-back pair (a fin of no thickness, e.g. what is left of a
+  // collapsed bubble) goes entirely.
+  std::vector<Triangle> kept;
+  {
+    std::map<Triangle, int> seen; // sorted points -> index in kept
+    std::vector<bool> fin;
+    for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t)
+    {
+      Triangle tri;
+      for (int k = 0; k < 3; ++k)
+      {
+        const std::int64_t original = surface.triangles(t, k);
+        tri[k] = representative[original];
+        mergedAway[original] = mergedAway[original] || tri[k] != original;
+      }
+      if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
+      {
+        ++report.degenerateTrianglesRemoved;
+        continue;
+      }
+      Triangle sorted = tri;
+      std::sort(sorted.begin(), sorted.end());
+      auto found = seen.find(sorted);
+      if (found == seen.end())
+      {
+        seen.emplace(sorted, static_cast<int>(kept.size()));
+        kept.push_back(tri);
+        fin.push_back(false);
+        continue;
+      }
+      const Triangle& first = kept[found->second];
+      const bool sameWay = WalksFrom(first, tri[0], tri[1]);
+      if (sameWay)
+      {
+        ++report.duplicateTrianglesRemoved;
+      }
+      else if (!fin[found->second])
+      {
+        fin[found->second] = true;
+        report.finTrianglesRemoved += 2;
+      }
+    }
+    for (size_t t = 0; t < kept.size(); ++t)
+    {
+      if (!fin[t])
+      {
+        triangles.push_back(kept[t]);
+      }
+    }
+    for (const Triangle& tri : triangles)
+    {
+      for (std::int64_t p : tri)
+      {
+        used[p] = true;
+      }
+    }
+  }
+  for (std::int64_t i = 0; i < pointCount; ++i)
+  {
+    report.duplicatePointsMerged += mergedAway[i] ? 1 : 0;
+    report.unusedPointsRemoved += (!used[i] && !mergedAway[i]) ? 1 : 0;
+  }
+  if (triangles.size() < 4)
+  {
+    throw InputError("the surface has fewer than 4 usable triangles");
+  }
+
+  // Holes cannot be closed safely.
+  auto edges = EdgeFaces(triangles);
+  std::int64_t boundary = 0;
+  for (const auto& entry : edges)
+  {
+    boundary += entry.second.size() == 1 ? 1 : 0;
+  }
+  if (boundary > 0)
+  {
+    throw InputError("the surface is open: " + std::to_string(boundary) +
+      " edges belong to a single triangle (holes); a muscle must be a closed surface");
+  }
+
+  // Consistent orientation, by walking across manifold edges; `component`
+  // numbers the parts so reached, each oriented outwards at the end.
+  std::vector<int> component(triangles.size(), -1);
+  int components = 0;
+  {
+    std::vector<int>& state = component;
+    for (size_t seed = 0; seed < triangles.size(); ++seed)
+    {
+      if (state[seed] >= 0)
+      {
+        continue;
+      }
+      std::queue<int> queue;
+      queue.push(static_cast<int>(seed));
+      state[seed] = components;
+      while (!queue.empty())
+      {
+        const int t = queue.front();
+        queue.pop();
+        for (int k = 0; k < 3; ++k)
+        {
+          const std::int64_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+          const std::vector<int>& around = edges[EdgeKey(a, b)];
+          if (around.size() != 2)
+          {
+            continue;
+          }
+          const int other = around[0] == t ? around[1] : around[0];
+          if (state[other] >= 0)
+          {
+            continue;
+          }
+          if (WalksFrom(triangles[other], a, b)) // must walk b -> a to agree with t
+          {
+            std::swap(triangles[other][1], triangles[other][2]);
+            ++report.trianglesReoriented;
+          }
+          state[other] = components;
+          queue.push(other);
+        }
+      }
+      ++components;
+    }
+  }
+
+  // Points in double, for the fix-ups below.
+  Points points = surface.points;
+  // Size of the surface, for the separation of pinched sheets.
+  const double size = (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
+
+  // Non-manifold edges: pair the triangles around the edge so that each pair
+  // bounds one lobe. Rotating about the edge a -> b, a triangle walking b -> a
+  // has its lobe on the side of increasing angle, one walking a -> b on the
+  // side of decreasing angle; a lobe runs from the first to the next.
+  std::map<std::pair<int, std::uint64_t>, int> pairing;
+  for (const auto& entry : edges)
+  {
+    if (entry.second.size() <= 2)
+    {
+      continue;
+    }
+    ++report.nonManifoldEdgesSplit;
+    const std::uint64_t key = entry.first;
+    const auto a = static_cast<std::int64_t>(key >> 32);
+    const auto b = static_cast<std::int64_t>(key & 0xffffffffu);
+    const Eigen::Vector3d pa = points.row(a).transpose(), axis = (points.row(b).transpose() - pa).normalized();
+    Eigen::Vector3d u = axis.unitOrthogonal();
+    const Eigen::Vector3d w = axis.cross(u);
+    struct Around
+    {
+      double angle;
+      int face;
+      bool walksBA;
+    };
+    std::vector<Around> around;
+    for (int f : entry.second)
+    {
+      const Eigen::Vector3d d = points.row(ThirdPoint(triangles[f], a, b)).transpose() - pa;
+      around.push_back({ std::atan2(d.dot(w), d.dot(u)), f, WalksFrom(triangles[f], b, a) });
+    }
+    std::sort(around.begin(), around.end(), [](const Around& x, const Around& y) { return x.angle < y.angle; });
+    const size_t count = around.size();
+    for (size_t i = 0; i < count; ++i)
+    {
+      if (!around[i].walksBA)
+      {
+        continue;
+      }
+      for (size_t step = 1; step < count; ++step)
+      {
+        const Around& next = around[(i + step) % count];
+        if (!next.walksBA && !pairing.count({ next.face, key }))
+        {
+          pairing[{ around[i].face, key }] = next.face;
+          pairing[{ next.face, key }] = around[i].face;
+          break;
+        }
+      }
+    }
+  }
+
+  // Neighbour of triangle t across its edge k, or -1 where the edge is cut.
+  auto neighbour = [&](int t, int k) {
+    const std::int64_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+    const std::uint64_t key = EdgeKey(a, b);
+    const std::vector<int>& around = edges[key];
+    if (around.size() == 2)
+    {
+      return around[0] == t ? around[1] : around[0];
+    }
+    auto found = pairing.find({ t, key });
+    return found == pairing.end() ? -1 : found->second;
+  };
+
+  // Points whose triangles form several fans (pinches) get one copy per extra
+  // fan; the point and its copies move a tiny way into their own lobes.
+  std::vector<std::vector<int>> facesOfPoint(static_cast<size_t>(points.rows()));
+  for (int t = 0; t < static_cast<int>(triangles.size()); ++t)
+  {
+    for (std::int64_t p : triangles[t])
+    {
+      facesOfPoint[p].push_back(t);
+    }
+  }
+  std::vector<Eigen::RowVector3d> copies;
+  const double separation = 1e-6 * size;
+  for (std::int64_t p = 0; p < static_cast<std::int64_t>(facesOfPoint.size()); ++p)
+  {
+    std::map<int, int> fanOf; // triangle -> fan
+    int fans = 0;
+    for (int start : facesOfPoint[p])
+    {
+      if (fanOf.count(start))
+      {
+        continue;
+      }
+      std::queue<int> queue;
+      queue.push(start);
+      fanOf[start] = fans;
+      while (!queue.empty())
+      {
+        const int t = queue.front();
+        queue.pop();
+        for (int k = 0; k < 3; ++k)
+        {
+          if (triangles[t][k] != p && triangles[t][(k + 1) % 3] != p)
+          {
+            continue; // only edges through p join the triangles of a fan
+          }
+          const int other = neighbour(t, k);
+          if (other >= 0 && !fanOf.count(other))
+          {
+            fanOf[other] = fans;
+            queue.push(other);
+          }
+        }
+      }
+      ++fans;
+    }
+    if (fans < 2)
+    {
+      continue;
+    }
+    std::vector<Eigen::Vector3d> fanNormal(static_cast<size_t>(fans), Eigen::Vector3d::Zero());
+    for (const auto& [t, fan] : fanOf)
+    {
+      const Triangle& tri = triangles[t];
+      fanNormal[fan] += (points.row(tri[1]) - points.row(tri[0])).transpose().cross(
+        (points.row(tri[2]) - points.row(tri[0])).transpose());
+    }
+    const Eigen::RowVector3d original = points.row(p);
+    AppendRows(report.originalPositionsOfMovedPoints, { original });
+    points.row(p) = original - separation * fanNormal[0].normalized().transpose();
+    for (int fan = 1; fan < fans; ++fan)
+    {
+      const std::int64_t copy = static_cast<std::int64_t>(facesOfPoint.size() + copies.size());
+      copies.push_back(original - separation * fanNormal[fan].normalized().transpose());
+      ++report.pointsDuplicatedAtPinches;
+      for (const auto& [t, f] : fanOf)
+      {
+        if (f == fan)
+        {
+          std::replace(triangles[t].begin(), triangles[t].end(), p, copy);
+        }
+      }
+    }
+  }
+  if (!copies.empty())
+  {
+    const Eigen::Index old = points.rows();
+    points.conservativeResize(old + static_cast<Eigen::Index>(copies.size()), 3);
+    for (size_t i = 0; i < copies.size(); ++i)
+    {
+      points.row(old + static_cast<Eigen::Index>(i)) = copies[i];
+    }
+  }
+
+  // Compact: drop unused and merged-away points.
+  std::vector<std::int64_t> newIndex(static_cast<size_t>(points.rows()), -1);
+  std::int64_t next = 0;
+  for (const Triangle& t : triangles)
+  {
+    for (std::int64_t p : t)
+    {
+      if (newIndex[p] < 0)
+      {
+        newIndex[p] = next++;
+      }
+    }
+  }
+  TriangleMesh out;
+  out.points.resize(next, 3);
+  for (std::int64_t p = 0; p < points.rows(); ++p)
+  {
+    if (newIndex[p] >= 0)
+    {
+      out.points.row(newIndex[p]) = points.row(p);
+    }
+  }
+  out.triangles.resize(static_cast<Eigen::Index>(triangles.size()), 3);
+  for (size_t t = 0; t < triangles.size(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      out.triangles(static_cast<Eigen::Index>(t), k) = newIndex[triangles[t][k]];
+    }
+  }
+
+  // Each part outwards (positive volume).
+  std::vector<double> partVolume(static_cast<size_t>(components), 0.0);
+  for (Eigen::Index t = 0; t < out.triangles.rows(); ++t)
+  {
+    const Eigen::Vector3d a = out.points.row(out.triangles(t, 0)), b = out.points.row(out.triangles(t, 1)),
+                          c = out.points.row(out.triangles(t, 2));
+    partVolume[component[t]] += a.cross(b).dot(c) / 6.0;
+  }
+  for (Eigen::Index t = 0; t < out.triangles.rows(); ++t)
+  {
+    if (partVolume[component[t]] < 0)
+    {
+      std::swap(out.triangles(t, 1), out.triangles(t, 2));
+      ++report.trianglesReoriented;
+    }
+  }
+  UntangleSelfIntersections(out, report);
+  RemoveEnclosedPieces(out, report);
+  const double volume = SignedVolume(out.points, out.triangles);
+  if (!(volume > 1e-12 * size * size * size))
+  {
+    throw InputError("the surface encloses no volume (it is flat or degenerate)");
+  }
+  return out;
+}
+}

@@ -1,0 +1,51 @@
+// Making a scanned closed surface usable: what is safe to repair is repaired
+// and counted, what cannot be used is refused.
+#pragma once
+
+#include "MeshTypes.h"
+
+#include <string>
+
+namespace md
+{
+struct RepairReport
+{
+  std::int64_t unusedPointsRemoved = 0;
+  std::int64_t duplicatePointsMerged = 0;     ///< points at exactly the same coordinates
+  std::int64_t degenerateTrianglesRemoved = 0; ///< triangles repeating a point
+  std::int64_t duplicateTrianglesRemoved = 0;
+  std::int64_t finTrianglesRemoved = 0;        ///< back-to-back pairs on the same points
+  std::int64_t trianglesReoriented = 0;        ///< flipped to agree with their neighbours
+  std::int64_t nonManifoldEdgesSplit = 0;      ///< edges of more than two triangles, cut apart
+  std::int64_t pointsDuplicatedAtPinches = 0;  ///< points copied so that every fan is its own
+  std::int64_t selfIntersectionsUntangled = 0; ///< crossing triangle pairs undone by smoothing
+  std::int64_t pointsSmoothed = 0;             ///< points moved to undo them
+  double largestSmoothingShift = 0;            ///< farthest such move
+  std::int64_t selfIntersectionsLeft = 0;      ///< crossing pairs smoothing could not undo
+  std::int64_t enclosedPiecesRemoved = 0;      ///< separate pieces lying inside another piece
+  /// Where the moved points were: the points a hull of the repaired surface
+  /// must enclose besides it (see BuildProgressiveHull).
+  Points originalPositionsOfMovedPoints;
+
+  bool Changed() const
+  {
+    return unusedPointsRemoved || duplicatePointsMerged || degenerateTrianglesRemoved ||
+      duplicateTrianglesRemoved || finTrianglesRemoved || trianglesReoriented || nonManifoldEdgesSplit || pointsDuplicatedAtPinches ||
+      selfIntersectionsUntangled || selfIntersectionsLeft || enclosedPiecesRemoved;
+  }
+  /// One line naming every repair made, e.g. "removed 10 unused points, ...".
+  std::string Describe() const;
+};
+
+/// A closed, manifold, outward-oriented copy of `surface`. Non-manifold edges
+/// (two sheets pinched along an edge) are cut apart: the triangles around the
+/// edge are paired so that each pair bounds one lobe, and every point whose
+/// triangles then form several fans gets a copy per fan, moved by a tiny
+/// distance (1e-6 of the surface's size) into its own lobe so that the sheets
+/// no longer touch. Small self-intersections of a scan (folded triangles) are
+/// undone by smoothing the points around them, as little as it takes; pieces
+/// lying entirely inside another piece are removed. Throws InputError for what cannot be repaired safely: an
+/// open surface (boundary edges), fewer than 4 triangles, non-finite
+/// coordinates, a surface of no volume.
+TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& report);
+}

@@ -1,0 +1,30 @@
+// Intersection tests between triangles of one mesh (shared corners allowed).
+#pragma once
+
+#include "MeshTypes.h"
+
+#include <array>
+
+namespace md
+{
+/// Does the segment pq cross triangle abc? eps > 0 counts touching (within
+/// eps of the barycentric range) as crossing, eps < 0 requires a clear crossing.
+bool SegmentHitsTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
+  const Eigen::Vector3d& b, const Eigen::Vector3d& c, double eps);
+
+/// Do two triangles of one mesh (corner indices fx, fy; positions x, y)
+/// intersect anywhere but at what they share? Triangles sharing an edge are
+/// not tested (that is a matter of folding); coplanar overlaps are not found.
+bool TrianglesIntersect(const std::array<Eigen::Vector3d, 3>& x, const std::array<int, 3>& fx,
+  const std::array<Eigen::Vector3d, 3>& y, const std::array<int, 3>& fy);
+}
+
+#include <utility>
+#include <vector>
+
+namespace md
+{
+/// Every pair (s < t) of triangles of the mesh that intersect other than at
+/// what they share, found through a uniform grid of triangle bounds.
+std::vector<std::pair<int, int>> FindSelfIntersections(const Points& points, const Triangles& triangles);
+}
