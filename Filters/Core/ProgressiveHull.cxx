@@ -533,7 +533,10 @@ private:
   /// Reads the mesh only, so edges can be costed in parallel.
   std::optional<Candidate> Evaluate(int a, int b) const
   {
-    std::vector<int> star(this->VF[a].begin(), this->VF[a].end());
+    // Reused per thread: costing runs in parallel and allocates nothing.
+    thread_local std::vector<int> star;
+    thread_local std::vector<HalfSpace> halfSpaces;
+    star.assign(this->VF[a].begin(), this->VF[a].end());
     for (int f : this->VF[b])
     {
       if (std::find(this->VF[a].begin(), this->VF[a].end(), f) == this->VF[a].end())
@@ -541,8 +544,7 @@ private:
         star.push_back(f);
       }
     }
-    std::vector<HalfSpace> halfSpaces;
-    halfSpaces.reserve(star.size());
+    halfSpaces.clear();
     Vec3 objective = Vec3::Zero();
     const double margin = 1e-10 * this->Size; // rounding never puts the point below a plane
     for (int f : star)

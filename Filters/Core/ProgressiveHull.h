@@ -40,7 +40,7 @@ struct HullResult
 /// it intersect itself.
 ///
 /// `enclose` (optional): points that must end inside the hull besides the
-/// surface, such as RepairReport::originalPositionsOfMovedPoints. Each one the
+/// surface, such as RepairReport::pointsToEnclose. Each one the
 /// surface leaves out first becomes a surface point (a small fan replaces the
 /// nearest triangles facing it) and decimation keeps it inside from then on.
 HullResult BuildProgressiveHull(

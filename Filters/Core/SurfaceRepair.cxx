@@ -26,6 +26,28 @@ std::uint64_t EdgeKey(std::int64_t a, std::int64_t b)
   return (lo << 32) | hi;
 }
 
+struct CoordinateHash
+{
+  size_t operator()(const std::array<double, 3>& p) const
+  {
+    size_t h = 0;
+    for (double c : p)
+    {
+      h = h * 1000003u ^ std::hash<double>()(c);
+    }
+    return h;
+  }
+};
+
+struct TriangleHash
+{
+  size_t operator()(const Triangle& t) const
+  {
+    return static_cast<size_t>(t[0]) * 73856093u ^ static_cast<size_t>(t[1]) * 19349663u ^
+      static_cast<size_t>(t[2]) * 83492791u;
+  }
+};
+
 /// Triangles incident to each undirected edge.
 std::unordered_map<std::uint64_t, std::vector<int>> EdgeFaces(const std::vector<Triangle>& triangles)
 {
@@ -299,7 +321,7 @@ void UntangleSelfIntersections(TriangleMesh& mesh, RepairReport& report)
     }
     report.largestSmoothingShift = std::max(report.largestSmoothingShift, shift);
   }
-  AppendRows(report.originalPositionsOfMovedPoints, movedFrom);
+  AppendRows(report.pointsToEnclose, movedFrom);
 }
 
 /// Removes the connected pieces whose every point lies inside another piece.
@@ -448,7 +470,7 @@ std::string RepairReport::Describe() const
 TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& report)
 {
   report = RepairReport{};
-  report.originalPositionsOfMovedPoints.resize(0, 3);
+  report.pointsToEnclose.resize(0, 3);
   if (!AllFinite(surface.points))
   {
     throw InputError("the surface has non-finite (NaN or infinite) coordinates");
@@ -468,7 +490,8 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
   // Merge points at identical coordinates.
   std::vector<std::int64_t> representative(static_cast<size_t>(pointCount));
   {
-    std::map<std::array<double, 3>, std::int64_t> first;
+    std::unordered_map<std::array<double, 3>, std::int64_t, CoordinateHash> first;
+    first.reserve(static_cast<size_t>(pointCount));
     for (std::int64_t i = 0; i < pointCount; ++i)
     {
       const std::array<double, 3> key{ surface.points(i, 0), surface.points(i, 1), surface.points(i, 2) };
@@ -484,7 +507,8 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
   // collapsed bubble) goes entirely.
   std::vector<Triangle> kept;
   {
-    std::map<Triangle, int> seen; // sorted points -> index in kept
+    std::unordered_map<Triangle, int, TriangleHash> seen; // sorted points -> index in kept
+    seen.reserve(static_cast<size_t>(surface.triangles.rows()));
     std::vector<bool> fin;
     for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t)
     {
@@ -544,7 +568,8 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
   }
   if (triangles.size() < 4)
   {
-    throw InputError("the surface has fewer than 4 usable triangles");
+    throw InputError("the surface has fewer than 4 usable triangles once degenerate, duplicate and "
+                     "back-to-back ones are removed: it is flat or degenerate");
   }
 
   // Holes cannot be closed safely.
@@ -684,8 +709,16 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
       facesOfPoint[p].push_back(t);
     }
   }
-  std::vector<Eigen::RowVector3d> copies;
   const double separation = 1e-6 * size;
+  // First every point's fans, on the triangles as they are (the neighbour
+  // look-up goes by the original point indices); then the copies.
+  struct Split
+  {
+    std::int64_t point;
+    std::vector<std::pair<int, int>> fanOfTriangle; // (triangle, fan)
+    std::vector<Eigen::Vector3d> fanNormal;
+  };
+  std::vector<Split> splits;
   for (std::int64_t p = 0; p < static_cast<std::int64_t>(facesOfPoint.size()); ++p)
   {
     std::map<int, int> fanOf; // triangle -> fan
@@ -723,37 +756,35 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
     {
       continue;
     }
-    std::vector<Eigen::Vector3d> fanNormal(static_cast<size_t>(fans), Eigen::Vector3d::Zero());
+    Split split{ p, {}, std::vector<Eigen::Vector3d>(static_cast<size_t>(fans), Eigen::Vector3d::Zero()) };
     for (const auto& [t, fan] : fanOf)
     {
       const Triangle& tri = triangles[t];
-      fanNormal[fan] += (points.row(tri[1]) - points.row(tri[0])).transpose().cross(
+      split.fanNormal[fan] += (points.row(tri[1]) - points.row(tri[0])).transpose().cross(
         (points.row(tri[2]) - points.row(tri[0])).transpose());
+      split.fanOfTriangle.emplace_back(t, fan);
     }
-    const Eigen::RowVector3d original = points.row(p);
-    AppendRows(report.originalPositionsOfMovedPoints, { original });
-    points.row(p) = original - separation * fanNormal[0].normalized().transpose();
-    for (int fan = 1; fan < fans; ++fan)
+    splits.push_back(std::move(split));
+  }
+  for (const Split& split : splits)
+  {
+    const std::int64_t p = split.point;
+    const Eigen::RowVector3d original = surface.points.row(p);
+    AppendRows(report.pointsToEnclose, { original });
+    points.row(p) = original - separation * split.fanNormal[0].normalized().transpose();
+    for (int fan = 1; fan < static_cast<int>(split.fanNormal.size()); ++fan)
     {
-      const std::int64_t copy = static_cast<std::int64_t>(facesOfPoint.size() + copies.size());
-      copies.push_back(original - separation * fanNormal[fan].normalized().transpose());
+      const std::int64_t copy = points.rows();
+      points.conservativeResize(copy + 1, 3);
+      points.row(copy) = original - separation * split.fanNormal[fan].normalized().transpose();
       ++report.pointsDuplicatedAtPinches;
-      for (const auto& [t, f] : fanOf)
+      for (const auto& [t, f] : split.fanOfTriangle)
       {
         if (f == fan)
         {
           std::replace(triangles[t].begin(), triangles[t].end(), p, copy);
         }
       }
-    }
-  }
-  if (!copies.empty())
-  {
-    const Eigen::Index old = points.rows();
-    points.conservativeResize(old + static_cast<Eigen::Index>(copies.size()), 3);
-    for (size_t i = 0; i < copies.size(); ++i)
-    {
-      points.row(old + static_cast<Eigen::Index>(i)) = copies[i];
     }
   }
 
@@ -769,6 +800,26 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
         newIndex[p] = next++;
       }
     }
+  }
+  // Points the input's triangles used but the repaired surface dropped.
+  {
+    std::vector<char> usedInInput(static_cast<size_t>(pointCount), 0);
+    for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        usedInInput[surface.triangles(t, k)] = 1;
+      }
+    }
+    std::vector<Eigen::RowVector3d> dropped;
+    for (std::int64_t i = 0; i < pointCount; ++i)
+    {
+      if (usedInInput[i] && newIndex[representative[i]] < 0)
+      {
+        dropped.push_back(surface.points.row(i));
+      }
+    }
+    AppendRows(report.pointsToEnclose, dropped);
   }
   TriangleMesh out;
   out.points.resize(next, 3);

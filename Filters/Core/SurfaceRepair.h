@@ -23,9 +23,10 @@ struct RepairReport
   double largestSmoothingShift = 0;            ///< farthest such move
   std::int64_t selfIntersectionsLeft = 0;      ///< crossing pairs smoothing could not undo
   std::int64_t enclosedPiecesRemoved = 0;      ///< separate pieces lying inside another piece
-  /// Where the moved points were: the points a hull of the repaired surface
-  /// must enclose besides it (see BuildProgressiveHull).
-  Points originalPositionsOfMovedPoints;
+  /// Points of the input surface that the repaired one does not carry where
+  /// they were (moved by smoothing or at pinches, or dropped with a fin): a
+  /// hull of the repaired surface must enclose them too (BuildProgressiveHull).
+  Points pointsToEnclose;
 
   bool Changed() const
   {

@@ -87,7 +87,7 @@ void Measure(const std::string& name, const md::TriangleMesh& muscle, int target
   parameters.targetNumberOfPoints = target;
   start = std::chrono::steady_clock::now();
   const md::HullResult result =
-    md::BuildProgressiveHull(clean, parameters, &report.originalPositionsOfMovedPoints);
+    md::BuildProgressiveHull(clean, parameters, &report.pointsToEnclose);
   const double hullTime = Seconds(start);
   const md::TriangleMesh& hull = result.hull;
 
