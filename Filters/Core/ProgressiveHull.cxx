@@ -114,7 +114,12 @@ private:
       {
         continue; // stale: its neighbourhood changed since it was costed
       }
-      if (!this->Collapse(top.a, top.b, top.position))
+      if (top.placeholder)
+      {
+        this->Push(top.a, top.b); // cost it now, against the mesh as it is
+        continue;
+      }
+      if (!this->Collapse(top.a, top.b, top.position, top.cost))
       {
         ++result.rejectedCollapses;
         continue; // re-costed when its neighbourhood next changes
@@ -377,6 +382,7 @@ private:
     int a, b;
     unsigned stampA, stampB;
     Vec3 position;
+    bool placeholder = false; // cost a guess: evaluate when popped
     bool operator<(const Candidate& other) const { return this->cost > other.cost; } // min-heap
   };
 
@@ -522,11 +528,25 @@ private:
   // --- costing: least added volume, outside every plane around the edge
   void Push(int a, int b)
   {
-    std::optional<Candidate> candidate = this->Evaluate(a, b);
+    this->PushCosted(this->Evaluate(a, b), a, b);
+  }
+
+  void PushCosted(const std::optional<Candidate>& candidate, int a, int b)
+  {
     if (candidate)
     {
       this->Heap.push(*candidate);
+      this->LastCost[EdgeKey(a, b)] = candidate->cost;
     }
+    else
+    {
+      this->LastCost.erase(EdgeKey(a, b));
+    }
+  }
+
+  static std::uint64_t EdgeKey(int a, int b)
+  {
+    return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
   }
 
   /// The cost and position of collapsing edge a-b, if a position exists.
@@ -598,11 +618,11 @@ private:
       }
       added += height / 6.0;
     }
-    return Candidate{ added, a, b, this->Stamp[a], this->Stamp[b], *position };
+    return Candidate{ added, a, b, this->Stamp[a], this->Stamp[b], *position, false };
   }
 
   // --- the collapse itself, after every check
-  bool Collapse(int a, int b, const Vec3& position)
+  bool Collapse(int a, int b, const Vec3& position, double cost)
   {
     // Link condition: a and b share exactly the two neighbours across their edge.
     std::vector<int> shared;
@@ -679,8 +699,10 @@ private:
     }
     this->MaintainGrid();
 
-    // Re-cost every edge whose neighbourhood changed: the edges of a and of
-    // its neighbours, each once, in parallel (then pushed in a fixed order).
+    // Every edge whose neighbourhood changed needs a new cost: the edges of a
+    // now (in parallel, pushed in a fixed order); the other edges of its
+    // neighbours lazily, as placeholders at their last cost (or this one's)
+    // that are costed when they come to the top, perhaps after more changes.
     std::vector<int> ring = this->Neighbours(a);
     ring.push_back(a);
     std::sort(ring.begin(), ring.end());
@@ -690,30 +712,41 @@ private:
     }
     std::vector<std::pair<int, int>>& edges = this->EdgeBuffer;
     edges.clear();
-    for (int v : ring)
+    for (int w : this->Neighbours(a))
     {
-      for (int w : this->Neighbours(v))
-      {
-        // An edge between two ring points is listed from its smaller end only.
-        if (!std::binary_search(ring.begin(), ring.end(), w) || v < w)
-        {
-          edges.emplace_back(std::min(v, w), std::max(v, w));
-        }
-      }
+      edges.emplace_back(std::min(a, w), std::max(a, w));
     }
     std::vector<std::optional<Candidate>>& costed = this->CandidateBuffer;
     costed.assign(edges.size(), std::nullopt);
     const auto count = static_cast<long>(edges.size());
-#pragma omp parallel for schedule(static) if (count > 16)
+#pragma omp parallel for schedule(static) if (count > 8)
     for (long i = 0; i < count; ++i)
     {
       costed[i] = this->Evaluate(edges[i].first, edges[i].second);
     }
-    for (const std::optional<Candidate>& candidate : costed)
+    for (size_t i = 0; i < edges.size(); ++i)
     {
-      if (candidate)
+      this->PushCosted(costed[i], edges[i].first, edges[i].second);
+    }
+    for (int v : ring)
+    {
+      if (v == a)
       {
-        this->Heap.push(*candidate);
+        continue;
+      }
+      for (int w : this->Neighbours(v))
+      {
+        // Edges of a are costed above; an edge between two neighbours once.
+        if (w == a || (std::binary_search(ring.begin(), ring.end(), w) && w < v))
+        {
+          continue;
+        }
+        auto last = this->LastCost.find(EdgeKey(v, w));
+        const double guess = last != this->LastCost.end() ? std::max(last->second, cost) : cost;
+        Candidate placeholder{ guess, std::min(v, w), std::max(v, w), 0, 0, Vec3::Zero(), true };
+        placeholder.stampA = this->Stamp[placeholder.a];
+        placeholder.stampB = this->Stamp[placeholder.b];
+        this->Heap.push(placeholder);
       }
     }
     return true;
@@ -933,6 +966,7 @@ private:
   std::vector<char> Folded; // input triangles that cross another (indexed by face id)
   std::vector<std::pair<int, int>> EdgeBuffer;              // edges to re-cost after a collapse
   std::vector<std::optional<Candidate>> CandidateBuffer;   // their costs
+  std::unordered_map<std::uint64_t, double> LastCost;      // latest cost of each edge
   std::vector<int> NearbyBuffer;          // reused by NewFacesAcceptable
   std::vector<unsigned> VisitedFace;      // last Visit that gathered each face
   std::vector<unsigned> ReplacedMark;     // Visit in which a face is being replaced

@@ -40,7 +40,7 @@ class ServerManagerXML(unittest.TestCase):
                                     "%s.%s has no documentation" % (name, prop.get("name")))
 
     def test_proxies_have_the_names_users_rely_on(self):
-        for name in ("MusculoskeletalPhantom", "ActionLineMatching", "BoneInterpolation"):
+        for name in ("MusculoskeletalPhantom", "ActionLineMatching", "BoneInterpolation", "HullDecimation"):
             self.assertTrue(hasattr(simple, name), name)
         matching = simple.ActionLineMatching()
         self.assertAlmostEqual(matching.Tolerance, 0.01)
@@ -103,6 +103,25 @@ class Pipeline(unittest.TestCase):
         bones.UpdatePipelineInformation()
         self.assertGreater(len(bones.TimestepValues), 6)
         simple.Delete(bones)
+
+    def test_hull_decimation_encloses_every_muscle(self):
+        hulls = simple.HullDecimation(Input=simple.OutputPort(self.phantom, 0), TargetNumberOfPoints=120)
+        with mdtesting.CapturedMessages() as messages:
+            hulls.UpdatePipeline()
+        self.assertEqual(messages.text, "")
+        data = servermanager.Fetch(hulls)
+        for name in ("Iliopsoas", "GluteusMaximus", "RectusFemoris"):
+            hull = block(data, name)
+            self.assertEqual(hull.GetNumberOfPoints(), 120, name)
+            fields = hull.GetFieldData()
+            self.assertEqual(fields.GetArray("PointsOutsideHull").GetValue(0), 0, name)
+            self.assertEqual(fields.GetArray("HullSelfIntersections").GetValue(0), 0, name)
+            self.assertGreaterEqual(fields.GetArray("HullVolumeRatio").GetValue(0), 1.0, name)
+        hulls.TargetNumberOfPoints = 5000
+        with mdtesting.CapturedMessages() as messages:
+            hulls.UpdatePipeline()
+        self.assertIn("is larger than the surface's", messages.text)
+        simple.Delete(hulls)
 
     def test_bad_input_reports_the_block_and_recovers(self):
         bones = simple.BoneInterpolation(Input=simple.OutputPort(self.phantom, 1),
