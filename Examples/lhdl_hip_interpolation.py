@@ -7,7 +7,7 @@ Run with pvpython (under xvfb-run on a machine without a display):
 Reads ../shared/data/lhdl_hip_r (or --data / $MUSCLEDEFORMATION_DATA_DIR); the pelvis bones stay,
 the femur and the action-line points fixed to it move by the frame's transform
 (femur_transforms.csv; frame 35 of hip_flexion is 60 degrees). Writes lhdl_rest.png,
-lhdl_current.png, lhdl_step_<j>.png, the meshes as .vtp and figures.json. Exits with code 77
+lhdl_current.png, lhdl_hulls.png, lhdl_step_<j>.png, the meshes as .vtp and figures.json. Exits with code 77
 (skipped) when the data is absent.
 """
 import argparse

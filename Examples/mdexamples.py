@@ -170,6 +170,7 @@ def interpolation_pipeline(inputs, steps=4, mode="Rigid"):
     # move with different bodies, so they are interpolated linearly.
     pipeline["lines"] = simple.BoneInterpolation(Input=simple.OutputPort(pipeline["matching"], 0),
                                                  NumberOfSteps=steps, InterpolationMode="Linear")
+    pipeline["hulls"] = simple.HullDecimation(Input=inputs["muscles"])
     return pipeline
 
 
@@ -179,6 +180,16 @@ def show_pose(view, pipeline, pose):
     show_surface(pipeline["bones_" + pose], view, BONE_COLOUR)
     show_surface(pipeline["muscles"], view, MUSCLE_COLOURS[0], opacity=0.45)
     show_lines(pipeline["lines_" + pose], view, LINE_COLOUR if pose == "rest" else CURRENT_LINE_COLOUR)
+
+
+def show_hulls(view, pipeline):
+    """The muscles with their coarse hulls as wireframes, over the rest-pose bones."""
+    hide_all(view)
+    show_surface(pipeline["bones_rest"], view, BONE_COLOUR, opacity=0.35)
+    show_surface(pipeline["muscles"], view, MUSCLE_COLOURS[0])
+    display = _show_in_colour(pipeline["hulls"], view, LINE_COLOUR, None)
+    display.Representation = "Wireframe"
+    display.LineWidth = 1.5
 
 
 def show_steps(view, pipeline):
@@ -217,6 +228,9 @@ def run(pipeline, view, camera, output, prefix):
         show_pose(view, pipeline, pose)
         camera(view)
         images.append(screenshot(view, os.path.join(output, "%s_%s.png" % (prefix, pose))))
+    show_hulls(view, pipeline)
+    camera(view)
+    images.append(screenshot(view, os.path.join(output, "%s_hulls.png" % prefix)))
     show_steps(view, pipeline)
     camera(view)
     figures = {"number_of_steps": steps, "steps": []}
@@ -232,6 +246,12 @@ def run(pipeline, view, camera, output, prefix):
         write_blocks(bones, output, "bones_step_%d" % step, time=step)
         write_blocks(lines, output, "action_lines_step_%d" % step, time=step)
     write_blocks(pipeline["muscles"], output, "muscles_rest")
+    write_blocks(pipeline["hulls"], output, "hull")
+    hulls = servermanager.Fetch(pipeline["hulls"])
+    figures["hulls"] = {
+        name: {field: _field_value(hulls, field).get(name)
+               for field in ("HullVolumeRatio", "PointsOutsideHull", "HullSelfIntersections", "ElapsedSeconds")}
+        for name in _field_value(hulls, "HullVolumeRatio")}
     write_blocks(pipeline["bones_rest"], output, "bones_rest")
     write_blocks(pipeline["bones_current"], output, "bones_current")
     write_blocks(matching, output, "action_lines_matched_rest", port=0)

@@ -6,7 +6,8 @@ Run with pvpython (under xvfb-run on a machine without a display):
 
 Writes, into the output folder: phantom_rest.png and phantom_current.png (bones, muscles and
 action lines in the rest and the current pose), phantom_step_<j>.png for every interpolation
-step j = 0..N, the meshes of every block as .vtp, and figures.json.
+step j = 0..N, phantom_hulls.png (the muscles' coarse hulls), the meshes of every block as
+.vtp, and figures.json.
 """
 import argparse
 import json

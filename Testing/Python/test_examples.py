@@ -39,13 +39,16 @@ class PhantomExample(unittest.TestCase):
         self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
         self.assertIn(os.path.abspath(output), result.stdout)
         pictures = sorted(glob.glob(os.path.join(output, "phantom_*.png")))
-        self.assertEqual(len(pictures), 2 + 4, pictures)
+        self.assertEqual(len(pictures), 3 + 4, pictures)
         for picture in pictures:
             self.assertGreater(non_white_fraction(picture), 0.02, picture)
         with open(os.path.join(output, "figures.json")) as f:
             figures = json.load(f)
         self.assertEqual(figures["number_of_steps"], 3)
         self.assertAlmostEqual(figures["steps"][3]["rotation_degrees_of_rigid_fit_per_block"]["Femur"], 45.0)
+        for name, hull in figures["hulls"].items():
+            self.assertEqual(hull["PointsOutsideHull"], 0, name)
+            self.assertEqual(hull["HullSelfIntersections"], 0, name)
         reader = vtkXMLPolyDataReader()
         reader.SetFileName(os.path.join(output, "bones_step_3_Femur.vtp"))
         reader.Update()

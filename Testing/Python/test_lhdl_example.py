@@ -18,7 +18,7 @@ class LhdlExample(unittest.TestCase):
         result = run_example("lhdl_hip_interpolation.py", output, "--motion", "hip_flexion", "--frame", "35")
         self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
         pictures = sorted(glob.glob(os.path.join(output, "lhdl_*.png")))
-        self.assertEqual(len(pictures), 2 + 5)
+        self.assertEqual(len(pictures), 3 + 5)
         for picture in pictures:
             self.assertGreater(non_white_fraction(picture), 0.02, picture)
         with open(os.path.join(output, "figures.json")) as f:
@@ -27,6 +27,10 @@ class LhdlExample(unittest.TestCase):
         last = figures["steps"][-1]
         self.assertAlmostEqual(last["rotation_degrees_of_rigid_fit_per_block"]["femur_r"], 58.598, places=2)
         self.assertLess(last["rotation_degrees_of_rigid_fit_per_block"]["iliac_r"], 1e-9)
+        self.assertEqual(set(figures["hulls"]), {"gluteus_maximus_r", "gluteus_medius_r", "iliacus_r", "psoas_r"})
+        for name, hull in figures["hulls"].items():
+            self.assertEqual(hull["PointsOutsideHull"], 0, name)
+            self.assertEqual(hull["HullSelfIntersections"], 0, name)
         # psoas and iliacus lose their conditional via point beyond 40 and 54 degrees of flexion.
         rest, current = figures["action_line_points_rest"], figures["action_line_points_current"]
         matched = figures["matched_action_line_points"]
