@@ -5,6 +5,8 @@
 #include <vtkCompositeDataSet.h>
 #include <vtkDataObjectTreeIterator.h>
 #include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkIntArray.h>
 #include <vtkIdList.h>
 #include <vtkInformation.h>
 #include <vtkMultiBlockDataSet.h>
@@ -35,6 +37,27 @@ void ForEachLeaf(vtkMultiBlockDataSet* tree, Visitor&& visit)
     visit(it.Get());
   }
 }
+}
+
+void AddFieldValue(vtkFieldData* fieldData, const char* name, double value)
+{
+  vtkNew<vtkDoubleArray> array;
+  array->SetName(name);
+  array->InsertNextValue(value);
+  fieldData->AddArray(array);
+}
+
+void AddFieldValue(vtkFieldData* fieldData, const char* name, int value)
+{
+  vtkNew<vtkIntArray> array;
+  array->SetName(name);
+  array->InsertNextValue(value);
+  fieldData->AddArray(array);
+}
+
+void AddFieldValue(vtkFieldData* fieldData, const char* name, std::int64_t value)
+{
+  AddFieldValue(fieldData, name, static_cast<int>(value));
 }
 
 void AcceptPolyDataOrMultiBlock(vtkInformation* info)

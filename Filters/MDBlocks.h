@@ -11,6 +11,7 @@
 #include <vector>
 
 class vtkDataObject;
+class vtkFieldData;
 class vtkInformation;
 class vtkInformationVector;
 class vtkPoints;
@@ -45,6 +46,11 @@ bool PairLeaves(const std::vector<Leaf>& a, const std::string& nameA, const std:
 /// output gets the input's structure and block names.
 void AssignLeaves(vtkDataObject* input, vtkDataObject* output,
   const std::vector<vtkSmartPointer<vtkPolyData>>& results);
+
+/// Adds a one-value array to field data (a double, or an int for counts).
+void AddFieldValue(vtkFieldData* fieldData, const char* name, double value);
+void AddFieldValue(vtkFieldData* fieldData, const char* name, int value);
+void AddFieldValue(vtkFieldData* fieldData, const char* name, std::int64_t value);
 
 /// Accept vtkPolyData or vtkMultiBlockDataSet on an input port.
 void AcceptPolyDataOrMultiBlock(vtkInformation* info);

@@ -56,21 +56,6 @@ bool SameTopology(vtkPolyData* rest, vtkPolyData* current)
     SameCells(rest->GetStrips(), current->GetStrips());
 }
 
-void AddValue(vtkFieldData* fieldData, const char* name, double value)
-{
-  vtkNew<vtkDoubleArray> array;
-  array->SetName(name);
-  array->InsertNextValue(value);
-  fieldData->AddArray(array);
-}
-
-void AddValue(vtkFieldData* fieldData, const char* name, int value)
-{
-  vtkNew<vtkIntArray> array;
-  array->SetName(name);
-  array->InsertNextValue(value);
-  fieldData->AddArray(array);
-}
 }
 
 vtkBoneInterpolation::vtkBoneInterpolation()
@@ -280,9 +265,9 @@ int vtkBoneInterpolation::RequestData(
       if (interpolator.Fit())
       {
         const md::RigidFit& fit = *interpolator.Fit();
-        AddValue(fieldData, "RigidFitRMSResidual", fit.rmsResidual);
-        AddValue(fieldData, "RigidFitMaxResidual", fit.maxResidual);
-        AddValue(fieldData, "RotationAngleDegrees", vtkMath::DegreesFromRadians(interpolator.RotationAngle()));
+        mdvtk::AddFieldValue(fieldData, "RigidFitRMSResidual", fit.rmsResidual);
+        mdvtk::AddFieldValue(fieldData, "RigidFitMaxResidual", fit.maxResidual);
+        mdvtk::AddFieldValue(fieldData, "RotationAngleDegrees", vtkMath::DegreesFromRadians(interpolator.RotationAngle()));
         double bounds[6];
         pose.restData->GetBounds(bounds);
         const double diagonal = std::sqrt(vtkMath::Distance2BetweenPoints(
@@ -304,9 +289,9 @@ int vtkBoneInterpolation::RequestData(
       return 0;
     }
     output->SetPoints(mdvtk::ToVtkPoints(positions));
-    AddValue(fieldData, "InterpolationStep", step);
-    AddValue(fieldData, "NumberOfSteps", steps);
-    AddValue(fieldData, "InterpolationFraction", static_cast<double>(step) / steps);
+    mdvtk::AddFieldValue(fieldData, "InterpolationStep", step);
+    mdvtk::AddFieldValue(fieldData, "NumberOfSteps", steps);
+    mdvtk::AddFieldValue(fieldData, "InterpolationFraction", static_cast<double>(step) / steps);
     results[b] = output;
   }
   vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);

@@ -25,22 +25,6 @@ vtkStandardNewMacro(vtkHullDecimation);
 
 namespace
 {
-void AddValue(vtkFieldData* fieldData, const char* name, double value)
-{
-  vtkNew<vtkDoubleArray> array;
-  array->SetName(name);
-  array->InsertNextValue(value);
-  fieldData->AddArray(array);
-}
-
-void AddCount(vtkFieldData* fieldData, const char* name, std::int64_t value)
-{
-  vtkNew<vtkIntArray> array;
-  array->SetName(name);
-  array->InsertNextValue(static_cast<int>(value));
-  fieldData->AddArray(array);
-}
-
 /// The polygons of `input` as triangles (polygons and strips triangulated).
 /// Returns the number of cells that were not triangles.
 vtkIdType ReadTriangles(vtkPolyData* input, md::TriangleMesh& mesh)
@@ -73,27 +57,6 @@ vtkIdType ReadTriangles(vtkPolyData* input, md::TriangleMesh& mesh)
   return converted;
 }
 
-/// The points the triangles use (input files may carry others).
-md::Points UsedPoints(const md::TriangleMesh& mesh)
-{
-  std::vector<char> used(static_cast<size_t>(mesh.points.rows()), 0);
-  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
-  {
-    for (int k = 0; k < 3; ++k)
-    {
-      used[mesh.triangles(t, k)] = 1;
-    }
-  }
-  md::Points out(std::count(used.begin(), used.end(), 1), 3);
-  for (Eigen::Index i = 0, next = 0; i < mesh.points.rows(); ++i)
-  {
-    if (used[i])
-    {
-      out.row(next++) = mesh.points.row(i);
-    }
-  }
-  return out;
-}
 }
 
 int vtkHullDecimation::FillInputPortInformation(int, vtkInformation* info)
@@ -168,11 +131,11 @@ int vtkHullDecimation::RequestData(
     vtkFieldData* fieldData = output->GetFieldData();
     const double hullVolume = md::SignedVolume(hull.hull.points, hull.hull.triangles);
     const double muscleVolume = md::SignedVolume(clean.points, clean.triangles);
-    AddValue(fieldData, "HullVolume", hullVolume);
-    AddValue(fieldData, "MuscleVolume", muscleVolume);
-    AddValue(fieldData, "HullVolumeRatio", hullVolume / muscleVolume);
-    AddCount(fieldData, "NumberOfCollapses", hull.collapses);
-    AddValue(fieldData, "ElapsedSeconds", seconds);
+    mdvtk::AddFieldValue(fieldData, "HullVolume", hullVolume);
+    mdvtk::AddFieldValue(fieldData, "MuscleVolume", muscleVolume);
+    mdvtk::AddFieldValue(fieldData, "HullVolumeRatio", hullVolume / muscleVolume);
+    mdvtk::AddFieldValue(fieldData, "NumberOfCollapses", hull.collapses);
+    mdvtk::AddFieldValue(fieldData, "ElapsedSeconds", seconds);
     if (report.Changed() || converted > 0)
     {
       vtkNew<vtkStringArray> repairs;
@@ -183,10 +146,10 @@ int vtkHullDecimation::RequestData(
     if (this->VerifyEnclosure)
     {
       const double size = (muscle.points.colwise().maxCoeff() - muscle.points.colwise().minCoeff()).norm();
-      const std::int64_t outside = md::CountOutside(hull.hull, UsedPoints(muscle), 1e-9 * size);
+      const std::int64_t outside = md::CountOutside(hull.hull, md::UsedPoints(muscle), 1e-9 * size);
       const std::int64_t crossings = md::CountSelfIntersections(hull.hull);
-      AddCount(fieldData, "PointsOutsideHull", outside);
-      AddCount(fieldData, "HullSelfIntersections", crossings);
+      mdvtk::AddFieldValue(fieldData, "PointsOutsideHull", outside);
+      mdvtk::AddFieldValue(fieldData, "HullSelfIntersections", crossings);
       if (outside > 0 || crossings > 0)
       {
         vtkWarningMacro(<< "the hull of " << leaf.label << " leaves " << outside << " muscle points outside and has "

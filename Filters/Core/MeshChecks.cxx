@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <unordered_map>
+#include <vector>
 
 namespace md
 {
@@ -161,6 +162,27 @@ std::int64_t CountOutside(const TriangleMesh& surface, const Points& points, dou
     outside += near ? 0 : 1;
   }
   return outside;
+}
+
+Points UsedPoints(const TriangleMesh& mesh)
+{
+  std::vector<char> used(static_cast<size_t>(mesh.points.rows()), 0);
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      used[mesh.triangles(t, k)] = 1;
+    }
+  }
+  Points out(std::count(used.begin(), used.end(), 1), 3);
+  for (Eigen::Index i = 0, next = 0; i < mesh.points.rows(); ++i)
+  {
+    if (used[i])
+    {
+      out.row(next++) = mesh.points.row(i);
+    }
+  }
+  return out;
 }
 
 std::int64_t CountSelfIntersections(const TriangleMesh& surface)

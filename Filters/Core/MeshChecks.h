@@ -45,6 +45,9 @@ double PointTriangleDistance(
 /// and farther than `tolerance` from every triangle. Every point is tested.
 std::int64_t CountOutside(const TriangleMesh& surface, const Points& points, double tolerance);
 
+/// The points the triangles use, in order (mesh files may carry others).
+Points UsedPoints(const TriangleMesh& mesh);
+
 /// Number of pairs of triangles that intersect other than at what they share.
 std::int64_t CountSelfIntersections(const TriangleMesh& surface);
 }

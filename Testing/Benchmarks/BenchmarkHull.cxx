@@ -7,21 +7,14 @@
 #include "MeshChecks.h"
 #include "Phantom.h"
 #include "ProgressiveHull.h"
+#include "RealData.h"
 #include "SurfaceRepair.h"
 
-#include <vtkCellArray.h>
-#include <vtkIdTypeArray.h>
-#include <vtkNew.h>
-#include <vtkPolyData.h>
-#include <vtkPolyDataReader.h>
-#include <vtkSTLReader.h>
-#include <vtkTriangleFilter.h>
 
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <algorithm>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -30,41 +23,6 @@ namespace
 double Seconds(std::chrono::steady_clock::time_point since)
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
-bool ReadSurface(const std::string& path, md::TriangleMesh& mesh)
-{
-  if (!std::ifstream(path).good())
-  {
-    return false;
-  }
-  vtkNew<vtkTriangleFilter> triangles;
-  if (path.size() > 4 && path.substr(path.size() - 4) == ".stl")
-  {
-    vtkNew<vtkSTLReader> reader;
-    reader->SetFileName(path.c_str());
-    triangles->SetInputConnection(reader->GetOutputPort());
-  }
-  else
-  {
-    vtkNew<vtkPolyDataReader> reader;
-    reader->SetFileName(path.c_str());
-    triangles->SetInputConnection(reader->GetOutputPort());
-  }
-  triangles->PassVertsOff();
-  triangles->PassLinesOff();
-  triangles->Update();
-  vtkPolyData* data = triangles->GetOutput();
-  mesh.points.resize(data->GetNumberOfPoints(), 3);
-  for (vtkIdType i = 0; i < data->GetNumberOfPoints(); ++i)
-  {
-    data->GetPoint(i, mesh.points.row(i).data());
-  }
-  vtkNew<vtkIdTypeArray> connectivity;
-  connectivity->DeepCopy(data->GetPolys()->GetConnectivityArray());
-  mesh.triangles.resize(data->GetNumberOfPolys(), 3);
-  std::copy(connectivity->GetPointer(0), connectivity->GetPointer(0) + mesh.triangles.size(), mesh.triangles.data());
-  return true;
 }
 
 void Measure(const std::string& name, const md::TriangleMesh& muscle, int target)
@@ -99,23 +57,7 @@ void Measure(const std::string& name, const md::TriangleMesh& muscle, int target
   const double sumError = (weights.rowwise().sum().array() - 1.0).abs().maxCoeff();
 
   // The muscle's points are those its triangles use (files carry unused ones too).
-  std::vector<char> used(static_cast<size_t>(muscle.points.rows()), 0);
-  for (Eigen::Index t = 0; t < muscle.triangles.rows(); ++t)
-  {
-    for (int k = 0; k < 3; ++k)
-    {
-      used[muscle.triangles(t, k)] = 1;
-    }
-  }
-  md::Points surfacePoints(std::count(used.begin(), used.end(), 1), 3);
-  for (Eigen::Index i = 0, next = 0; i < muscle.points.rows(); ++i)
-  {
-    if (used[i])
-    {
-      surfacePoints.row(next++) = muscle.points.row(i);
-    }
-  }
-  const std::int64_t outside = md::CountOutside(hull, surfacePoints, 1e-9 * size);
+  const std::int64_t outside = md::CountOutside(hull, md::UsedPoints(muscle), 1e-9 * size);
   const md::EdgeReport edges = md::CheckEdges(hull.triangles);
   const std::int64_t intersections = md::CountSelfIntersections(hull);
   const double ratio = md::SignedVolume(hull.points, hull.triangles) / md::SignedVolume(muscle.points, muscle.triangles);
@@ -159,12 +101,13 @@ int main(int argc, char** argv)
   int missing = 0;
   for (const std::string& file : files)
   {
-    md::TriangleMesh muscle;
-    if (!ReadSurface(data + "/" + file, muscle))
+    const std::string path = RealDataFile(file, data);
+    if (path.empty())
     {
       ++missing;
       continue;
     }
+    const md::TriangleMesh muscle = ReadSurface(path);
     Measure(file.substr(0, file.find('/')) + "/" + file.substr(file.rfind('/') + 1), muscle, target);
   }
   if (missing > 0)

@@ -2,6 +2,7 @@
 // Reads ../shared/data/lhdl_hip_r (MUSCLEDEFORMATION_DATA_DIR); skipped, and
 // reported as skipped by ctest, when the data is absent.
 #include "FilterTestUtilities.h"
+#include "RealData.h"
 
 #include "BoneInterpolation.h"
 #include "vtkBoneInterpolation.h"
@@ -18,13 +19,6 @@
 
 namespace
 {
-std::string DataFile(const std::string& relative)
-{
-  const char* dir = std::getenv("MUSCLEDEFORMATION_DATA_DIR");
-  const std::string path = std::string(dir ? dir : "") + "/" + relative;
-  return std::ifstream(path).good() ? path : std::string();
-}
-
 /// x_CP = R x_RP + t for one frame of femur_transforms.csv.
 bool ReadFemurTransform(const std::string& csv, const std::string& motion, int frame,
   Eigen::Matrix3d& rotation, Eigen::Vector3d& translation)
@@ -68,8 +62,8 @@ class RealFemur : public ::testing::Test
 protected:
   void SetUp() override
   {
-    const std::string femurFile = DataFile("lhdl_hip_r/femur_r.vtk");
-    const std::string transforms = DataFile("lhdl_hip_r/femur_transforms.csv");
+    const std::string femurFile = RealDataFile("lhdl_hip_r/femur_r.vtk");
+    const std::string transforms = RealDataFile("lhdl_hip_r/femur_transforms.csv");
     if (femurFile.empty() || transforms.empty())
     {
       GTEST_SKIP() << "real data not found: set MUSCLEDEFORMATION_DATA_DIR to the folder holding "

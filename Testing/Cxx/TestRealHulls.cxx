@@ -4,80 +4,15 @@
 #include "MeanValueCoordinates.h"
 #include "MeshChecks.h"
 #include "ProgressiveHull.h"
+#include "RealData.h"
 #include "SurfaceRepair.h"
 
-#include <vtkCellArray.h>
-#include <vtkIdTypeArray.h>
-#include <vtkNew.h>
-#include <vtkPolyData.h>
-#include <vtkPolyDataReader.h>
-#include <vtkSTLReader.h>
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <fstream>
 
 namespace
 {
-std::string DataFile(const std::string& relative)
-{
-  const char* dir = std::getenv("MUSCLEDEFORMATION_DATA_DIR");
-  const std::string path = std::string(dir ? dir : "") + "/" + relative;
-  return std::ifstream(path).good() ? path : std::string();
-}
-
-md::TriangleMesh Read(const std::string& path)
-{
-  vtkSmartPointer<vtkPolyData> data;
-  if (path.substr(path.size() - 4) == ".stl")
-  {
-    vtkNew<vtkSTLReader> reader;
-    reader->SetFileName(path.c_str());
-    reader->Update();
-    data = reader->GetOutput();
-  }
-  else
-  {
-    vtkNew<vtkPolyDataReader> reader;
-    reader->SetFileName(path.c_str());
-    reader->Update();
-    data = reader->GetOutput();
-  }
-  md::TriangleMesh mesh;
-  mesh.points.resize(data->GetNumberOfPoints(), 3);
-  for (vtkIdType i = 0; i < data->GetNumberOfPoints(); ++i)
-  {
-    data->GetPoint(i, mesh.points.row(i).data());
-  }
-  vtkNew<vtkIdTypeArray> connectivity;
-  connectivity->DeepCopy(data->GetPolys()->GetConnectivityArray());
-  mesh.triangles.resize(data->GetNumberOfPolys(), 3);
-  std::copy(connectivity->GetPointer(0), connectivity->GetPointer(0) + mesh.triangles.size(), mesh.triangles.data());
-  return mesh;
-}
-
-md::Points UsedPoints(const md::TriangleMesh& mesh)
-{
-  std::vector<char> used(static_cast<size_t>(mesh.points.rows()), 0);
-  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
-  {
-    for (int k = 0; k < 3; ++k)
-    {
-      used[mesh.triangles(t, k)] = 1;
-    }
-  }
-  md::Points out(std::count(used.begin(), used.end(), 1), 3);
-  for (Eigen::Index i = 0, next = 0; i < mesh.points.rows(); ++i)
-  {
-    if (used[i])
-    {
-      out.row(next++) = mesh.points.row(i);
-    }
-  }
-  return out;
-}
-
 class RealMuscleHull : public ::testing::TestWithParam<std::string>
 {
 };
@@ -85,13 +20,13 @@ class RealMuscleHull : public ::testing::TestWithParam<std::string>
 
 TEST_P(RealMuscleHull, EnclosesEveryPointIsClosedManifoldAndReproducesPoints)
 {
-  const std::string path = DataFile(GetParam());
+  const std::string path = RealDataFile(GetParam());
   if (path.empty())
   {
     GTEST_SKIP() << GetParam() << " not found: set MUSCLEDEFORMATION_DATA_DIR (default ../shared/data)";
   }
-  const md::TriangleMesh muscle = Read(path);
-  const md::Points points = UsedPoints(muscle);
+  const md::TriangleMesh muscle = ReadSurface(path);
+  const md::Points points = md::UsedPoints(muscle);
   const double size = (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
   md::RepairReport report;
   const md::TriangleMesh clean = md::RepairClosedSurface(muscle, report);
