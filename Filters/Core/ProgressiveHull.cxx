@@ -64,6 +64,10 @@ public:
 
   HullResult Run(const Points* enclose)
   {
+    if (enclose && enclose->rows() == 0)
+    {
+      enclose = nullptr;
+    }
     for (int v = 0; v < static_cast<int>(this->P.size()); ++v)
     {
       for (int w : this->Neighbours(v))
