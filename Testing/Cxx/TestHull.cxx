@@ -262,6 +262,24 @@ TEST(ProgressiveHull, EnclosesEveryPhantomMuscleWithAClosedManifoldHull)
   }
 }
 
+TEST(ProgressiveHull, WorksTheSameInMetresAndMillimetres)
+{
+  // All tolerances are relative to the surface's size.
+  const TriangleMesh millimetres = md::BuildPhantom(md::PhantomParameters{}).muscles[2].rest;
+  const TriangleMesh metres{ millimetres.points * 1e-3, millimetres.triangles };
+  for (const TriangleMesh* muscle : { &millimetres, &metres })
+  {
+    const md::HullResult result = md::BuildProgressiveHull(*muscle, md::HullParameters{});
+    EXPECT_TRUE(result.reachedTarget);
+    EXPECT_TRUE(md::CheckEdges(result.hull.triangles).IsClosedOrientedManifold());
+    EXPECT_EQ(md::CountSelfIntersections(result.hull), 0);
+    EXPECT_EQ(md::CountOutside(result.hull, muscle->points, 1e-9 * Size(muscle->points)), 0);
+    const double ratio = md::SignedVolume(result.hull.points, result.hull.triangles) /
+      md::SignedVolume(muscle->points, muscle->triangles);
+    EXPECT_NEAR(ratio, 1.03, 0.02);
+  }
+}
+
 TEST(ProgressiveHull, EnclosesExtraPointsItIsGiven)
 {
   const TriangleMesh muscle = md::BuildPhantom(md::PhantomParameters{}).muscles[0].rest;
