@@ -99,7 +99,7 @@ std::int64_t CountInside(const Points& points, const Triangles& triangles, const
   return inside;
 }
 
-double PointTriangleDistance(
+Eigen::Vector3d ClosestPointOnTriangle(
   const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c)
 {
   // Closest point by regions (Ericson, Real-Time Collision Detection, 5.1.5).
@@ -107,37 +107,43 @@ double PointTriangleDistance(
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0 && d2 <= 0)
   {
-    return ap.norm();
+    return a;
   }
   const Eigen::Vector3d bp = p - b;
   const double d3 = ab.dot(bp), d4 = ac.dot(bp);
   if (d3 >= 0 && d4 <= d3)
   {
-    return bp.norm();
+    return b;
   }
   const double vc = d1 * d4 - d3 * d2;
   if (vc <= 0 && d1 >= 0 && d3 <= 0)
   {
-    return (p - (a + d1 / (d1 - d3) * ab)).norm();
+    return a + d1 / (d1 - d3) * ab;
   }
   const Eigen::Vector3d cp = p - c;
   const double d5 = ab.dot(cp), d6 = ac.dot(cp);
   if (d6 >= 0 && d5 <= d6)
   {
-    return cp.norm();
+    return c;
   }
   const double vb = d5 * d2 - d1 * d6;
   if (vb <= 0 && d2 >= 0 && d6 <= 0)
   {
-    return (p - (a + d2 / (d2 - d6) * ac)).norm();
+    return a + d2 / (d2 - d6) * ac;
   }
   const double va = d3 * d6 - d5 * d4;
   if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
   {
-    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
+    return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
   }
   const double denominator = 1.0 / (va + vb + vc);
-  return (p - (a + ab * (vb * denominator) + ac * (vc * denominator))).norm();
+  return a + ab * (vb * denominator) + ac * (vc * denominator);
+}
+
+double PointTriangleDistance(
+  const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c)
+{
+  return (p - ClosestPointOnTriangle(p, a, b, c)).norm();
 }
 
 std::int64_t CountOutside(const TriangleMesh& surface, const Points& points, double tolerance)

@@ -37,6 +37,10 @@ double WindingNumber(const Points& points, const Triangles& triangles, const Eig
 /// Number of `queries` inside the closed surface (winding number > 0.5).
 std::int64_t CountInside(const Points& points, const Triangles& triangles, const Points& queries);
 
+/// The point of triangle abc closest to `p`.
+Eigen::Vector3d ClosestPointOnTriangle(
+  const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c);
+
 /// Distance from `p` to the triangle abc.
 double PointTriangleDistance(
   const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c);

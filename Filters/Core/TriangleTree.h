@@ -1,0 +1,61 @@
+// A bounding-volume hierarchy over the triangles of a closed surface, for the
+// queries intersection handling needs against obstacles (bones, other muscles):
+// first hit along a segment, inside or outside, closest point.
+#pragma once
+
+#include "MeshTypes.h"
+
+#include <optional>
+#include <vector>
+
+namespace md
+{
+class TriangleTree
+{
+public:
+  /// Builds the tree (median splits on the longest axis, a few triangles a
+  /// leaf). The mesh is copied: the tree stays valid whatever happens to it.
+  explicit TriangleTree(const TriangleMesh& mesh);
+
+  struct Hit
+  {
+    double t = 0;              ///< fraction of the segment, in [0, 1]
+    Eigen::Index triangle = -1;
+    Eigen::Vector3d point;
+  };
+  /// The first triangle the segment from `from` to `to` meets, if any.
+  std::optional<Hit> FirstHit(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
+
+  /// Whether p is inside the closed surface: the parity of crossings along
+  /// rays, decided by the majority of three directions so that a ray grazing
+  /// an edge or a point cannot decide alone.
+  bool Inside(const Eigen::Vector3d& p) const;
+
+  struct Closest
+  {
+    double distance = 0;
+    Eigen::Index triangle = -1;
+    Eigen::Vector3d point;
+  };
+  /// The point of the surface closest to p.
+  Closest ClosestPoint(const Eigen::Vector3d& p) const;
+
+  const TriangleMesh& Mesh() const { return this->Surface; }
+
+private:
+  struct Node
+  {
+    Eigen::Vector3d low, high;
+    int first = 0, count = 0; // leaf: triangles Order[first .. first + count)
+    int left = -1, right = -1;
+  };
+  int Build(int first, int count, int depth);
+  int CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, bool& grazed) const;
+
+  TriangleMesh Surface;
+  std::vector<Node> Nodes;
+  std::vector<Eigen::Index> Order;
+  std::vector<Eigen::Vector3d> Centroid;
+  double Size = 0;
+};
+}
