@@ -1,0 +1,124 @@
+#include "VolumeConstrainedSolver.h"
+
+#include <cmath>
+#include <vector>
+
+namespace md
+{
+SparseMatrix CotangentLaplacian(const TriangleMesh& mesh)
+{
+  const Eigen::Index n = mesh.points.rows();
+  std::vector<Eigen::Triplet<double>> cotangents; // c_ij, summed by setFromTriplets
+  std::vector<Eigen::Triplet<double>> adjacency;  // 1 per edge end, for the uniform fallback
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      const std::int64_t i = mesh.triangles(t, (k + 1) % 3), j = mesh.triangles(t, (k + 2) % 3);
+      const Eigen::Vector3d apex = mesh.points.row(mesh.triangles(t, k)).transpose();
+      const Eigen::Vector3d u = mesh.points.row(i).transpose() - apex;
+      const Eigen::Vector3d v = mesh.points.row(j).transpose() - apex;
+      const double sine = u.cross(v).norm();
+      const double cotangent = sine > 0 ? u.dot(v) / sine : 0.0;
+      cotangents.emplace_back(i, j, cotangent);
+      cotangents.emplace_back(j, i, cotangent);
+      adjacency.emplace_back(i, j, 0.5); // each edge is seen from two triangles
+      adjacency.emplace_back(j, i, 0.5);
+    }
+  }
+  SparseMatrix c(n, n), a(n, n);
+  c.setFromTriplets(cotangents.begin(), cotangents.end());
+  a.setFromTriplets(adjacency.begin(), adjacency.end());
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index i = 0; i < n; ++i)
+  {
+    double sum = 0;
+    bool usable = true;
+    for (SparseMatrix::InnerIterator it(c, i); it; ++it)
+    {
+      sum += it.value();
+    }
+    usable = sum > 1e-12;
+    const SparseMatrix& weights = usable ? c : a;
+    double total = 0;
+    for (SparseMatrix::InnerIterator it(weights, i); it; ++it)
+    {
+      total += it.value();
+    }
+    entries.emplace_back(i, i, -1.0);
+    for (SparseMatrix::InnerIterator it(weights, i); it; ++it)
+    {
+      entries.emplace_back(i, it.col(), it.value() / total);
+    }
+  }
+  SparseMatrix laplacian(n, n);
+  laplacian.setFromTriplets(entries.begin(), entries.end());
+  return laplacian;
+}
+
+double EnclosedVolume(const Points& points, const Triangles& triangles, Points* gradient)
+{
+  if (gradient)
+  {
+    gradient->setZero(points.rows(), 3);
+  }
+  double sixTimes = 0;
+  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
+  {
+    const Eigen::Vector3d a = points.row(triangles(t, 0)).transpose();
+    const Eigen::Vector3d b = points.row(triangles(t, 1)).transpose();
+    const Eigen::Vector3d c = points.row(triangles(t, 2)).transpose();
+    sixTimes += a.cross(b).dot(c);
+    if (gradient)
+    {
+      gradient->row(triangles(t, 0)) += b.cross(c).transpose() / 6.0;
+      gradient->row(triangles(t, 1)) += c.cross(a).transpose() / 6.0;
+      gradient->row(triangles(t, 2)) += a.cross(b).transpose() / 6.0;
+    }
+  }
+  return sixTimes / 6.0;
+}
+
+VolumeConstrainedSolver::VolumeConstrainedSolver(const SparseMatrix& rows, const Triangles& triangles)
+  : Rows(rows)
+  , Faces(triangles)
+{
+  const Eigen::SparseMatrix<double> normal = Eigen::SparseMatrix<double>(rows.transpose()) * rows;
+  this->Normal = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>(normal);
+  // A singular system shows as a pivot that is only rounding.
+  const Eigen::VectorXd pivots = this->Normal->vectorD();
+  if (this->Normal->info() != Eigen::Success || pivots.size() == 0 ||
+    pivots.minCoeff() <= 1e-12 * pivots.cwiseAbs().maxCoeff())
+  {
+    throw InputError("the deformation's least-squares system is singular: nothing fixes the muscle's position "
+                     "(are there action-line rows?)");
+  }
+}
+
+Points VolumeConstrainedSolver::Step(const Points& x, const Points& targets, double targetVolume, double alpha) const
+{
+  return this->StepImpl(x, targets, targetVolume, alpha, 1.0);
+}
+
+Points VolumeConstrainedSolver::StepWithOriginalSignError(
+  const Points& x, const Points& targets, double targetVolume, double alpha) const
+{
+  return this->StepImpl(x, targets, targetVolume, alpha, -1.0);
+}
+
+Points VolumeConstrainedSolver::StepImpl(
+  const Points& x, const Points& targets, double targetVolume, double alpha, double sign) const
+{
+  Points gradient;
+  const double volume = EnclosedVolume(x, this->Faces, &gradient);
+  const Points residual = this->Rows * x - targets;
+  const Points pulled = this->Rows.transpose() * residual; // L^T r
+  // A applied column by column (the three coordinates share L).
+  const Eigen::MatrixXd aPulled = this->Normal->solve(Eigen::MatrixXd(pulled));
+  const Eigen::MatrixXd aGradient = this->Normal->solve(Eigen::MatrixXd(gradient));
+  const double jaj = (gradient.array() * aGradient.array()).sum();
+  const double jalr = (gradient.array() * aPulled.array()).sum();
+  const double lambda = (( volume - targetVolume) / alpha - sign * jalr) / jaj;
+  return x - alpha * (aPulled + lambda * aGradient);
+}
+}

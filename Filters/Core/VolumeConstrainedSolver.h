@@ -1,0 +1,53 @@
+// The numerical core of the muscle deformation (Kellnhofer & Kohout, after
+// Huang et al. 2006): least squares |L X - b|^2 on the hull points X with the
+// enclosed volume held, by Gauss-Newton steps with a Lagrange multiplier.
+#pragma once
+
+#include "MeshTypes.h"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include <memory>
+
+namespace md
+{
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+/// Cotangent Laplacian of a closed triangle mesh: row i has -1 on the
+/// diagonal and c_ij / sum_k c_ik for each neighbour j, c_ij = cot(alpha) +
+/// cot(beta) of the two angles facing edge ij. Where a point's cotangent sum is
+/// not positive (degenerate triangles) its row falls back to uniform weights.
+SparseMatrix CotangentLaplacian(const TriangleMesh& mesh);
+
+/// V = 1/6 sum over triangles (x_a x x_b) . x_c, and dV/dx_i (one row per point).
+double EnclosedVolume(const Points& points, const Triangles& triangles, Points* gradient = nullptr);
+
+/// Solves min |L X - b|^2 subject to V(X) = V0 step by step. A = (L^T L)^-1 is
+/// factored once (L must have full column rank: the Laplacian rows alone do
+/// not, a translation costs them nothing; rows fixing positions, such as
+/// action-line rows, give it).
+class VolumeConstrainedSolver
+{
+public:
+  VolumeConstrainedSolver(const SparseMatrix& rows, const Triangles& triangles);
+
+  /// One step of length alpha in (0, 1] from X, with r = L X - b, J = dV/dX,
+  /// c = V(X) - V0:
+  ///   lambda = (J A J^T)^-1 (c / alpha - J A L^T r),  h = -alpha A (L^T r + J^T lambda),
+  /// so that the linearised volume after the step is exactly V0. (The original
+  /// implementation had the sign of the J A L^T r term wrong; its volume then
+  /// settles at an error proportional to alpha.)
+  Points Step(const Points& x, const Points& targets, double targetVolume, double alpha) const;
+
+  /// The same step with that sign error, kept only to show the difference.
+  Points StepWithOriginalSignError(const Points& x, const Points& targets, double targetVolume, double alpha) const;
+
+private:
+  Points StepImpl(const Points& x, const Points& targets, double targetVolume, double alpha, double sign) const;
+
+  SparseMatrix Rows;
+  Triangles Faces;
+  std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> Normal;
+};
+}

@@ -1,0 +1,154 @@
+#include "Phantom.h"
+#include "ProgressiveHull.h"
+#include "VolumeConstrainedSolver.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using md::Points;
+using md::SparseMatrix;
+using md::TriangleMesh;
+
+namespace
+{
+TriangleMesh CoarseMuscleHull()
+{
+  const TriangleMesh muscle = md::BuildPhantom(md::PhantomParameters{}).muscles[0].rest;
+  md::HullParameters parameters;
+  parameters.targetNumberOfPoints = 60;
+  return md::BuildProgressiveHull(muscle, parameters).hull;
+}
+
+/// Laplacian rows (targets: the rest-pose Laplacian coordinates) stacked on
+/// rows fixing a few anchor points (targets: where the anchors should go).
+struct Problem
+{
+  SparseMatrix rows;
+  Points targets;
+};
+
+Problem StretchProblem(const TriangleMesh& hull, double stretch)
+{
+  const SparseMatrix laplacian = md::CotangentLaplacian(hull);
+  const Eigen::Index n = hull.points.rows();
+  // Anchors at both ends of the muscle's long axis, moved apart by `stretch`.
+  const Eigen::RowVector3d centre = hull.points.colwise().mean();
+  Eigen::Index top = 0, bottom = 0;
+  for (Eigen::Index i = 0; i < n; ++i)
+  {
+    top = hull.points(i, 2) > hull.points(top, 2) ? i : top;
+    bottom = hull.points(i, 2) < hull.points(bottom, 2) ? i : bottom;
+  }
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index i = 0; i < laplacian.outerSize(); ++i)
+  {
+    for (SparseMatrix::InnerIterator it(laplacian, i); it; ++it)
+    {
+      entries.emplace_back(it.row(), it.col(), it.value());
+    }
+  }
+  entries.emplace_back(n, top, 1.0);
+  entries.emplace_back(n + 1, bottom, 1.0);
+  Problem problem;
+  problem.rows.resize(n + 2, n);
+  problem.rows.setFromTriplets(entries.begin(), entries.end());
+  problem.targets.resize(n + 2, 3);
+  problem.targets.topRows(n) = laplacian * hull.points;
+  problem.targets.row(n) = centre + stretch * (hull.points.row(top) - centre);
+  problem.targets.row(n + 1) = centre + stretch * (hull.points.row(bottom) - centre);
+  return problem;
+}
+}
+
+TEST(CotangentLaplacian, RowsSumToZeroAndARegularOctahedronHasEqualWeights)
+{
+  TriangleMesh octahedron;
+  octahedron.points.resize(6, 3);
+  octahedron.points << 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1;
+  octahedron.triangles.resize(8, 3);
+  octahedron.triangles << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
+  const SparseMatrix l = md::CotangentLaplacian(octahedron);
+  for (Eigen::Index i = 0; i < 6; ++i)
+  {
+    EXPECT_NEAR(l.row(i).sum(), 0.0, 1e-15);
+    EXPECT_DOUBLE_EQ(l.coeff(i, i), -1.0);
+  }
+  EXPECT_NEAR(l.coeff(0, 2), 0.25, 1e-15);
+  EXPECT_NEAR(l.coeff(0, 1), 0.0, 1e-15); // opposite points are not neighbours
+  const TriangleMesh hull = CoarseMuscleHull();
+  const SparseMatrix m = md::CotangentLaplacian(hull);
+  EXPECT_LT((m * Eigen::VectorXd::Ones(hull.points.rows())).cwiseAbs().maxCoeff(), 1e-13);
+}
+
+TEST(EnclosedVolume, GradientMatchesFiniteDifferences)
+{
+  const TriangleMesh hull = CoarseMuscleHull();
+  Points gradient;
+  const double volume = md::EnclosedVolume(hull.points, hull.triangles, &gradient);
+  EXPECT_NEAR(volume, md::EnclosedVolume(hull.points, hull.triangles), 0.0);
+  const double h = 1e-4;
+  for (Eigen::Index i : { 0, 7, 31 })
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      Points plus = hull.points, minus = hull.points;
+      plus(i, c) += h;
+      minus(i, c) -= h;
+      const double difference = (md::EnclosedVolume(plus, hull.triangles) - md::EnclosedVolume(minus, hull.triangles)) / (2 * h);
+      EXPECT_NEAR(gradient(i, c), difference, 1e-6 * std::abs(difference) + 1e-9);
+    }
+  }
+}
+
+TEST(VolumeConstrainedSolver, VolumeConvergesToTheRestVolumeWhereTheOriginalFormulaMisses)
+{
+  const TriangleMesh hull = CoarseMuscleHull();
+  const Problem problem = StretchProblem(hull, 1.3); // unconstrained, the muscle would swell by ~30 %
+  const md::VolumeConstrainedSolver solver(problem.rows, hull.triangles);
+  const double restVolume = md::EnclosedVolume(hull.points, hull.triangles);
+  for (double alpha : { 0.1, 0.3 })
+  {
+    Points corrected = hull.points, original = hull.points;
+    for (int iteration = 0; iteration < 400; ++iteration)
+    {
+      corrected = solver.Step(corrected, problem.targets, restVolume, alpha);
+      original = solver.StepWithOriginalSignError(original, problem.targets, restVolume, alpha);
+    }
+    const double correctedError = std::abs(md::EnclosedVolume(corrected, hull.triangles) / restVolume - 1);
+    const double originalError = std::abs(md::EnclosedVolume(original, hull.triangles) / restVolume - 1);
+    std::cout << "[ measured ] step length " << alpha << ": volume error " << 100 * correctedError
+              << " % (corrected), " << 100 * originalError << " % (original sign)\n";
+    EXPECT_LT(correctedError, 1e-8) << "alpha " << alpha;
+    EXPECT_GT(originalError, 1e-3) << "alpha " << alpha;
+    // The anchors did move: the muscle was stretched, at constant volume.
+    const Eigen::Index n = hull.points.rows();
+    const Points anchors = problem.rows.bottomRows(2) * corrected;
+    EXPECT_LT((anchors - problem.targets.bottomRows(2)).rowwise().norm().maxCoeff(),
+      0.25 * (problem.targets.row(n) - problem.targets.row(n + 1)).norm());
+  }
+}
+
+TEST(VolumeConstrainedSolver, FollowsATranslationExactly)
+{
+  const TriangleMesh hull = CoarseMuscleHull();
+  Problem problem = StretchProblem(hull, 1.0);
+  const Eigen::RowVector3d shift(12.0, -3.0, 7.5);
+  const Eigen::Index n = hull.points.rows();
+  problem.targets.bottomRows(2).rowwise() += shift;
+  const md::VolumeConstrainedSolver solver(problem.rows, hull.triangles);
+  const double restVolume = md::EnclosedVolume(hull.points, hull.triangles);
+  Points x = hull.points;
+  for (int iteration = 0; iteration < 200; ++iteration)
+  {
+    x = solver.Step(x, problem.targets, restVolume, 0.3);
+  }
+  const Points expected = hull.points.rowwise() + shift;
+  EXPECT_LT((x - expected).rowwise().norm().maxCoeff(), 1e-8 * (hull.points.row(0) - hull.points.row(n - 1)).norm());
+}
+
+TEST(VolumeConstrainedSolver, RefusesASystemThatDoesNotFixThePosition)
+{
+  const TriangleMesh hull = CoarseMuscleHull();
+  EXPECT_THROW(md::VolumeConstrainedSolver(md::CotangentLaplacian(hull), hull.triangles), md::InputError);
+}
