@@ -68,15 +68,28 @@ public:
     {
       enclose = nullptr;
     }
+    // Every edge costed once, in parallel, then pushed in a fixed order.
+    std::vector<std::pair<int, int>> edges;
     for (int v = 0; v < static_cast<int>(this->P.size()); ++v)
     {
       for (int w : this->Neighbours(v))
       {
         if (v < w)
         {
-          this->Push(v, w);
+          edges.emplace_back(v, w);
         }
       }
+    }
+    std::vector<std::optional<Candidate>> costed(edges.size());
+    const auto count = static_cast<long>(edges.size());
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < count; ++i)
+    {
+      costed[i] = this->Evaluate(edges[i].first, edges[i].second);
+    }
+    for (size_t i = 0; i < edges.size(); ++i)
+    {
+      this->PushCosted(costed[i], edges[i].first, edges[i].second);
     }
     HullResult result;
     // Points to enclose that the surface leaves out become surface points
