@@ -48,10 +48,12 @@ struct TriangleHash
   }
 };
 
+using EdgeMap = std::unordered_map<std::uint64_t, std::vector<int>>;
+
 /// Triangles incident to each undirected edge.
-std::unordered_map<std::uint64_t, std::vector<int>> EdgeFaces(const std::vector<Triangle>& triangles)
+EdgeMap EdgeFaces(const std::vector<Triangle>& triangles)
 {
-  std::unordered_map<std::uint64_t, std::vector<int>> edges;
+  EdgeMap edges;
   edges.reserve(triangles.size() * 2);
   for (int t = 0; t < static_cast<int>(triangles.size()); ++t)
   {
@@ -435,60 +437,17 @@ void RemoveEnclosedPieces(TriangleMesh& mesh, RepairReport& report)
   mesh.points = points;
   mesh.triangles = kept;
 }
-}
 
-std::string RepairReport::Describe() const
-{
-  std::ostringstream out;
-  const char* separator = "";
-  auto say = [&](std::int64_t count, const char* what) {
-    if (count > 0)
-    {
-      out << separator << what << " " << count;
-      separator = ", ";
-    }
-  };
-  say(unusedPointsRemoved, "removed unused points:");
-  say(duplicatePointsMerged, "merged duplicate points:");
-  say(degenerateTrianglesRemoved, "removed degenerate triangles:");
-  say(duplicateTrianglesRemoved, "removed duplicate triangles:");
-  say(finTrianglesRemoved, "removed back-to-back triangles (fins of no thickness):");
-  say(trianglesReoriented, "reoriented triangles:");
-  say(nonManifoldEdgesSplit, "split non-manifold edges:");
-  say(pointsDuplicatedAtPinches, "points duplicated at those pinches:");
-  say(selfIntersectionsUntangled, "self-intersecting triangle pairs undone:");
-  if (pointsSmoothed > 0)
-  {
-    out << separator << "by smoothing " << pointsSmoothed << " points (moved at most " << largestSmoothingShift << ")";
-    separator = ", ";
-  }
-  say(selfIntersectionsLeft, "self-intersecting triangle pairs left:");
-  say(enclosedPiecesRemoved, "removed pieces lying inside another:");
-  return out.str();
-}
+using Pairing = std::map<std::pair<int, std::uint64_t>, int>; // (triangle, edge) -> triangle
 
-TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& report)
+/// Merges points at identical coordinates (`representative`: each input
+/// point's surviving twin) and drops degenerate, duplicate and back-to-back triangles.
+std::vector<Triangle> MergeAndDeduplicate(
+  const TriangleMesh& surface, std::vector<std::int64_t>& representative, RepairReport& report)
 {
-  report = RepairReport{};
-  report.pointsToEnclose.resize(0, 3);
-  if (!AllFinite(surface.points))
-  {
-    throw InputError("the surface has non-finite (NaN or infinite) coordinates");
-  }
   const auto pointCount = static_cast<std::int64_t>(surface.points.rows());
-  for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t)
-  {
-    for (int k = 0; k < 3; ++k)
-    {
-      if (surface.triangles(t, k) < 0 || surface.triangles(t, k) >= pointCount)
-      {
-        throw InputError("a triangle refers to a point that does not exist");
-      }
-    }
-  }
-
   // Merge points at identical coordinates.
-  std::vector<std::int64_t> representative(static_cast<size_t>(pointCount));
+  representative.assign(static_cast<size_t>(pointCount), 0);
   {
     std::unordered_map<std::array<double, 3>, std::int64_t, CoordinateHash> first;
     first.reserve(static_cast<size_t>(pointCount));
@@ -566,14 +525,12 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
     report.duplicatePointsMerged += mergedAway[i] ? 1 : 0;
     report.unusedPointsRemoved += (!used[i] && !mergedAway[i]) ? 1 : 0;
   }
-  if (triangles.size() < 4)
-  {
-    throw InputError("the surface has fewer than 4 usable triangles once degenerate, duplicate and "
-                     "back-to-back ones are removed: it is flat or degenerate");
-  }
+  return triangles;
+}
 
-  // Holes cannot be closed safely.
-  auto edges = EdgeFaces(triangles);
+/// Holes cannot be closed safely.
+void RequireClosed(const EdgeMap& edges)
+{
   std::int64_t boundary = 0;
   for (const auto& entry : edges)
   {
@@ -584,62 +541,64 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
     throw InputError("the surface is open: " + std::to_string(boundary) +
       " edges belong to a single triangle (holes); a muscle must be a closed surface");
   }
+}
 
-  // Consistent orientation, by walking across manifold edges; `component`
-  // numbers the parts so reached, each oriented outwards at the end.
+/// Orients the triangles consistently by walking across manifold edges;
+/// returns the part each triangle was reached in (`parts` of them).
+std::vector<int> OrientConsistently(
+  std::vector<Triangle>& triangles, const EdgeMap& edges, int& parts, RepairReport& report)
+{
   std::vector<int> component(triangles.size(), -1);
   int components = 0;
+  for (size_t seed = 0; seed < triangles.size(); ++seed)
   {
-    std::vector<int>& state = component;
-    for (size_t seed = 0; seed < triangles.size(); ++seed)
+    if (component[seed] >= 0)
     {
-      if (state[seed] >= 0)
-      {
-        continue;
-      }
-      std::queue<int> queue;
-      queue.push(static_cast<int>(seed));
-      state[seed] = components;
-      while (!queue.empty())
-      {
-        const int t = queue.front();
-        queue.pop();
-        for (int k = 0; k < 3; ++k)
-        {
-          const std::int64_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
-          const std::vector<int>& around = edges[EdgeKey(a, b)];
-          if (around.size() != 2)
-          {
-            continue;
-          }
-          const int other = around[0] == t ? around[1] : around[0];
-          if (state[other] >= 0)
-          {
-            continue;
-          }
-          if (WalksFrom(triangles[other], a, b)) // must walk b -> a to agree with t
-          {
-            std::swap(triangles[other][1], triangles[other][2]);
-            ++report.trianglesReoriented;
-          }
-          state[other] = components;
-          queue.push(other);
-        }
-      }
-      ++components;
+      continue;
     }
+    std::queue<int> queue;
+    queue.push(static_cast<int>(seed));
+    component[seed] = components;
+    while (!queue.empty())
+    {
+      const int t = queue.front();
+      queue.pop();
+      for (int k = 0; k < 3; ++k)
+      {
+        const std::int64_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+        const std::vector<int>& around = edges.at(EdgeKey(a, b));
+        if (around.size() != 2)
+        {
+          continue;
+        }
+        const int other = around[0] == t ? around[1] : around[0];
+        if (component[other] >= 0)
+        {
+          continue;
+        }
+        if (WalksFrom(triangles[other], a, b)) // must walk b -> a to agree with t
+        {
+          std::swap(triangles[other][1], triangles[other][2]);
+          ++report.trianglesReoriented;
+        }
+        component[other] = components;
+        queue.push(other);
+      }
+    }
+    ++components;
   }
+  parts = components;
+  return component;
+}
 
-  // Points in double, for the fix-ups below.
-  Points points = surface.points;
-  // Size of the surface, for the separation of pinched sheets.
-  const double size = (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
-
-  // Non-manifold edges: pair the triangles around the edge so that each pair
-  // bounds one lobe. Rotating about the edge a -> b, a triangle walking b -> a
-  // has its lobe on the side of increasing angle, one walking a -> b on the
-  // side of decreasing angle; a lobe runs from the first to the next.
-  std::map<std::pair<int, std::uint64_t>, int> pairing;
+/// Non-manifold edges: pairs the triangles around each so that every pair
+/// bounds one lobe. Rotating about the edge a -> b, a triangle walking b -> a
+/// has its lobe on the side of increasing angle, one walking a -> b on the side
+/// of decreasing angle; a lobe runs from the first to the next.
+Pairing PairTrianglesAtPinches(
+  const Points& points, const std::vector<Triangle>& triangles, const EdgeMap& edges, RepairReport& report)
+{
+  Pairing pairing;
   for (const auto& entry : edges)
   {
     if (entry.second.size() <= 2)
@@ -686,11 +645,20 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
     }
   }
 
+  return pairing;
+}
+
+/// Points whose triangles form several fans (pinches) get one copy per extra
+/// fan; the point and its copies move `separation` into their own lobes, and
+/// where the point was is kept in report.pointsToEnclose.
+void SplitPinchedPoints(Points& points, std::vector<Triangle>& triangles, const EdgeMap& edges,
+  const Pairing& pairing, const Points& original, double separation, RepairReport& report)
+{
   // Neighbour of triangle t across its edge k, or -1 where the edge is cut.
   auto neighbour = [&](int t, int k) {
     const std::int64_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
     const std::uint64_t key = EdgeKey(a, b);
-    const std::vector<int>& around = edges[key];
+    const std::vector<int>& around = edges.at(key);
     if (around.size() == 2)
     {
       return around[0] == t ? around[1] : around[0];
@@ -699,8 +667,6 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
     return found == pairing.end() ? -1 : found->second;
   };
 
-  // Points whose triangles form several fans (pinches) get one copy per extra
-  // fan; the point and its copies move a tiny way into their own lobes.
   std::vector<std::vector<int>> facesOfPoint(static_cast<size_t>(points.rows()));
   for (int t = 0; t < static_cast<int>(triangles.size()); ++t)
   {
@@ -709,7 +675,6 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
       facesOfPoint[p].push_back(t);
     }
   }
-  const double separation = 1e-6 * size;
   // First every point's fans, on the triangles as they are (the neighbour
   // look-up goes by the original point indices); then the copies.
   struct Split
@@ -769,14 +734,14 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
   for (const Split& split : splits)
   {
     const std::int64_t p = split.point;
-    const Eigen::RowVector3d original = surface.points.row(p);
-    AppendRows(report.pointsToEnclose, { original });
-    points.row(p) = original - separation * split.fanNormal[0].normalized().transpose();
+    const Eigen::RowVector3d from = original.row(p);
+    AppendRows(report.pointsToEnclose, { from });
+    points.row(p) = from - separation * split.fanNormal[0].normalized().transpose();
     for (int fan = 1; fan < static_cast<int>(split.fanNormal.size()); ++fan)
     {
       const std::int64_t copy = points.rows();
       points.conservativeResize(copy + 1, 3);
-      points.row(copy) = original - separation * split.fanNormal[fan].normalized().transpose();
+      points.row(copy) = from - separation * split.fanNormal[fan].normalized().transpose();
       ++report.pointsDuplicatedAtPinches;
       for (const auto& [t, f] : split.fanOfTriangle)
       {
@@ -788,7 +753,14 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
     }
   }
 
-  // Compact: drop unused and merged-away points.
+}
+
+/// The mesh on the points its triangles use; input points that it no longer
+/// carries are added to report.pointsToEnclose.
+TriangleMesh Compact(const Points& points, const std::vector<Triangle>& triangles, const TriangleMesh& surface,
+  const std::vector<std::int64_t>& representative, RepairReport& report)
+{
+  const auto pointCount = static_cast<std::int64_t>(surface.points.rows());
   std::vector<std::int64_t> newIndex(static_cast<size_t>(points.rows()), -1);
   std::int64_t next = 0;
   for (const Triangle& t : triangles)
@@ -839,7 +811,12 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
     }
   }
 
-  // Each part outwards (positive volume).
+  return out;
+}
+
+/// Each part outwards (positive volume).
+void OrientPartsOutwards(TriangleMesh& out, const std::vector<int>& component, int components, RepairReport& report)
+{
   std::vector<double> partVolume(static_cast<size_t>(components), 0.0);
   for (Eigen::Index t = 0; t < out.triangles.rows(); ++t)
   {
@@ -855,6 +832,75 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
       ++report.trianglesReoriented;
     }
   }
+}
+}
+
+std::string RepairReport::Describe() const
+{
+  std::ostringstream out;
+  const char* separator = "";
+  auto say = [&](std::int64_t count, const char* what) {
+    if (count > 0)
+    {
+      out << separator << what << " " << count;
+      separator = ", ";
+    }
+  };
+  say(unusedPointsRemoved, "removed unused points:");
+  say(duplicatePointsMerged, "merged duplicate points:");
+  say(degenerateTrianglesRemoved, "removed degenerate triangles:");
+  say(duplicateTrianglesRemoved, "removed duplicate triangles:");
+  say(finTrianglesRemoved, "removed back-to-back triangles (fins of no thickness):");
+  say(trianglesReoriented, "reoriented triangles:");
+  say(nonManifoldEdgesSplit, "split non-manifold edges:");
+  say(pointsDuplicatedAtPinches, "points duplicated at those pinches:");
+  say(selfIntersectionsUntangled, "self-intersecting triangle pairs undone:");
+  if (pointsSmoothed > 0)
+  {
+    out << separator << "by smoothing " << pointsSmoothed << " points (moved at most " << largestSmoothingShift << ")";
+    separator = ", ";
+  }
+  say(selfIntersectionsLeft, "self-intersecting triangle pairs left:");
+  say(enclosedPiecesRemoved, "removed pieces lying inside another:");
+  return out.str();
+}
+
+TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& report)
+{
+  report = RepairReport{};
+  report.pointsToEnclose.resize(0, 3);
+  if (!AllFinite(surface.points))
+  {
+    throw InputError("the surface has non-finite (NaN or infinite) coordinates");
+  }
+  const auto pointCount = static_cast<std::int64_t>(surface.points.rows());
+  for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      if (surface.triangles(t, k) < 0 || surface.triangles(t, k) >= pointCount)
+      {
+        throw InputError("a triangle refers to a point that does not exist");
+      }
+    }
+  }
+  std::vector<std::int64_t> representative;
+  std::vector<Triangle> triangles = MergeAndDeduplicate(surface, representative, report);
+  if (triangles.size() < 4)
+  {
+    throw InputError("the surface has fewer than 4 usable triangles once degenerate, duplicate and "
+                     "back-to-back ones are removed: it is flat or degenerate");
+  }
+  const EdgeMap edges = EdgeFaces(triangles);
+  RequireClosed(edges);
+  int parts = 0;
+  const std::vector<int> part = OrientConsistently(triangles, edges, parts, report);
+  Points points = surface.points;
+  const double size = (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
+  const Pairing pairing = PairTrianglesAtPinches(points, triangles, edges, report);
+  SplitPinchedPoints(points, triangles, edges, pairing, surface.points, 1e-6 * size, report);
+  TriangleMesh out = Compact(points, triangles, surface, representative, report);
+  OrientPartsOutwards(out, part, parts, report);
   UntangleSelfIntersections(out, report);
   RemoveEnclosedPieces(out, report);
   const double volume = SignedVolume(out.points, out.triangles);
