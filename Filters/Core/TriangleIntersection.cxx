@@ -8,32 +8,39 @@ namespace md
 {
 using Vec3 = Eigen::Vector3d;
 
-bool SegmentHitsTriangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c, double eps)
+bool IntersectLineTriangle(const Vec3& p, const Vec3& d, const Vec3& a, const Vec3& b, const Vec3& c, double eps,
+  double& t, double& u, double& v)
 {
-  const Vec3 d = q - p;
+  // Moller & Trumbore 1997, leaving as early as it can (this is a hot path).
   const Vec3 e1 = b - a, e2 = c - a;
   const Vec3 h = d.cross(e2);
   const double det = e1.dot(h);
-  const double scale = e1.norm() * e2.norm() * d.norm();
-  if (std::abs(det) <= 1e-12 * scale)
+  if (std::abs(det) <= 1e-12 * e1.norm() * e2.norm() * d.norm())
   {
-    return false; // parallel (coplanar overlaps are not looked for)
+    return false;
   }
   const double inverse = 1.0 / det;
   const Vec3 s = p - a;
-  const double u = s.dot(h) * inverse;
+  u = s.dot(h) * inverse;
   if (u < -eps || u > 1 + eps)
   {
     return false;
   }
-  const Vec3 qv = s.cross(e1);
-  const double v = d.dot(qv) * inverse;
+  const Vec3 q = s.cross(e1);
+  v = d.dot(q) * inverse;
   if (v < -eps || u + v > 1 + eps)
   {
     return false;
   }
-  const double t = e2.dot(qv) * inverse;
-  return t >= -eps && t <= 1 + eps;
+  t = e2.dot(q) * inverse;
+  return true;
+}
+
+bool SegmentHitsTriangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c, double eps)
+{
+  double t, u, v;
+  // Coplanar overlaps (a parallel segment) are not looked for.
+  return IntersectLineTriangle(p, q - p, a, b, c, eps, t, u, v) && t >= -eps && t <= 1 + eps;
 }
 
 bool TrianglesIntersect(const std::array<Vec3, 3>& x, const std::array<int, 3>& fx, const std::array<Vec3, 3>& y,
@@ -102,6 +109,7 @@ std::vector<std::pair<int, int>> FindSelfIntersections(const Points& points, con
   std::unordered_map<std::uint64_t, std::vector<int>> grid;
   std::vector<std::array<Vec3, 3>> corners(static_cast<size_t>(m));
   std::vector<std::array<int, 3>> ids(static_cast<size_t>(m));
+  std::vector<Vec3> low(static_cast<size_t>(m)), high(static_cast<size_t>(m));
   for (int t = 0; t < m; ++t)
   {
     for (int k = 0; k < 3; ++k)
@@ -109,26 +117,50 @@ std::vector<std::pair<int, int>> FindSelfIntersections(const Points& points, con
       corners[t][k] = points.row(triangles(t, k)).transpose();
       ids[t][k] = static_cast<int>(triangles(t, k));
     }
-    const Vec3 low = corners[t][0].cwiseMin(corners[t][1]).cwiseMin(corners[t][2]);
-    const Vec3 high = corners[t][0].cwiseMax(corners[t][1]).cwiseMax(corners[t][2]);
-    for (long i = index(low[0]); i <= index(high[0]); ++i)
-      for (long j = index(low[1]); j <= index(high[1]); ++j)
-        for (long k = index(low[2]); k <= index(high[2]); ++k)
+    low[t] = corners[t][0].cwiseMin(corners[t][1]).cwiseMin(corners[t][2]);
+    high[t] = corners[t][0].cwiseMax(corners[t][1]).cwiseMax(corners[t][2]);
+    for (long i = index(low[t][0]); i <= index(high[t][0]); ++i)
+      for (long j = index(low[t][1]); j <= index(high[t][1]); ++j)
+        for (long k = index(low[t][2]); k <= index(high[t][2]); ++k)
           grid[key(i, j, k)].push_back(t);
   }
+  // Cells in parallel, each thread collecting its own pairs; sorted after, so
+  // the result does not depend on the threads.
+  std::vector<const std::vector<int>*> cells;
+  cells.reserve(grid.size());
   for (const auto& entry : grid)
   {
-    const std::vector<int>& faces = entry.second;
-    for (size_t a = 0; a < faces.size(); ++a)
+    if (entry.second.size() > 1)
     {
-      for (size_t b = a + 1; b < faces.size(); ++b)
+      cells.push_back(&entry.second);
+    }
+  }
+  const auto cellCount = static_cast<long>(cells.size());
+#pragma omp parallel
+  {
+    std::vector<std::pair<int, int>> found;
+#pragma omp for schedule(dynamic, 64)
+    for (long c = 0; c < cellCount; ++c)
+    {
+      const std::vector<int>& faces = *cells[c];
+      for (size_t a = 0; a < faces.size(); ++a)
       {
-        if (TrianglesIntersect(corners[faces[a]], ids[faces[a]], corners[faces[b]], ids[faces[b]]))
+        for (size_t b = a + 1; b < faces.size(); ++b)
         {
-          pairs.emplace_back(std::min(faces[a], faces[b]), std::max(faces[a], faces[b]));
+          const int s = faces[a], t = faces[b];
+          if ((low[s].array() > high[t].array()).any() || (high[s].array() < low[t].array()).any())
+          {
+            continue; // bounding boxes apart
+          }
+          if (TrianglesIntersect(corners[s], ids[s], corners[t], ids[t]))
+          {
+            found.emplace_back(std::min(s, t), std::max(s, t));
+          }
         }
       }
     }
+#pragma omp critical
+    pairs.insert(pairs.end(), found.begin(), found.end());
   }
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());

@@ -7,6 +7,14 @@
 
 namespace md
 {
+/// Whether the line p + t d passes through triangle abc, within `eps` of
+/// its edges in barycentric terms (u, v >= -eps, u + v <= 1 + eps); if so, the
+/// line parameter t and the barycentric coordinates of the meeting point
+/// (a + u (b - a) + v (c - a)). False, early, as soon as one test fails, and
+/// when the line is parallel to the plane.
+bool IntersectLineTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& d, const Eigen::Vector3d& a,
+  const Eigen::Vector3d& b, const Eigen::Vector3d& c, double eps, double& t, double& u, double& v);
+
 /// Does the segment pq cross triangle abc? eps > 0 counts touching (within
 /// eps of the barycentric range) as crossing, eps < 0 requires a clear crossing.
 bool SegmentHitsTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,

@@ -1,6 +1,7 @@
 #include "TriangleTree.h"
 
 #include "MeshChecks.h"
+#include "TriangleIntersection.h"
 
 #include <algorithm>
 #include <cmath>
@@ -81,9 +82,8 @@ int TriangleTree::Build(int first, int count, int depth)
     const Eigen::Index t = this->Order[i];
     for (int k = 0; k < 3; ++k)
     {
-      const Eigen::Vector3d p = this->Surface.points.row(this->Surface.triangles(t, k)).transpose();
-      low = low.cwiseMin(p);
-      high = high.cwiseMax(p);
+      low = low.cwiseMin(this->Corner(t, k));
+      high = high.cwiseMax(this->Corner(t, k));
     }
     centreLow = centreLow.cwiseMin(this->Centroid[t]);
     centreHigh = centreHigh.cwiseMax(this->Centroid[t]);
@@ -133,29 +133,11 @@ std::optional<TriangleTree::Hit> TriangleTree::FirstHit(const Eigen::Vector3d& f
     for (int i = node.first; i < node.first + node.count; ++i)
     {
       const Eigen::Index t = this->Order[i];
-      const Eigen::Vector3d a = this->Surface.points.row(this->Surface.triangles(t, 0)).transpose();
-      const Eigen::Vector3d e1 = this->Surface.points.row(this->Surface.triangles(t, 1)).transpose() - a;
-      const Eigen::Vector3d e2 = this->Surface.points.row(this->Surface.triangles(t, 2)).transpose() - a;
-      // Moller-Trumbore.
-      const Eigen::Vector3d h = direction.cross(e2);
-      const double det = e1.dot(h);
-      if (std::abs(det) < 1e-300)
+      double t01, u, v;
+      if (!IntersectLineTriangle(from, direction, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2), 0.0, t01, u, v))
       {
         continue;
       }
-      const Eigen::Vector3d s = from - a;
-      const double u = s.dot(h) / det;
-      if (u < 0 || u > 1)
-      {
-        continue;
-      }
-      const Eigen::Vector3d q = s.cross(e1);
-      const double v = direction.dot(q) / det;
-      if (v < 0 || u + v > 1)
-      {
-        continue;
-      }
-      const double t01 = e2.dot(q) / det;
       if (t01 >= 0 && t01 <= limit)
       {
         limit = t01;
@@ -193,21 +175,10 @@ int TriangleTree::CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vec
     for (int i = node.first; i < node.first + node.count; ++i)
     {
       const Eigen::Index t = this->Order[i];
-      const Eigen::Vector3d a = this->Surface.points.row(this->Surface.triangles(t, 0)).transpose();
-      const Eigen::Vector3d e1 = this->Surface.points.row(this->Surface.triangles(t, 1)).transpose() - a;
-      const Eigen::Vector3d e2 = this->Surface.points.row(this->Surface.triangles(t, 2)).transpose() - a;
-      const Eigen::Vector3d h = d.cross(e2);
-      const double det = e1.dot(h);
-      if (std::abs(det) < 1e-300)
-      {
-        continue;
-      }
-      const Eigen::Vector3d s = origin - a;
-      const double u = s.dot(h) / det;
-      const Eigen::Vector3d q = s.cross(e1);
-      const double v = d.dot(q) / det;
-      const double t01 = e2.dot(q) / det;
-      if (t01 < 0 || t01 > 1 || u < -edgeTolerance || v < -edgeTolerance || u + v > 1 + edgeTolerance)
+      double t01, u, v;
+      if (!IntersectLineTriangle(
+            origin, d, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2), edgeTolerance, t01, u, v) ||
+        t01 < 0 || t01 > 1)
       {
         continue;
       }
@@ -276,10 +247,7 @@ TriangleTree::Closest TriangleTree::ClosestPoint(const Eigen::Vector3d& p) const
     for (int i = node.first; i < node.first + node.count; ++i)
     {
       const Eigen::Index t = this->Order[i];
-      const Eigen::Vector3d a = this->Surface.points.row(this->Surface.triangles(t, 0)).transpose();
-      const Eigen::Vector3d b = this->Surface.points.row(this->Surface.triangles(t, 1)).transpose();
-      const Eigen::Vector3d c = this->Surface.points.row(this->Surface.triangles(t, 2)).transpose();
-      const double d = PointTriangleDistance(p, a, b, c);
+      const double d = PointTriangleDistance(p, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2));
       if (d * d < bestSquared)
       {
         bestSquared = d * d;
@@ -291,10 +259,8 @@ TriangleTree::Closest TriangleTree::ClosestPoint(const Eigen::Vector3d& p) const
   // The closest point itself, on the closest triangle.
   if (best.triangle >= 0)
   {
-    const Eigen::Vector3d a = this->Surface.points.row(this->Surface.triangles(best.triangle, 0)).transpose();
-    const Eigen::Vector3d b = this->Surface.points.row(this->Surface.triangles(best.triangle, 1)).transpose();
-    const Eigen::Vector3d c = this->Surface.points.row(this->Surface.triangles(best.triangle, 2)).transpose();
-    best.point = ClosestPointOnTriangle(p, a, b, c);
+    best.point = ClosestPointOnTriangle(
+      p, this->Corner(best.triangle, 0), this->Corner(best.triangle, 1), this->Corner(best.triangle, 2));
   }
   return best;
 }

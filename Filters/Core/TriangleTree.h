@@ -50,6 +50,10 @@ private:
     int left = -1, right = -1;
   };
   int Build(int first, int count, int depth);
+  Eigen::Vector3d Corner(Eigen::Index triangle, int k) const
+  {
+    return this->Surface.points.row(this->Surface.triangles(triangle, k)).transpose();
+  }
   int CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, bool& grazed) const;
 
   TriangleMesh Surface;
