@@ -50,11 +50,7 @@ md_build() {
   export MUSCLEDEFORMATION_PLUGIN="$MD_PLUGIN"
 }
 
-# Runs a command with an X display: rendering needs one (Xvfb when there is none).
+# Runs a command with an X display: rendering needs one (a private Xvfb when there is none).
 md_with_display() {
-  if [ -n "${DISPLAY:-}" ]; then
-    "$@"
-  else
-    xvfb-run -a -s "-screen 0 1280x1024x24" "$@"
-  fi
+  "$MD_SOURCE_DIR/Testing/with_display.sh" "$@"
 }

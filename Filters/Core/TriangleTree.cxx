@@ -109,12 +109,12 @@ int TriangleTree::Build(int first, int count, int depth)
   return index;
 }
 
-std::optional<TriangleTree::Hit> TriangleTree::FirstHit(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const
+template <typename Visit>
+void TriangleTree::ForTrianglesNearSegment(
+  const Eigen::Vector3d& from, const Eigen::Vector3d& direction, const double& limit, Visit&& visit) const
 {
-  const Eigen::Vector3d direction = to - from;
+  // `limit` is read at every box: a caller may shorten the segment as it goes.
   const Eigen::Vector3d inverse = direction.cwiseInverse();
-  std::optional<Hit> best;
-  double limit = 1.0;
   std::vector<int> stack{ 0 };
   while (!stack.empty())
   {
@@ -132,63 +132,49 @@ std::optional<TriangleTree::Hit> TriangleTree::FirstHit(const Eigen::Vector3d& f
     }
     for (int i = node.first; i < node.first + node.count; ++i)
     {
-      const Eigen::Index t = this->Order[i];
-      double t01, u, v;
-      if (!IntersectLineTriangle(from, direction, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2), 0.0, t01, u, v))
-      {
-        continue;
-      }
-      if (t01 >= 0 && t01 <= limit)
-      {
-        limit = t01;
-        best = Hit{ t01, t, from + t01 * direction };
-      }
+      visit(this->Order[i]);
     }
   }
+}
+
+std::optional<TriangleTree::Hit> TriangleTree::FirstHit(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const
+{
+  const Eigen::Vector3d direction = to - from;
+  std::optional<Hit> best;
+  double limit = 1.0;
+  this->ForTrianglesNearSegment(from, direction, limit, [&](Eigen::Index t) {
+    double t01, u, v;
+    if (IntersectLineTriangle(from, direction, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2), 0.0, t01, u, v) &&
+      t01 >= 0 && t01 <= limit)
+    {
+      limit = t01;
+      best = Hit{ t01, t, from + t01 * direction };
+    }
+  });
   return best;
 }
 
 int TriangleTree::CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, bool& grazed) const
 {
   // A segment long enough to leave the surface's box.
-  const Eigen::Vector3d to = origin + 4.0 * (this->Size + (origin - this->Nodes[0].low).norm()) * direction;
-  const Eigen::Vector3d d = to - origin;
-  const Eigen::Vector3d inverse = d.cwiseInverse();
+  const Eigen::Vector3d d = 4.0 * (this->Size + (origin - this->Nodes[0].low).norm()) * direction;
   const double edgeTolerance = 1e-9;
   int crossings = 0;
   grazed = false;
-  std::vector<int> stack{ 0 };
-  while (!stack.empty())
-  {
-    const Node& node = this->Nodes[stack.back()];
-    stack.pop_back();
-    if (!SegmentMeetsBox(origin, inverse, 1.0, node.low, node.high))
+  this->ForTrianglesNearSegment(origin, d, 1.0, [&](Eigen::Index t) {
+    double t01, u, v;
+    if (!IntersectLineTriangle(
+          origin, d, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2), edgeTolerance, t01, u, v) ||
+      t01 < 0 || t01 > 1)
     {
-      continue;
+      return;
     }
-    if (node.left >= 0)
+    if (u < edgeTolerance || v < edgeTolerance || u + v > 1 - edgeTolerance)
     {
-      stack.push_back(node.left);
-      stack.push_back(node.right);
-      continue;
+      grazed = true; // through an edge or a point: this ray cannot be trusted
     }
-    for (int i = node.first; i < node.first + node.count; ++i)
-    {
-      const Eigen::Index t = this->Order[i];
-      double t01, u, v;
-      if (!IntersectLineTriangle(
-            origin, d, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2), edgeTolerance, t01, u, v) ||
-        t01 < 0 || t01 > 1)
-      {
-        continue;
-      }
-      if (u < edgeTolerance || v < edgeTolerance || u + v > 1 - edgeTolerance)
-      {
-        grazed = true; // through an edge or a point: this ray cannot be trusted
-      }
-      ++crossings;
-    }
-  }
+    ++crossings;
+  });
   return crossings;
 }
 

@@ -55,6 +55,11 @@ private:
     return this->Surface.points.row(this->Surface.triangles(triangle, k)).transpose();
   }
   int CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, bool& grazed) const;
+  /// Calls visit(triangle) for every triangle whose leaf box the segment
+  /// from + t direction, t in [0, limit], meets.
+  template <typename Visit>
+  void ForTrianglesNearSegment(
+    const Eigen::Vector3d& from, const Eigen::Vector3d& direction, const double& limit, Visit&& visit) const;
 
   TriangleMesh Surface;
   std::vector<Node> Nodes;
