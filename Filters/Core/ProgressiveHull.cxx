@@ -413,8 +413,10 @@ private:
     const int id = static_cast<int>(this->F.size());
     this->F.push_back(f);
     this->FaceAlive.push_back(1);
-    this->FaceLow.push_back(this->P[f[0]].cwiseMin(this->P[f[1]]).cwiseMin(this->P[f[2]]));
-    this->FaceHigh.push_back(this->P[f[0]].cwiseMax(this->P[f[1]]).cwiseMax(this->P[f[2]]));
+    Vec3 low, high;
+    this->Bounds(f, low, high);
+    this->FaceLow.push_back(low);
+    this->FaceHigh.push_back(high);
     this->ReplacedMark.push_back(0);
     if (!this->Folded.empty())
     {
@@ -479,11 +481,6 @@ private:
     return { static_cast<long>(std::floor(p[0] / this->CellSize)), static_cast<long>(std::floor(p[1] / this->CellSize)),
       static_cast<long>(std::floor(p[2] / this->CellSize)) };
   }
-  static std::uint64_t CellKey(long i, long j, long k)
-  {
-    return (static_cast<std::uint64_t>(i & 0x1fffff) << 42) | (static_cast<std::uint64_t>(j & 0x1fffff) << 21) |
-      static_cast<std::uint64_t>(k & 0x1fffff);
-  }
   template <typename Visit>
   void ForCells(const Vec3& low, const Vec3& high, Visit&& visit) const
   {
@@ -491,7 +488,7 @@ private:
     for (long i = lo[0]; i <= hi[0]; ++i)
       for (long j = lo[1]; j <= hi[1]; ++j)
         for (long k = lo[2]; k <= hi[2]; ++k)
-          visit(CellKey(i, j, k));
+          visit(GridCellKey(i, j, k));
   }
   void Bounds(const Face& f, Vec3& low, Vec3& high) const
   {

@@ -149,10 +149,6 @@ void RestoreTowardsOriginal(TriangleMesh& mesh, const Points& original, const st
   }
   const double cell = 2.0 * edge / static_cast<double>(mesh.triangles.rows());
   auto cellOf = [cell](double x) { return static_cast<long>(std::floor(x / cell)); };
-  auto key = [](long i, long j, long k) {
-    return (static_cast<std::uint64_t>(i & 0x1fffff) << 42) | (static_cast<std::uint64_t>(j & 0x1fffff) << 21) |
-      static_cast<std::uint64_t>(k & 0x1fffff);
-  };
   auto bounds = [&](Eigen::Index t, Eigen::Vector3d& low, Eigen::Vector3d& high) {
     low = high = mesh.points.row(mesh.triangles(t, 0)).transpose();
     bool widen = false;
@@ -176,7 +172,7 @@ void RestoreTowardsOriginal(TriangleMesh& mesh, const Points& original, const st
     for (long i = cellOf(low[0]); i <= cellOf(high[0]); ++i)
       for (long j = cellOf(low[1]); j <= cellOf(high[1]); ++j)
         for (long k = cellOf(low[2]); k <= cellOf(high[2]); ++k)
-          grid[key(i, j, k)].push_back(t);
+          grid[GridCellKey(i, j, k)].push_back(t);
   }
   auto corners = [&](Eigen::Index t) {
     return std::array<Eigen::Vector3d, 3>{ mesh.points.row(mesh.triangles(t, 0)).transpose(),
@@ -203,7 +199,7 @@ void RestoreTowardsOriginal(TriangleMesh& mesh, const Points& original, const st
         for (long j = cellOf(low[1]); j <= cellOf(high[1]); ++j)
           for (long k = cellOf(low[2]); k <= cellOf(high[2]); ++k)
           {
-            auto found = grid.find(key(i, j, k));
+            auto found = grid.find(GridCellKey(i, j, k));
             if (found == grid.end())
             {
               continue;

@@ -102,10 +102,6 @@ std::vector<std::pair<int, int>> FindSelfIntersections(const Points& points, con
   }
   const double cell = std::max(2.0 * edgeSum / m, 1e-300);
   auto index = [cell](double x) { return static_cast<long>(std::floor(x / cell)); };
-  auto key = [](long i, long j, long k) {
-    return (static_cast<std::uint64_t>(i & 0x1fffff) << 42) | (static_cast<std::uint64_t>(j & 0x1fffff) << 21) |
-      static_cast<std::uint64_t>(k & 0x1fffff);
-  };
   std::unordered_map<std::uint64_t, std::vector<int>> grid;
   std::vector<std::array<Vec3, 3>> corners(static_cast<size_t>(m));
   std::vector<std::array<int, 3>> ids(static_cast<size_t>(m));
@@ -122,7 +118,7 @@ std::vector<std::pair<int, int>> FindSelfIntersections(const Points& points, con
     for (long i = index(low[t][0]); i <= index(high[t][0]); ++i)
       for (long j = index(low[t][1]); j <= index(high[t][1]); ++j)
         for (long k = index(low[t][2]); k <= index(high[t][2]); ++k)
-          grid[key(i, j, k)].push_back(t);
+          grid[GridCellKey(i, j, k)].push_back(t);
   }
   // Cells in parallel, each thread collecting its own pairs; sorted after, so
   // the result does not depend on the threads.

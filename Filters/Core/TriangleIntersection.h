@@ -32,6 +32,13 @@ bool TrianglesIntersect(const std::array<Eigen::Vector3d, 3>& x, const std::arra
 
 namespace md
 {
+/// Key of cell (i, j, k) of a uniform grid, 21 bits a coordinate (wrapping).
+inline std::uint64_t GridCellKey(long i, long j, long k)
+{
+  return (static_cast<std::uint64_t>(i & 0x1fffff) << 42) | (static_cast<std::uint64_t>(j & 0x1fffff) << 21) |
+    static_cast<std::uint64_t>(k & 0x1fffff);
+}
+
 /// Every pair (s < t) of triangles of the mesh that intersect other than at
 /// what they share, found through a uniform grid of triangle bounds.
 std::vector<std::pair<int, int>> FindSelfIntersections(const Points& points, const Triangles& triangles);
