@@ -171,6 +171,11 @@ def interpolation_pipeline(inputs, steps=4, mode="Rigid"):
     pipeline["lines"] = simple.BoneInterpolation(Input=simple.OutputPort(pipeline["matching"], 0),
                                                  NumberOfSteps=steps, InterpolationMode="Linear")
     pipeline["hulls"] = simple.HullDecimation(Input=inputs["muscles"])
+    # One pass RP -> CP (the paper's original method), every muscle together, bones in the CP.
+    pipeline["deformation"] = simple.MuscleDeformation(Input=inputs["muscles"],
+                                                       ActionLines=simple.OutputPort(pipeline["matching"], 0),
+                                                       Obstacles=[inputs["bones_current"]],
+                                                       Hull=pipeline["hulls"])
     return pipeline
 
 
@@ -190,6 +195,16 @@ def show_hulls(view, pipeline):
     display = _show_in_colour(pipeline["hulls"], view, LINE_COLOUR, None)
     display.Representation = "Wireframe"
     display.LineWidth = 1.5
+
+
+def show_deformed(view, pipeline):
+    """The muscles deformed in one pass to the current pose, with the current-pose bones and
+    action lines, and the rest-pose muscles faintly."""
+    hide_all(view)
+    show_surface(pipeline["bones_current"], view, BONE_COLOUR)
+    show_surface(pipeline["muscles"], view, MUSCLE_COLOURS[1], opacity=0.15)
+    show_surface(pipeline["deformation"], view, MUSCLE_COLOURS[0])
+    show_lines(pipeline["lines_current"], view, CURRENT_LINE_COLOUR)
 
 
 def show_steps(view, pipeline):
@@ -231,6 +246,9 @@ def run(pipeline, view, camera, output, prefix):
     show_hulls(view, pipeline)
     camera(view)
     images.append(screenshot(view, os.path.join(output, "%s_hulls.png" % prefix)))
+    show_deformed(view, pipeline)
+    camera(view)
+    images.append(screenshot(view, os.path.join(output, "%s_deformed_one_pass.png" % prefix)))
     show_steps(view, pipeline)
     camera(view)
     figures = {"number_of_steps": steps, "steps": []}
@@ -252,6 +270,14 @@ def run(pipeline, view, camera, output, prefix):
         name: {field: _field_value(hulls, field).get(name)
                for field in ("HullVolumeRatio", "PointsOutsideHull", "HullSelfIntersections", "ElapsedSeconds")}
         for name in _field_value(hulls, "HullVolumeRatio")}
+    write_blocks(pipeline["deformation"], output, "muscles_deformed_one_pass")
+    deformed = servermanager.Fetch(pipeline["deformation"])
+    figures["deformation_one_pass"] = {
+        name: {field: _field_value(deformed, field).get(name)
+               for field in ("VolumeChangePercent", "NumberOfIterations", "Converged", "FlippedTriangleCount",
+                             "PointsFrozenInObstacles", "PointsStoppedAtObstacles", "RestActionLineSamplesInside",
+                             "CurrentActionLineSamplesInside", "DeformationSeconds", "ElapsedSeconds")}
+        for name in _field_value(deformed, "VolumeChangePercent")}
     write_blocks(pipeline["bones_rest"], output, "bones_rest")
     write_blocks(pipeline["bones_current"], output, "bones_current")
     write_blocks(matching, output, "action_lines_matched_rest", port=0)

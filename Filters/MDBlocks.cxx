@@ -13,6 +13,8 @@
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkAlgorithm.h>
+#include <vtkIdTypeArray.h>
+#include <vtkTriangleFilter.h>
 
 #include <map>
 #include <set>
@@ -262,5 +264,37 @@ std::vector<Points> ToPolylines(vtkPolyData* polyData)
     lines.push_back(std::move(line));
   }
   return lines;
+}
+
+/// The polygons of `input` as triangles (polygons and strips triangulated).
+/// Returns the number of cells that were not triangles.
+vtkIdType ReadTriangles(vtkPolyData* input, TriangleMesh& mesh)
+{
+  vtkIdType converted = input->GetNumberOfStrips();
+  vtkCellArray* polys = input->GetPolys();
+  if (polys->IsHomogeneous() != 3)
+  {
+    auto it = vtk::TakeSmartPointer(polys->NewIterator());
+    for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
+    {
+      converted += it->GetCurrentCell()->GetNumberOfIds() != 3 ? 1 : 0;
+    }
+  }
+  vtkSmartPointer<vtkPolyData> triangles = input;
+  if (converted > 0)
+  {
+    vtkNew<vtkTriangleFilter> triangulate;
+    triangulate->SetInputData(input);
+    triangulate->PassVertsOff();
+    triangulate->PassLinesOff();
+    triangulate->Update();
+    triangles = triangulate->GetOutput();
+  }
+  mesh.points = ToPoints(triangles->GetPoints());
+  vtkNew<vtkIdTypeArray> connectivity;
+  connectivity->DeepCopy(triangles->GetPolys()->GetConnectivityArray());
+  mesh.triangles.resize(triangles->GetNumberOfPolys(), 3);
+  std::copy(connectivity->GetPointer(0), connectivity->GetPointer(0) + mesh.triangles.size(), mesh.triangles.data());
+  return converted;
 }
 }

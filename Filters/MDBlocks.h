@@ -6,6 +6,7 @@
 #include "MeshTypes.h"
 
 #include <vtkSmartPointer.h>
+#include <vtkType.h>
 
 #include <string>
 #include <vector>
@@ -59,6 +60,9 @@ void AcceptPolyDataOrMultiBlock(vtkInformation* info);
 Points ToPoints(vtkPoints* points);
 vtkSmartPointer<vtkPoints> ToVtkPoints(const Points& points);
 vtkSmartPointer<vtkPolyData> ToPolyData(const TriangleMesh& mesh);
+/// The polygons of `input` as triangles (polygons and strips triangulated),
+/// with all of its points. Returns the number of cells that were not triangles.
+vtkIdType ReadTriangles(vtkPolyData* input, TriangleMesh& mesh);
 /// The polylines of a polydata, each as its point coordinates.
 std::vector<Points> ToPolylines(vtkPolyData* polyData);
 }

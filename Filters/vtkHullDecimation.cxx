@@ -3,59 +3,17 @@
 #include "MDBlocks.h"
 #include "MeshChecks.h"
 #include "ProgressiveHull.h"
-#include "SurfaceRepair.h"
 
-#include <vtkCellArray.h>
-#include <vtkCellArrayIterator.h>
-#include <vtkIdList.h>
 #include <vtkFieldData.h>
-#include <vtkIdTypeArray.h>
 #include <vtkInformation.h>
 #include <vtkInformationVector.h>
 #include <vtkObjectFactory.h>
 #include <vtkPolyData.h>
 #include <vtkStringArray.h>
-#include <vtkTriangleFilter.h>
 
 #include <chrono>
 
 vtkStandardNewMacro(vtkHullDecimation);
-
-namespace
-{
-/// The polygons of `input` as triangles (polygons and strips triangulated).
-/// Returns the number of cells that were not triangles.
-vtkIdType ReadTriangles(vtkPolyData* input, md::TriangleMesh& mesh)
-{
-  vtkIdType converted = input->GetNumberOfStrips();
-  vtkCellArray* polys = input->GetPolys();
-  if (polys->IsHomogeneous() != 3)
-  {
-    auto it = vtk::TakeSmartPointer(polys->NewIterator());
-    for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
-    {
-      converted += it->GetCurrentCell()->GetNumberOfIds() != 3 ? 1 : 0;
-    }
-  }
-  vtkSmartPointer<vtkPolyData> triangles = input;
-  if (converted > 0)
-  {
-    vtkNew<vtkTriangleFilter> triangulate;
-    triangulate->SetInputData(input);
-    triangulate->PassVertsOff();
-    triangulate->PassLinesOff();
-    triangulate->Update();
-    triangles = triangulate->GetOutput();
-  }
-  mesh.points = mdvtk::ToPoints(triangles->GetPoints());
-  vtkNew<vtkIdTypeArray> connectivity;
-  connectivity->DeepCopy(triangles->GetPolys()->GetConnectivityArray());
-  mesh.triangles.resize(triangles->GetNumberOfPolys(), 3);
-  std::copy(connectivity->GetPointer(0), connectivity->GetPointer(0) + mesh.triangles.size(), mesh.triangles.data());
-  return converted;
-}
-
-}
 
 int vtkHullDecimation::FillInputPortInformation(int, vtkInformation* info)
 {
@@ -96,14 +54,11 @@ int vtkHullDecimation::RequestData(
     }
     const auto start = std::chrono::steady_clock::now();
     md::TriangleMesh muscle;
-    const vtkIdType converted = ReadTriangles(leaf.data, muscle);
-    md::RepairReport report;
-    md::TriangleMesh clean;
-    md::HullResult hull;
+    const vtkIdType converted = mdvtk::ReadTriangles(leaf.data, muscle);
+    md::MuscleHull built;
     try
     {
-      clean = md::RepairClosedSurface(muscle, report);
-      hull = md::BuildProgressiveHull(clean, parameters, &report.pointsToEnclose);
+      built = md::BuildMuscleHull(muscle, parameters);
     }
     catch (const md::InputError& e)
     {
@@ -111,6 +66,9 @@ int vtkHullDecimation::RequestData(
       return 0;
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const md::RepairReport& report = built.report;
+    const md::TriangleMesh& clean = built.clean;
+    const md::HullResult& hull = built.result;
     if (converted > 0 || report.Changed())
     {
       vtkWarningMacro(<< leaf.label << " was repaired before building its hull: "

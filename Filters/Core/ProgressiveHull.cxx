@@ -1017,4 +1017,12 @@ HullResult BuildProgressiveHull(const TriangleMesh& surface, const HullParameter
   HullBuilder builder(surface, parameters);
   return builder.Run(enclose);
 }
+
+MuscleHull BuildMuscleHull(const TriangleMesh& muscle, const HullParameters& parameters)
+{
+  MuscleHull built;
+  built.clean = RepairClosedSurface(muscle, built.report);
+  built.result = BuildProgressiveHull(built.clean, parameters, &built.report.pointsToEnclose);
+  return built;
+}
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "MeshTypes.h"
+#include "SurfaceRepair.h"
 
 namespace md
 {
@@ -45,4 +46,17 @@ struct HullResult
 /// nearest triangles facing it) and decimation keeps it inside from then on.
 HullResult BuildProgressiveHull(
   const TriangleMesh& surface, const HullParameters& parameters, const Points* enclose = nullptr);
+}
+
+namespace md
+{
+/// A muscle's hull as the filters build it: the surface repaired where safe
+/// (RepairClosedSurface), then decimated, enclosing the points the repair moved too.
+struct MuscleHull
+{
+  TriangleMesh clean; ///< the repaired surface
+  RepairReport report;
+  HullResult result;
+};
+MuscleHull BuildMuscleHull(const TriangleMesh& muscle, const HullParameters& parameters);
 }

@@ -56,57 +56,104 @@ TriangleTree::TriangleTree(const TriangleMesh& mesh)
     throw InputError("an obstacle has no triangles");
   }
   this->Size = (mesh.points.colwise().maxCoeff() - mesh.points.colwise().minCoeff()).norm();
-  this->Order.resize(static_cast<size_t>(m));
-  this->Centroid.resize(static_cast<size_t>(m));
+  // Triangles are ordered by splitting (contiguous centroids: cache-friendly).
+  std::vector<BuildItem> items(static_cast<size_t>(m));
   for (Eigen::Index t = 0; t < m; ++t)
   {
-    this->Order[t] = t;
-    this->Centroid[t] = (mesh.points.row(mesh.triangles(t, 0)) + mesh.points.row(mesh.triangles(t, 1)) +
+    items[t].centroid = (mesh.points.row(mesh.triangles(t, 0)) + mesh.points.row(mesh.triangles(t, 1)) +
                           mesh.points.row(mesh.triangles(t, 2)))
                           .transpose() /
       3.0;
+    items[t].triangle = t;
   }
-  this->Nodes.reserve(static_cast<size_t>(2 * m / leafSize + 1));
-  this->Build(0, static_cast<int>(m), 0);
+  this->Nodes.reserve(static_cast<size_t>(4 * m / leafSize + 1));
+  this->Build(items, 0, static_cast<int>(m), 0);
+  this->Order.resize(static_cast<size_t>(m));
+  for (Eigen::Index t = 0; t < m; ++t)
+  {
+    this->Order[t] = items[t].triangle;
+  }
+  this->UpdateBoxes();
 }
 
-int TriangleTree::Build(int first, int count, int depth)
+int TriangleTree::Build(std::vector<BuildItem>& items, int first, int count, int depth)
 {
   const int index = static_cast<int>(this->Nodes.size());
   this->Nodes.emplace_back();
-  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
-  Eigen::Vector3d high = -low;
-  Eigen::Vector3d centreLow = low, centreHigh = high;
-  for (int i = first; i < first + count; ++i)
-  {
-    const Eigen::Index t = this->Order[i];
-    for (int k = 0; k < 3; ++k)
-    {
-      low = low.cwiseMin(this->Corner(t, k));
-      high = high.cwiseMax(this->Corner(t, k));
-    }
-    centreLow = centreLow.cwiseMin(this->Centroid[t]);
-    centreHigh = centreHigh.cwiseMax(this->Centroid[t]);
-  }
-  this->Nodes[index].low = low;
-  this->Nodes[index].high = high;
+  this->Nodes[index].first = first;
+  this->Nodes[index].count = count;
   if (count <= leafSize || depth > 60)
   {
-    this->Nodes[index].first = first;
-    this->Nodes[index].count = count;
     return index;
+  }
+  Eigen::Vector3d centreLow = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+  Eigen::Vector3d centreHigh = -centreLow;
+  for (int i = first; i < first + count; ++i)
+  {
+    centreLow = centreLow.cwiseMin(items[i].centroid);
+    centreHigh = centreHigh.cwiseMax(items[i].centroid);
   }
   Eigen::Index axis;
   (centreHigh - centreLow).maxCoeff(&axis);
-  const int half = count / 2;
-  std::nth_element(this->Order.begin() + first, this->Order.begin() + first + half,
-    this->Order.begin() + first + count,
-    [&](Eigen::Index a, Eigen::Index b) { return this->Centroid[a][axis] < this->Centroid[b][axis]; });
-  const int left = this->Build(first, half, depth + 1);
-  const int right = this->Build(first + half, count - half, depth + 1);
+  // Split at the middle of the centroids' extent (one linear pass); at the
+  // median when that leaves a side empty or nearly so.
+  const double middle = 0.5 * (centreLow[axis] + centreHigh[axis]);
+  auto begin = items.begin() + first, end = items.begin() + first + count;
+  int half = static_cast<int>(
+    std::partition(begin, end, [&](const BuildItem& item) { return item.centroid[axis] < middle; }) - begin);
+  if (half < count / 8 || half > count - count / 8)
+  {
+    half = count / 2;
+    std::nth_element(begin, begin + half, end,
+      [&](const BuildItem& a, const BuildItem& b) { return a.centroid[axis] < b.centroid[axis]; });
+  }
+  const int left = this->Build(items, first, half, depth + 1);
+  const int right = this->Build(items, first + half, count - half, depth + 1);
   this->Nodes[index].left = left;
   this->Nodes[index].right = right;
   return index;
+}
+
+void TriangleTree::LeafBox(Node& node) const
+{
+  node.low = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+  node.high = -node.low;
+  for (int i = node.first; i < node.first + node.count; ++i)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      node.low = node.low.cwiseMin(this->Corner(this->Order[i], k));
+      node.high = node.high.cwiseMax(this->Corner(this->Order[i], k));
+    }
+  }
+}
+
+void TriangleTree::Refit(const Points& points)
+{
+  if (points.rows() != this->Surface.points.rows())
+  {
+    throw InputError("TriangleTree::Refit needs the same number of points as the tree was built with");
+  }
+  this->Surface.points = points;
+  this->UpdateBoxes();
+  this->Size = (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
+}
+
+void TriangleTree::UpdateBoxes()
+{
+  // Children come after their parent (pre-order build): walk backwards.
+  for (auto node = this->Nodes.rbegin(); node != this->Nodes.rend(); ++node)
+  {
+    if (node->left < 0)
+    {
+      this->LeafBox(*node);
+    }
+    else
+    {
+      node->low = this->Nodes[node->left].low.cwiseMin(this->Nodes[node->right].low);
+      node->high = this->Nodes[node->left].high.cwiseMax(this->Nodes[node->right].high);
+    }
+  }
 }
 
 template <typename Visit>

@@ -42,6 +42,26 @@ public:
 
   const TriangleMesh& Mesh() const { return this->Surface; }
 
+  /// Moves the surface's points (same triangles) and updates the boxes
+  /// bottom-up: O(triangles), far cheaper than a rebuild, for obstacles that
+  /// deform a little at a time (muscles). Queries stay exact; only their speed
+  /// suffers if the points move far.
+  void Refit(const Points& points);
+
+  /// Whether p lies inside the box of the whole surface.
+  bool InBounds(const Eigen::Vector3d& p) const
+  {
+    return (p.array() >= this->Nodes[0].low.array()).all() && (p.array() <= this->Nodes[0].high.array()).all();
+  }
+
+  /// Unit normal of a triangle (by its point order).
+  Eigen::Vector3d Normal(Eigen::Index triangle) const
+  {
+    return (this->Corner(triangle, 1) - this->Corner(triangle, 0))
+      .cross(this->Corner(triangle, 2) - this->Corner(triangle, 0))
+      .normalized();
+  }
+
 private:
   struct Node
   {
@@ -49,7 +69,14 @@ private:
     int first = 0, count = 0; // leaf: triangles Order[first .. first + count)
     int left = -1, right = -1;
   };
-  int Build(int first, int count, int depth);
+  struct BuildItem
+  {
+    Eigen::Vector3d centroid;
+    Eigen::Index triangle;
+  };
+  int Build(std::vector<BuildItem>& items, int first, int count, int depth);
+  void LeafBox(Node& node) const;
+  void UpdateBoxes();
   Eigen::Vector3d Corner(Eigen::Index triangle, int k) const
   {
     return this->Surface.points.row(this->Surface.triangles(triangle, k)).transpose();
@@ -64,7 +91,6 @@ private:
   TriangleMesh Surface;
   std::vector<Node> Nodes;
   std::vector<Eigen::Index> Order;
-  std::vector<Eigen::Vector3d> Centroid;
   double Size = 0;
 };
 }

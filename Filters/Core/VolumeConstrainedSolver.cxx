@@ -97,28 +97,34 @@ VolumeConstrainedSolver::VolumeConstrainedSolver(const SparseMatrix& rows, const
 
 Points VolumeConstrainedSolver::Step(const Points& x, const Points& targets, double targetVolume, double alpha) const
 {
-  return this->StepImpl(x, targets, targetVolume, alpha, 1.0);
+  Points gradient;
+  const double volume = EnclosedVolume(x, this->Faces, &gradient);
+  return this->Step(x, targets, volume - targetVolume, gradient, alpha);
 }
 
 Points VolumeConstrainedSolver::StepWithOriginalSignError(
   const Points& x, const Points& targets, double targetVolume, double alpha) const
 {
-  return this->StepImpl(x, targets, targetVolume, alpha, -1.0);
-}
-
-Points VolumeConstrainedSolver::StepImpl(
-  const Points& x, const Points& targets, double targetVolume, double alpha, double sign) const
-{
   Points gradient;
   const double volume = EnclosedVolume(x, this->Faces, &gradient);
+  return this->Step(x, targets, volume - targetVolume, gradient, alpha, -1.0);
+}
+
+Points VolumeConstrainedSolver::Step(const Points& x, const Points& targets, double volumeError,
+  const Points& gradient, double alpha, double sign) const
+{
   const Points residual = this->Rows * x - targets;
   const Points pulled = this->Rows.transpose() * residual; // L^T r
   // A applied column by column (the three coordinates share L).
   const Eigen::MatrixXd aPulled = this->Normal->solve(Eigen::MatrixXd(pulled));
+  if (gradient.rows() == 0)
+  {
+    return x - alpha * aPulled;
+  }
   const Eigen::MatrixXd aGradient = this->Normal->solve(Eigen::MatrixXd(gradient));
   const double jaj = (gradient.array() * aGradient.array()).sum();
   const double jalr = (gradient.array() * aPulled.array()).sum();
-  const double lambda = (( volume - targetVolume) / alpha - sign * jalr) / jaj;
+  const double lambda = (volumeError / alpha - sign * jalr) / jaj;
   return x - alpha * (aPulled + lambda * aGradient);
 }
 }

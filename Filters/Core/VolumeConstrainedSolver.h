@@ -43,8 +43,15 @@ public:
   /// The same step with that sign error, kept only to show the difference.
   Points StepWithOriginalSignError(const Points& x, const Points& targets, double targetVolume, double alpha) const;
 
-private:
-  Points StepImpl(const Points& x, const Points& targets, double targetVolume, double alpha, double sign) const;
+  /// The step with the volume measured by the caller (the fine phase measures
+  /// it on the full mesh): c = V - V0 and J = dV/dX. An empty J means no
+  /// volume constraint (lambda = 0). `sign` = -1 reproduces the original's
+  /// error (for the tests that show it); leave it at 1.
+  Points Step(const Points& x, const Points& targets, double volumeError, const Points& volumeGradient,
+    double alpha, double sign = 1.0) const;
+
+  /// The hull's triangles the volume is measured on.
+  const Triangles& HullTriangles() const { return this->Faces; }
 
   SparseMatrix Rows;
   Triangles Faces;

@@ -19,34 +19,6 @@
 
 namespace
 {
-/// x_CP = R x_RP + t for one frame of femur_transforms.csv.
-bool ReadFemurTransform(const std::string& csv, const std::string& motion, int frame,
-  Eigen::Matrix3d& rotation, Eigen::Vector3d& translation)
-{
-  std::ifstream in(csv);
-  std::string line;
-  std::getline(in, line); // header
-  while (std::getline(in, line))
-  {
-    std::vector<std::string> fields;
-    std::stringstream ss(line);
-    for (std::string field; std::getline(ss, field, ',');)
-    {
-      fields.push_back(field);
-    }
-    if (fields.size() >= 18 && fields[0] == motion && std::stoi(fields[1]) == frame)
-    {
-      for (int k = 0; k < 9; ++k)
-      {
-        rotation(k / 3, k % 3) = std::stod(fields[6 + k]);
-      }
-      translation << std::stod(fields[15]), std::stod(fields[16]), std::stod(fields[17]);
-      return true;
-    }
-  }
-  return false;
-}
-
 md::Points PointsOf(vtkPolyData* polyData)
 {
   md::Points p(polyData->GetNumberOfPoints(), 3);
@@ -75,9 +47,10 @@ protected:
     this->Rest = reader->GetOutput();
     ASSERT_EQ(this->Rest->GetNumberOfPoints(), 42502);
     // hip_flexion frame 35: 60 degrees of hip flexion.
-    Eigen::Matrix3d rotation;
-    Eigen::Vector3d translation;
-    ASSERT_TRUE(ReadFemurTransform(transforms, "hip_flexion", 35, rotation, translation));
+    FemurFrame frame;
+    ASSERT_TRUE(ReadFemurFrame(transforms, "hip_flexion", 35, frame));
+    const Eigen::Matrix3d rotation = frame.rotation;
+    const Eigen::Vector3d translation = frame.translation;
     this->Current = vtkSmartPointer<vtkPolyData>::New();
     this->Current->DeepCopy(this->Rest);
     vtkNew<vtkPoints> moved;

@@ -117,3 +117,35 @@ TEST(TriangleTree, RefusesAnEmptyMesh)
 {
   EXPECT_THROW(md::TriangleTree(md::TriangleMesh{ md::Points(0, 3), md::Triangles(0, 3) }), md::InputError);
 }
+
+TEST(TriangleTree, RefitAnswersLikeATreeBuiltOnTheMovedPoints)
+{
+  const md::TriangleMesh bone = md::BuildPhantom(md::PhantomParameters{}).bones[1].rest;
+  md::TriangleMesh moved = bone;
+  // Bend it: a smooth, non-rigid displacement.
+  for (Eigen::Index i = 0; i < moved.points.rows(); ++i)
+  {
+    moved.points(i, 0) += 0.002 * moved.points(i, 2) * moved.points(i, 2);
+  }
+  md::TriangleTree refitted(bone);
+  refitted.Refit(moved.points);
+  const md::TriangleTree rebuilt(moved);
+  std::mt19937 generator(3);
+  const Eigen::Vector3d low = moved.points.colwise().minCoeff().transpose();
+  const Eigen::Vector3d high = moved.points.colwise().maxCoeff().transpose();
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int q = 0; q < 500; ++q)
+  {
+    const Eigen::Vector3d p = low + (high - low).cwiseProduct(Eigen::Vector3d(unit(generator), unit(generator), unit(generator)));
+    const Eigen::Vector3d to = low + (high - low).cwiseProduct(Eigen::Vector3d(unit(generator), unit(generator), unit(generator)));
+    EXPECT_EQ(refitted.Inside(p), rebuilt.Inside(p));
+    EXPECT_NEAR(refitted.ClosestPoint(p).distance, rebuilt.ClosestPoint(p).distance, 1e-9);
+    const auto a = refitted.FirstHit(p, to), b = rebuilt.FirstHit(p, to);
+    ASSERT_EQ(a.has_value(), b.has_value());
+    if (a)
+    {
+      EXPECT_NEAR(a->t, b->t, 1e-12);
+    }
+  }
+  EXPECT_THROW(refitted.Refit(moved.points.topRows(3)), md::InputError);
+}

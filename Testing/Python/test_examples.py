@@ -39,7 +39,7 @@ class PhantomExample(unittest.TestCase):
         self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
         self.assertIn(os.path.abspath(output), result.stdout)
         pictures = sorted(glob.glob(os.path.join(output, "phantom_*.png")))
-        self.assertEqual(len(pictures), 3 + 4, pictures)
+        self.assertEqual(len(pictures), 4 + 4, pictures)  # rest, current, hulls, one-pass deformation, steps
         for picture in pictures:
             self.assertGreater(non_white_fraction(picture), 0.02, picture)
         with open(os.path.join(output, "figures.json")) as f:
@@ -49,6 +49,11 @@ class PhantomExample(unittest.TestCase):
         for name, hull in figures["hulls"].items():
             self.assertEqual(hull["PointsOutsideHull"], 0, name)
             self.assertEqual(hull["HullSelfIntersections"], 0, name)
+        for name, deformed in figures["deformation_one_pass"].items():
+            self.assertLess(abs(deformed["VolumeChangePercent"]), 0.05, name)
+            self.assertEqual(deformed["FlippedTriangleCount"], 0, name)
+            self.assertEqual(deformed["Converged"], 1, name)
+        self.assertTrue(os.path.isfile(os.path.join(output, "muscles_deformed_one_pass_RectusFemoris.vtp")))
         reader = vtkXMLPolyDataReader()
         reader.SetFileName(os.path.join(output, "bones_step_3_Femur.vtp"))
         reader.Update()

@@ -50,6 +50,11 @@ class Images(unittest.TestCase):
         phantom_interpolation.lateral_camera(self.view)
         self.compare("PhantomCurrentPose60.png")
 
+    def test_phantom_deformed_in_one_pass_at_60_degrees(self):
+        mdexamples.show_deformed(self.view, self.pipeline)
+        phantom_interpolation.lateral_camera(self.view)
+        self.compare("PhantomDeformed60.png")
+
     def test_middle_step_rigid_against_linear(self):
         """Step 2 of 4: the rigid femur (bone colour) and the linear one (red), shorter by 13 %."""
         mdexamples.show_steps(self.view, self.pipeline)

@@ -18,7 +18,7 @@ class LhdlExample(unittest.TestCase):
         result = run_example("lhdl_hip_interpolation.py", output, "--motion", "hip_flexion", "--frame", "35")
         self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
         pictures = sorted(glob.glob(os.path.join(output, "lhdl_*.png")))
-        self.assertEqual(len(pictures), 3 + 5)
+        self.assertEqual(len(pictures), 4 + 5)  # rest, current, hulls, one-pass deformation, steps
         for picture in pictures:
             self.assertGreater(non_white_fraction(picture), 0.02, picture)
         with open(os.path.join(output, "figures.json")) as f:
@@ -31,6 +31,11 @@ class LhdlExample(unittest.TestCase):
         for name, hull in figures["hulls"].items():
             self.assertEqual(hull["PointsOutsideHull"], 0, name)
             self.assertEqual(hull["HullSelfIntersections"], 0, name)
+        self.assertEqual(set(figures["deformation_one_pass"]), set(figures["hulls"]))
+        for name, deformed in figures["deformation_one_pass"].items():
+            self.assertLessEqual(abs(deformed["VolumeChangePercent"]), 0.05, name)
+            self.assertEqual(deformed["FlippedTriangleCount"], 0, name)
+            self.assertEqual(deformed["Converged"], 1, name)
         # psoas and iliacus lose their conditional via point beyond 40 and 54 degrees of flexion.
         rest, current = figures["action_line_points_rest"], figures["action_line_points_current"]
         matched = figures["matched_action_line_points"]

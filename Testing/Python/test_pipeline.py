@@ -40,13 +40,20 @@ class ServerManagerXML(unittest.TestCase):
                                     "%s.%s has no documentation" % (name, prop.get("name")))
 
     def test_proxies_have_the_names_users_rely_on(self):
-        for name in ("MusculoskeletalPhantom", "ActionLineMatching", "BoneInterpolation", "HullDecimation"):
+        for name in ("MusculoskeletalPhantom", "ActionLineMatching", "BoneInterpolation", "HullDecimation",
+                     "MuscleDeformation"):
             self.assertTrue(hasattr(simple, name), name)
         matching = simple.ActionLineMatching()
         self.assertAlmostEqual(matching.Tolerance, 0.01)
         interpolation = simple.BoneInterpolation()
         self.assertEqual(interpolation.NumberOfSteps, 4)
         self.assertEqual(interpolation.InterpolationMode, "Rigid")
+        deformation = simple.MuscleDeformation()
+        self.assertEqual(deformation.MaximumNumberOfIterations, 200)
+        self.assertAlmostEqual(deformation.ConvergenceTolerance, 0.01)
+        self.assertEqual(deformation.PreserveVolume, 1)
+        self.assertEqual(deformation.DynamicIntersections, 1)
+        simple.Delete(deformation)
         simple.Delete(interpolation)
         simple.Delete(matching)
 
@@ -122,6 +129,65 @@ class Pipeline(unittest.TestCase):
             hulls.UpdatePipeline()
         self.assertIn("is larger than the surface's", messages.text)
         simple.Delete(hulls)
+
+    def deformation(self, **properties):
+        matching = simple.ActionLineMatching(Input=simple.OutputPort(self.phantom, 3),
+                                             CurrentPose=simple.OutputPort(self.phantom, 4))
+        deformation = simple.MuscleDeformation(Input=simple.OutputPort(self.phantom, 0),
+                                               ActionLines=simple.OutputPort(matching, 0),
+                                               Obstacles=[simple.OutputPort(self.phantom, 2)], **properties)
+        return matching, deformation
+
+    def test_muscle_deformation_keeps_volume_structure_and_arrays(self):
+        matching, deformation = self.deformation()
+        with mdtesting.CapturedMessages() as messages:
+            deformation.UpdatePipeline()
+        self.assertEqual(messages.text, "")
+        data = servermanager.Fetch(deformation)
+        rest = servermanager.Fetch(simple.OutputPort(self.phantom, 0))
+        self.assertEqual(data.GetNumberOfBlocks(), 3)
+        for name in ("Iliopsoas", "GluteusMaximus", "RectusFemoris"):
+            muscle, before = block(data, name), block(rest, name)
+            self.assertEqual(muscle.GetNumberOfPoints(), before.GetNumberOfPoints(), name)
+            self.assertEqual(muscle.GetNumberOfPolys(), before.GetNumberOfPolys(), name)
+            displacement = vtk_to_numpy(muscle.GetPointData().GetArray("Displacement"))
+            self.assertTrue(numpy.allclose(points(before) + displacement, points(muscle)), name)
+            self.assertGreater(numpy.abs(displacement).max(), 10.0, name)  # it moved
+            fields = muscle.GetFieldData()
+            self.assertLess(abs(fields.GetArray("VolumeChangePercent").GetValue(0)), 0.05, name)
+            self.assertEqual(fields.GetArray("FlippedTriangleCount").GetValue(0), 0, name)
+            self.assertEqual(fields.GetArray("Converged").GetValue(0), 1, name)
+            self.assertLessEqual(fields.GetArray("NumberOfIterations").GetValue(0), 200, name)
+            for array in ("ElapsedSeconds", "RestActionLineSamplesInside", "CurrentActionLineSamplesInside"):
+                self.assertIsNotNone(fields.GetArray(array), array)
+            self.assertFalse(numpy.isnan(points(muscle)).any(), name)
+        simple.Delete(deformation)
+        simple.Delete(matching)
+
+    def test_muscle_deformation_errors_name_the_input(self):
+        # Raw action lines (no CurrentPosition) instead of ActionLineMatching's output.
+        deformation = simple.MuscleDeformation(Input=simple.OutputPort(self.phantom, 0),
+                                               ActionLines=simple.OutputPort(self.phantom, 3))
+        with mdtesting.CapturedMessages() as messages:
+            deformation.UpdatePipeline()
+        self.assertIn("has no point array CurrentPosition", messages.text)
+        self.assertIn("ActionLines block 'Iliopsoas'", messages.text)
+        simple.Delete(deformation)
+        # A hull that does not enclose its muscle: the rest bones given as hulls.
+        matching, deformation = self.deformation()
+        hulls = simple.HullDecimation(Input=simple.OutputPort(self.phantom, 0), TargetNumberOfPoints=60)
+        shrunk = simple.Transform(Input=hulls)
+        shrunk.Transform.Scale = [0.8, 0.8, 0.8]
+        deformation.Hull = shrunk
+        with mdtesting.CapturedMessages() as messages:
+            deformation.UpdatePipeline()
+        self.assertIn("does not enclose", messages.text)
+        deformation.Hull = hulls
+        with mdtesting.CapturedMessages() as messages:
+            deformation.UpdatePipeline()
+        self.assertEqual(messages.text, "")
+        for proxy in (deformation, shrunk, hulls, matching):
+            simple.Delete(proxy)
 
     def test_bad_input_reports_the_block_and_recovers(self):
         bones = simple.BoneInterpolation(Input=simple.OutputPort(self.phantom, 1),

@@ -1,0 +1,980 @@
+#include "MuscleDeformer.h"
+
+#include "MeshChecks.h"
+#include "VolumeConstrainedSolver.h"
+
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace md
+{
+namespace
+{
+using Clock = std::chrono::steady_clock;
+/// Unfold, let the volume settle, check again: at most this many times.
+constexpr int maximumUnfoldings = 8;
+
+double Diagonal(const Points& points)
+{
+  return (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
+}
+
+/// Distance from p to the segment ab.
+double SegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+{
+  const Eigen::Vector3d ab = b - a;
+  const double length2 = ab.squaredNorm();
+  const double t = length2 > 0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+/// Rotation of each hull point: the one taking the rest direction of the
+/// nearest action-line segment to its current direction.
+std::vector<Eigen::Matrix3d> SegmentRotations(const Points& hull, const std::vector<MatchedLine>& lines)
+{
+  std::vector<Eigen::Matrix3d> rotations(static_cast<size_t>(hull.rows()), Eigen::Matrix3d::Identity());
+  for (Eigen::Index i = 0; i < hull.rows(); ++i)
+  {
+    const Eigen::Vector3d p = hull.row(i).transpose();
+    double nearest = std::numeric_limits<double>::max();
+    for (const MatchedLine& line : lines)
+    {
+      for (Eigen::Index k = 0; k + 1 < line.rest.rows(); ++k)
+      {
+        const Eigen::Vector3d a = line.rest.row(k).transpose(), b = line.rest.row(k + 1).transpose();
+        const Eigen::Vector3d from = b - a;
+        const Eigen::Vector3d to = (line.current.row(k + 1) - line.current.row(k)).transpose();
+        if (from.norm() == 0 || to.norm() == 0)
+        {
+          continue; // a repeated point carries no direction
+        }
+        const double d = SegmentDistance(p, a, b);
+        if (d < nearest)
+        {
+          nearest = d;
+          rotations[i] = Eigen::Quaterniond::FromTwoVectors(from, to).toRotationMatrix();
+        }
+      }
+    }
+  }
+  return rotations;
+}
+
+/// Stacks the Laplacian rows, the dense action-line rows and one row per
+/// anchored point (its position).
+SparseMatrix StackRows(
+  const SparseMatrix& laplacian, const WeightMatrix& sampleWeights, const std::vector<Eigen::Index>& anchored)
+{
+  const Eigen::Index n = laplacian.cols();
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(static_cast<size_t>(laplacian.nonZeros() + sampleWeights.size()));
+  for (Eigen::Index r = 0; r < laplacian.outerSize(); ++r)
+  {
+    for (SparseMatrix::InnerIterator it(laplacian, r); it; ++it)
+    {
+      entries.emplace_back(r, it.col(), it.value());
+    }
+  }
+  for (Eigen::Index s = 0; s < sampleWeights.rows(); ++s)
+  {
+    for (Eigen::Index j = 0; j < n; ++j)
+    {
+      if (sampleWeights(s, j) != 0)
+      {
+        entries.emplace_back(laplacian.rows() + s, j, sampleWeights(s, j));
+      }
+    }
+  }
+  for (size_t a = 0; a < anchored.size(); ++a)
+  {
+    entries.emplace_back(laplacian.rows() + sampleWeights.rows() + static_cast<Eigen::Index>(a), anchored[a], 1.0);
+  }
+  SparseMatrix rows(laplacian.rows() + sampleWeights.rows() + static_cast<Eigen::Index>(anchored.size()), n);
+  rows.setFromTriplets(entries.begin(), entries.end());
+  return rows;
+}
+
+/// Connected component of every point (through triangles), numbered from 0.
+std::vector<int> Components(const Triangles& triangles, Eigen::Index points, int& count)
+{
+  std::vector<int> parent(static_cast<size_t>(points));
+  std::iota(parent.begin(), parent.end(), 0);
+  auto root = [&](int x) {
+    while (parent[x] != x)
+    {
+      x = parent[x] = parent[parent[x]];
+    }
+    return x;
+  };
+  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
+  {
+    for (int k = 1; k < 3; ++k)
+    {
+      parent[root(static_cast<int>(triangles(t, k)))] = root(static_cast<int>(triangles(t, 0)));
+    }
+  }
+  std::vector<int> label(static_cast<size_t>(points), -1), component(static_cast<size_t>(points));
+  count = 0;
+  for (Eigen::Index i = 0; i < points; ++i)
+  {
+    int& l = label[root(static_cast<int>(i))];
+    if (l < 0)
+    {
+      l = count++;
+    }
+    component[i] = l;
+  }
+  return component;
+}
+
+/// Where the nearest action-line segment's motion takes p: the segment's
+/// rotation about the nearest point on it, which moves with the segment.
+Eigen::Vector3d FollowNearestSegment(const Eigen::Vector3d& p, const std::vector<MatchedLine>& lines)
+{
+  double nearest = std::numeric_limits<double>::max();
+  Eigen::Vector3d moved = p;
+  for (const MatchedLine& line : lines)
+  {
+    for (Eigen::Index k = 0; k + 1 < line.rest.rows(); ++k)
+    {
+      const Eigen::Vector3d a = line.rest.row(k).transpose(), b = line.rest.row(k + 1).transpose();
+      const Eigen::Vector3d a1 = line.current.row(k).transpose(), b1 = line.current.row(k + 1).transpose();
+      const double length2 = (b - a).squaredNorm();
+      const double t = length2 > 0 ? std::clamp((p - a).dot(b - a) / length2, 0.0, 1.0) : 0.0;
+      const Eigen::Vector3d on = a + t * (b - a);
+      if ((p - on).norm() < nearest)
+      {
+        nearest = (p - on).norm();
+        const Eigen::Matrix3d rotation = (b - a).norm() > 0 && (b1 - a1).norm() > 0
+          ? Eigen::Quaterniond::FromTwoVectors(b - a, b1 - a1).toRotationMatrix()
+          : Eigen::Matrix3d::Identity();
+        moved = a1 + t * (b1 - a1) + rotation * (p - on);
+      }
+    }
+  }
+  return moved;
+}
+
+/// Whether every point lies inside the tree's surface (a box test first).
+bool EntirelyInside(const TriangleTree& tree, const Points& points)
+{
+  for (Eigen::Index i = 0; i < points.rows(); ++i)
+  {
+    if (!tree.InBounds(points.row(i).transpose()))
+    {
+      return false;
+    }
+  }
+  return CountInsideTree(tree, points) == points.rows();
+}
+
+double FractionInside(const TriangleTree& tree, const Points& points)
+{
+  return points.rows() ? static_cast<double>(CountInsideTree(tree, points)) / points.rows() : 0.0;
+}
+
+/// The state of one muscle through the pass.
+struct MuscleState
+{
+  const MuscleToDeform* input = nullptr;
+  double size = 0;
+  WeightMatrix ownWeights;               // when not given
+  const WeightMatrix* weights = nullptr; // full mesh = weights * hull
+  std::unique_ptr<VolumeConstrainedSolver> solver;
+  Points targets;
+  Points hull;    // X
+  Points points;  // the full mesh as it moves (W X where nothing held it)
+  Points start;   // rest pose
+  double hullVolume = 0, restVolume = 0;
+  std::vector<char> frozen;  // inside a bone before a step: stays
+  std::vector<char> stopped; // held at an obstacle in the last move
+  std::vector<char> touched; // held at an obstacle in any move: left out of the volume gradient, which
+                             // would otherwise swing as points come off the obstacle and back
+  std::unique_ptr<TriangleTree> tree; // of `points`, for the other muscles
+  double orientation = 1; // +1 when the triangles face outwards
+  bool converged = false;
+  bool fineDone = false;
+  int unfoldings = 0;
+  bool flipsCheckedClean = false;
+  double fineStep = 1;                                   // step length of the fine phase
+  double lastChange = std::numeric_limits<double>::max(); // largest hull change of the last fine step
+  Clock::duration time{};
+  DeformationResult result;
+};
+
+void Validate(const MuscleToDeform& m)
+{
+  const std::string name = "muscle '" + m.name + "'";
+  if (!m.muscle || !m.hull || m.muscle->points.rows() == 0 || m.muscle->triangles.rows() == 0)
+  {
+    throw InputError(name + " has no surface");
+  }
+  if (!AllFinite(m.muscle->points) || !AllFinite(m.hull->points))
+  {
+    throw InputError(name + " has non-finite coordinates (NaN or infinity) in its surface or its hull");
+  }
+  if (!CheckEdges(m.hull->triangles).IsClosedOrientedManifold())
+  {
+    throw InputError("the hull of " + name + " is not a closed, consistently oriented manifold surface");
+  }
+  if (m.lines.empty())
+  {
+    throw InputError(name + " has no action line: nothing says where it goes");
+  }
+  for (const MatchedLine& line : m.lines)
+  {
+    if (line.rest.rows() < 2 || line.rest.rows() != line.current.rows())
+    {
+      throw InputError("an action line of " + name +
+        " is not matched: it needs at least two points, as many in the rest pose as in the current pose");
+    }
+    if (!AllFinite(line.rest) || !AllFinite(line.current))
+    {
+      throw InputError("an action line of " + name + " has non-finite coordinates");
+    }
+  }
+}
+
+/// Builds the least-squares system and the mapping of one muscle.
+void SetUp(MuscleState& s, const DeformationParameters& parameters)
+{
+  const MuscleToDeform& m = *s.input;
+  const TriangleMesh& hull = *m.hull;
+  s.size = Diagonal(m.muscle->points);
+  const MeanValueCoordinateCalculator coordinates(hull);
+  if (m.weights && (m.weights->rows() != m.muscle->points.rows() || m.weights->cols() != hull.points.rows()))
+  {
+    throw InputError("the mean value coordinates given for muscle '" + m.name + "' do not fit its points and hull");
+  }
+  if (!m.weights)
+  {
+    s.ownWeights = coordinates.Compute(m.muscle->points);
+  }
+  s.weights = m.weights ? m.weights : &s.ownWeights;
+
+  Points restSamples, currentSamples;
+  SampleMatchedLines(m.lines, parameters.samplesPerSegment, restSamples, currentSamples);
+  const TriangleTree hullTree(hull);
+  for (size_t l = 0; l < m.lines.size(); ++l)
+  {
+    Points rest, current;
+    SampleMatchedLines({ m.lines[l] }, parameters.samplesPerSegment, rest, current);
+    if (CountInsideTree(hullTree, rest) == 0)
+    {
+      throw InputError("action line " + std::to_string(l + 1) + " of muscle '" + m.name +
+        "' does not pass through the muscle (none of its rest-pose samples is inside the muscle's hull): "
+        "are the action lines in the rest pose, in the same units, paired with the right muscle?");
+    }
+  }
+  const WeightMatrix sampleWeights = coordinates.Compute(restSamples);
+
+  // A piece of the hull that no action line passes through (a scan can leave
+  // one, e.g. cut apart at a pinch) has nothing to place it: its points follow
+  // their nearest action-line segment, as soft rows.
+  int pieces = 0;
+  const std::vector<int> piece = Components(hull.triangles, hull.points.rows(), pieces);
+  std::vector<Eigen::Index> anchored;
+  if (pieces > 1)
+  {
+    for (int c = 0; c < pieces; ++c)
+    {
+      std::vector<Eigen::Index> members, faces;
+      for (Eigen::Index t = 0; t < hull.triangles.rows(); ++t)
+      {
+        if (piece[hull.triangles(t, 0)] == c)
+        {
+          faces.push_back(t);
+        }
+      }
+      Triangles pieceTriangles(static_cast<Eigen::Index>(faces.size()), 3);
+      for (size_t f = 0; f < faces.size(); ++f)
+      {
+        pieceTriangles.row(static_cast<Eigen::Index>(f)) = hull.triangles.row(faces[f]);
+      }
+      bool driven = false;
+      for (Eigen::Index r = 0; r < restSamples.rows() && !driven; ++r)
+      {
+        driven = WindingNumber(hull.points, pieceTriangles, restSamples.row(r).transpose()) > 0.5;
+      }
+      if (!driven)
+      {
+        for (Eigen::Index i = 0; i < hull.points.rows(); ++i)
+        {
+          if (piece[i] == c)
+          {
+            anchored.push_back(i);
+          }
+        }
+      }
+    }
+    if (!anchored.empty())
+    {
+      s.result.warnings.push_back("part of muscle '" + m.name + "' (" + std::to_string(anchored.size()) +
+        " hull points) is a separate piece that no action line passes through: it follows its nearest "
+        "action-line segment");
+    }
+  }
+
+  const SparseMatrix laplacian = CotangentLaplacian(hull);
+  const Points delta = laplacian * hull.points;
+  const std::vector<Eigen::Matrix3d> rotations = SegmentRotations(hull.points, m.lines);
+  s.targets.resize(delta.rows() + currentSamples.rows() + static_cast<Eigen::Index>(anchored.size()), 3);
+  for (Eigen::Index i = 0; i < delta.rows(); ++i)
+  {
+    s.targets.row(i) = (rotations[i] * delta.row(i).transpose()).transpose();
+  }
+  s.targets.middleRows(delta.rows(), currentSamples.rows()) = currentSamples;
+  for (size_t a = 0; a < anchored.size(); ++a)
+  {
+    s.targets.row(delta.rows() + currentSamples.rows() + static_cast<Eigen::Index>(a)) =
+      FollowNearestSegment(hull.points.row(anchored[a]).transpose(), m.lines).transpose();
+  }
+  s.solver =
+    std::make_unique<VolumeConstrainedSolver>(StackRows(laplacian, sampleWeights, anchored), hull.triangles);
+
+  s.hull = hull.points;
+  s.start = m.muscle->points;
+  s.points = s.start;
+  s.hullVolume = EnclosedVolume(hull.points, hull.triangles);
+  s.restVolume = EnclosedVolume(s.start, m.muscle->triangles);
+  if (!(std::abs(s.restVolume) > 0))
+  {
+    throw InputError("muscle '" + m.name + "' encloses no volume");
+  }
+  s.orientation = s.restVolume > 0 ? 1.0 : -1.0;
+  s.frozen.assign(static_cast<size_t>(s.start.rows()), 0);
+  s.stopped.assign(static_cast<size_t>(s.start.rows()), 0);
+  s.touched.assign(static_cast<size_t>(s.start.rows()), 0);
+
+  const TriangleTree muscleTree(*m.muscle);
+  s.result.restSamplesInside = FractionInside(muscleTree, restSamples);
+}
+
+/// Coarse phase: the hull alone, its own volume held, no obstacles.
+void RunCoarsePhase(MuscleState& s, const DeformationParameters& parameters)
+{
+  const double alpha = parameters.stepLength;
+  const int limit = std::min(parameters.maximumCoarseIterations, parameters.maximumIterations);
+  for (int k = 0; k < limit; ++k)
+  {
+    Points next;
+    if (parameters.preserveVolume)
+    {
+      next = s.solver->Step(s.hull, s.targets, s.hullVolume, alpha);
+    }
+    else
+    {
+      next = s.solver->Step(s.hull, s.targets, 0.0, Points(), alpha);
+    }
+    const double change = (next - s.hull).cwiseAbs().maxCoeff();
+    s.hull = next;
+    ++s.result.coarseIterations;
+    if (!next.allFinite())
+    {
+      throw InputError("the deformation of muscle '" + s.input->name + "' diverged on its hull");
+    }
+    if (change < parameters.convergenceTolerance)
+    {
+      break;
+    }
+  }
+}
+
+/// Moves every point of `s` from `points` to `candidate`, except where an
+/// obstacle holds it.
+void MoveWithObstacles(MuscleState& s, const Points& candidate, const std::vector<Obstacle>& bones,
+  const std::vector<const MuscleState*>& others)
+{
+  const double backOff = 1e-6 * s.size;
+  const Eigen::Index n = s.points.rows();
+#pragma omp parallel for schedule(dynamic, 256)
+  for (Eigen::Index i = 0; i < n; ++i)
+  {
+    s.stopped[i] = 0;
+    if (s.frozen[i])
+    {
+      continue;
+    }
+    const Eigen::Vector3d from = s.points.row(i).transpose();
+    const Eigen::Vector3d to = candidate.row(i).transpose();
+    const double length = (to - from).norm();
+    if (length == 0)
+    {
+      continue;
+    }
+    double first = 2; // fraction of the move where the earliest obstacle stops it
+    for (const Obstacle& bone : bones)
+    {
+      if (auto hit = bone.tree->FirstHit(from, to); hit && hit->t < first)
+      {
+        first = hit->t;
+      }
+    }
+    for (const MuscleState* other : others)
+    {
+      // Only entering moves are stopped: the hit triangle faces the move.
+      if (auto hit = other->tree->FirstHit(from, to);
+          hit && hit->t < first && other->orientation * other->tree->Normal(hit->triangle).dot(to - from) < 0)
+      {
+        first = hit->t;
+      }
+    }
+    if (first <= 1)
+    {
+      const double t = std::max(0.0, first - backOff / length);
+      s.points.row(i) = (from + t * (to - from)).transpose();
+      s.stopped[i] = 1;
+      s.touched[i] = 1;
+    }
+    else
+    {
+      s.points.row(i) = candidate.row(i);
+    }
+  }
+}
+
+/// Undoes folds of the full mesh (triangles the mapping turned over, where
+/// the hull deformed too unevenly for its mean value coordinates): the points
+/// around the flipped triangles take back the rest shape of their
+/// neighbourhood (as-rigid-as-possible: local rotations, one small sparse
+/// solve with the region's border fixed), the region growing until nothing is
+/// flipped. Returns whether any point moved.
+bool UnfoldFlippedTriangles(MuscleState& s, const std::vector<Obstacle>& bones, bool dynamicIntersections)
+{
+  const Triangles& triangles = s.input->muscle->triangles;
+  std::vector<Eigen::Index> flipped = FlippedTriangles(s.start, s.points, triangles);
+  if (flipped.empty())
+  {
+    return false;
+  }
+  const Eigen::Index n = s.points.rows();
+  std::vector<std::vector<std::int64_t>> ring(static_cast<size_t>(n));
+  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      ring[triangles(t, k)].push_back(triangles(t, (k + 1) % 3)); // each edge twice: uniform weights
+      ring[triangles(t, k)].push_back(triangles(t, (k + 2) % 3));
+    }
+  }
+  std::vector<char> region(static_cast<size_t>(n), 0);
+  for (int attempt = 0; attempt < 8 && !flipped.empty(); ++attempt)
+  {
+    for (Eigen::Index t : flipped)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        region[triangles(t, k)] = 1;
+      }
+    }
+    for (int grow = 0; grow < 2; ++grow)
+    {
+      std::vector<char> grown = region;
+      for (Eigen::Index i = 0; i < n; ++i)
+      {
+        for (std::int64_t j : ring[i])
+        {
+          grown[i] |= region[j];
+        }
+      }
+      region.swap(grown);
+    }
+    std::vector<Eigen::Index> members, slot(static_cast<size_t>(n), -1);
+    for (Eigen::Index i = 0; i < n; ++i)
+    {
+      if (region[i] && !ring[i].empty())
+      {
+        slot[i] = static_cast<Eigen::Index>(members.size());
+        members.push_back(i);
+      }
+    }
+    const Eigen::Index k = static_cast<Eigen::Index>(members.size());
+    std::vector<Eigen::Triplet<double>> entries;
+    for (Eigen::Index a = 0; a < k; ++a)
+    {
+      const Eigen::Index i = members[a];
+      entries.emplace_back(a, a, static_cast<double>(ring[i].size()));
+      for (std::int64_t j : ring[i])
+      {
+        if (slot[j] >= 0)
+        {
+          entries.emplace_back(a, slot[j], -1.0);
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> system(k, k);
+    system.setFromTriplets(entries.begin(), entries.end());
+    const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(system);
+    Points shape = s.points; // the region reshaped, the rest unchanged
+    for (int local = 0; local < 5 && solver.info() == Eigen::Success; ++local)
+    {
+      std::vector<Eigen::Matrix3d> rotation(static_cast<size_t>(n));
+      auto rotationOf = [&](Eigen::Index i) {
+        Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+        for (std::int64_t j : ring[i])
+        {
+          covariance += (shape.row(j) - shape.row(i)).transpose() * (s.start.row(j) - s.start.row(i));
+        }
+        return BestRotation(covariance);
+      };
+      for (Eigen::Index i : members)
+      {
+        rotation[i] = rotationOf(i);
+      }
+      Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(k, 3);
+      for (Eigen::Index a = 0; a < k; ++a)
+      {
+        const Eigen::Index i = members[a];
+        for (std::int64_t j : ring[i])
+        {
+          const Eigen::Matrix3d r = slot[j] >= 0 ? Eigen::Matrix3d(0.5 * (rotation[i] + rotation[j])) : rotation[i];
+          rhs.row(a) += (r * (s.start.row(i) - s.start.row(j)).transpose()).transpose();
+          if (slot[j] < 0)
+          {
+            rhs.row(a) += shape.row(j);
+          }
+        }
+      }
+      const Eigen::MatrixXd solved = solver.solve(rhs);
+      for (Eigen::Index a = 0; a < k; ++a)
+      {
+        shape.row(members[a]) = solved.row(a);
+      }
+    }
+    // Unfolding is not held by obstacles (a fold is the worse defect): a
+    // point it moves into a bone is frozen there like any point found inside
+    // a bone, for the static resolution to settle.
+    s.points = shape;
+    if (dynamicIntersections)
+    {
+#pragma omp parallel for schedule(dynamic, 16)
+      for (Eigen::Index a = 0; a < k; ++a)
+      {
+        const Eigen::Index i = members[a];
+        const Eigen::Vector3d p = s.points.row(i).transpose();
+        for (const Obstacle& bone : bones)
+        {
+          if (!s.frozen[i] && bone.tree->InBounds(p) && bone.tree->Inside(p))
+          {
+            s.frozen[i] = 1;
+          }
+        }
+      }
+    }
+    // Only triangles whose corners' neighbourhoods changed can have changed.
+    std::vector<char> near = region;
+    for (Eigen::Index i = 0; i < n; ++i)
+    {
+      for (std::int64_t j : ring[i])
+      {
+        near[i] |= region[j];
+      }
+    }
+    std::vector<Eigen::Index> candidates;
+    for (Eigen::Index t = 0; t < triangles.rows(); ++t)
+    {
+      if (near[triangles(t, 0)] || near[triangles(t, 1)] || near[triangles(t, 2)])
+      {
+        candidates.push_back(t);
+      }
+    }
+    flipped = FlippedTriangles(s.start, s.points, triangles, &candidates);
+  }
+  return true;
+}
+
+std::vector<const MuscleState*> OthersOf(const MuscleState& s, const std::vector<MuscleState>& states)
+{
+  std::vector<const MuscleState*> others;
+  for (const MuscleState& o : states)
+  {
+    if (&o != &s)
+    {
+      others.push_back(&o);
+    }
+  }
+  return others;
+}
+
+/// The volume of the full mesh, its gradient with respect to the hull points
+/// (held points do not move, so they do not count), and the held points.
+double FullVolume(const MuscleState& s, Points& hullGradient)
+{
+  Points gradient;
+  const double volume = EnclosedVolume(s.points, s.input->muscle->triangles, &gradient);
+  for (Eigen::Index i = 0; i < gradient.rows(); ++i)
+  {
+    if (s.frozen[i] || s.touched[i])
+    {
+      gradient.row(i).setZero();
+    }
+  }
+  hullGradient = s.weights->transpose() * gradient;
+  return volume;
+}
+}
+
+void SampleMatchedLines(
+  const std::vector<MatchedLine>& lines, int samplesPerSegment, Points& restSamples, Points& currentSamples)
+{
+  samplesPerSegment = std::max(1, samplesPerSegment);
+  Eigen::Index count = 0;
+  for (const MatchedLine& line : lines)
+  {
+    count += (line.rest.rows() - 1) * samplesPerSegment + 1;
+  }
+  restSamples.resize(count, 3);
+  currentSamples.resize(count, 3);
+  Eigen::Index s = 0;
+  for (const MatchedLine& line : lines)
+  {
+    for (Eigen::Index k = 0; k + 1 < line.rest.rows(); ++k)
+    {
+      for (int j = 0; j < samplesPerSegment; ++j)
+      {
+        const double t = static_cast<double>(j) / samplesPerSegment;
+        restSamples.row(s) = (1 - t) * line.rest.row(k) + t * line.rest.row(k + 1);
+        currentSamples.row(s) = (1 - t) * line.current.row(k) + t * line.current.row(k + 1);
+        ++s;
+      }
+    }
+    restSamples.row(s) = line.rest.bottomRows(1);
+    currentSamples.row(s) = line.current.bottomRows(1);
+    ++s;
+  }
+}
+
+std::vector<Eigen::Index> FlippedTriangles(const Points& rest, const Points& deformed, const Triangles& triangles,
+  const std::vector<Eigen::Index>* candidates)
+{
+  // Each point's local motion: the covariance of its edges, rest against deformed.
+  const Eigen::Index n = rest.rows(), m = triangles.rows();
+  std::vector<Eigen::Matrix3d> covariance(static_cast<size_t>(n), Eigen::Matrix3d::Zero());
+  for (Eigen::Index t = 0; t < m; ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      const std::int64_t a = triangles(t, k), b = triangles(t, (k + 1) % 3);
+      const Eigen::Vector3d e0 = (rest.row(b) - rest.row(a)).transpose();
+      const Eigen::Vector3d e1 = (deformed.row(b) - deformed.row(a)).transpose();
+      covariance[a] += e1 * e0.transpose();
+      covariance[b] += e1 * e0.transpose();
+    }
+  }
+  std::vector<char> flipped(static_cast<size_t>(m), 0);
+  const Eigen::Index count = candidates ? static_cast<Eigen::Index>(candidates->size()) : m;
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index c = 0; c < count; ++c)
+  {
+    const Eigen::Index t = candidates ? (*candidates)[c] : c;
+    const Eigen::Vector3d a0 = rest.row(triangles(t, 0)).transpose(), a1 = deformed.row(triangles(t, 0)).transpose();
+    const Eigen::Vector3d n0 = (rest.row(triangles(t, 1)).transpose() - a0).cross(rest.row(triangles(t, 2)).transpose() - a0);
+    const Eigen::Vector3d n1 =
+      (deformed.row(triangles(t, 1)).transpose() - a1).cross(deformed.row(triangles(t, 2)).transpose() - a1);
+    if (n0.squaredNorm() == 0 || n1.squaredNorm() == 0)
+    {
+      continue; // degenerate: no orientation to compare
+    }
+    const Eigen::Matrix3d rotation =
+      BestRotation(covariance[triangles(t, 0)] + covariance[triangles(t, 1)] + covariance[triangles(t, 2)]);
+    flipped[t] = n1.dot(rotation * n0) < 0;
+  }
+  std::vector<Eigen::Index> list;
+  for (Eigen::Index t = 0; t < m; ++t)
+  {
+    if (flipped[t])
+    {
+      list.push_back(t);
+    }
+  }
+  return list;
+}
+
+std::int64_t CountFlippedTriangles(const Points& rest, const Points& deformed, const Triangles& triangles)
+{
+  return static_cast<std::int64_t>(FlippedTriangles(rest, deformed, triangles).size());
+}
+
+Eigen::Matrix3d BestRotation(const Eigen::Matrix3d& covariance)
+{
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
+  return svd.matrixU() * d * svd.matrixV().transpose();
+}
+
+std::int64_t CountInsideTree(const TriangleTree& tree, const Points& points)
+{
+  std::int64_t inside = 0;
+#pragma omp parallel for reduction(+ : inside) schedule(dynamic, 64)
+  for (Eigen::Index i = 0; i < points.rows(); ++i)
+  {
+    const Eigen::Vector3d p = points.row(i).transpose();
+    inside += tree.InBounds(p) && tree.Inside(p) ? 1 : 0;
+  }
+  return inside;
+}
+
+std::vector<Obstacle> BuildObstacles(const std::vector<std::string>& names, const std::vector<TriangleMesh>& meshes)
+{
+  std::vector<Obstacle> obstacles(meshes.size());
+  std::string error;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (size_t b = 0; b < meshes.size(); ++b)
+  {
+    try
+    {
+      obstacles[b] = { names[b], std::make_shared<TriangleTree>(meshes[b]) };
+    }
+    catch (const InputError& e)
+    {
+#pragma omp critical
+      error = "obstacle '" + names[b] + "': " + e.what();
+    }
+  }
+  if (!error.empty())
+  {
+    throw InputError(error);
+  }
+  return obstacles;
+}
+
+std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& muscles,
+  const std::vector<Obstacle>& bones, const DeformationParameters& parameters,
+  const std::function<void(double)>& progress)
+{
+  auto report = [&](double fraction) {
+    if (progress)
+    {
+      progress(fraction);
+    }
+  };
+  std::vector<MuscleState> states(muscles.size());
+  const double share = 1.0 / std::max<size_t>(1, muscles.size());
+  for (size_t m = 0; m < muscles.size(); ++m)
+  {
+    const auto start = Clock::now();
+    MuscleState& s = states[m];
+    s.input = &muscles[m];
+    Validate(muscles[m]);
+    for (const Obstacle& bone : bones)
+    {
+      if (EntirelyInside(*bone.tree, UsedPoints(*muscles[m].muscle)))
+      {
+        throw InputError("muscle '" + muscles[m].name + "' lies entirely inside obstacle '" + bone.name +
+          "' before it moves: are the obstacles in the current pose, in the same units as the muscle?");
+      }
+    }
+    SetUp(s, parameters);
+    report((m + 0.3) * share * 0.5);
+    RunCoarsePhase(s, parameters);
+    s.time += Clock::now() - start;
+    report((m + 1) * share * 0.5);
+  }
+
+  // The fine phase starts from the coarse result, W X. Overlap with a bone
+  // there (present in the rest pose already, or made by the bone's motion)
+  // is what the dynamic rule cannot undo: those points stay, as the paper's
+  // rule says; the static resolution deals with them afterwards.
+  for (MuscleState& s : states)
+  {
+    const auto start = Clock::now();
+    s.fineStep = parameters.stepLength;
+    s.points = *s.weights * s.hull;
+    if (parameters.dynamicIntersections)
+    {
+      const std::int64_t used = UsedPoints(*s.input->muscle).rows();
+      for (const Obstacle& bone : bones)
+      {
+        std::int64_t inside = 0;
+#pragma omp parallel for reduction(+ : inside) schedule(dynamic, 64)
+        for (Eigen::Index i = 0; i < s.points.rows(); ++i)
+        {
+          const Eigen::Vector3d p = s.points.row(i).transpose();
+          if (bone.tree->InBounds(p) && bone.tree->Inside(p))
+          {
+            s.frozen[i] = 1;
+            ++inside;
+          }
+        }
+        if (2 * inside > used)
+        {
+          s.result.warnings.push_back(std::to_string(inside) + " of " + std::to_string(used) + " points of muscle '" +
+            s.input->name + "' are inside obstacle '" + bone.name +
+            "'; they cannot move (are the obstacles in the current pose?)");
+        }
+      }
+      s.tree = std::make_unique<TriangleTree>(TriangleMesh{ s.points, s.input->muscle->triangles });
+    }
+    s.time += Clock::now() - start;
+  }
+
+  // Muscles as obstacles for each other: the coarse phase moved each one
+  // without regard to the others. A point that now lies inside another
+  // muscle but did not in the rest pose (new overlap) moves out to the
+  // nearest point of that muscle's surface (in turn, each muscle against the
+  // others' latest shape; back along its way would drag it far when both
+  // muscles moved together). Overlap the scans already had is left alone.
+  if (parameters.dynamicIntersections && states.size() > 1)
+  {
+    std::vector<std::unique_ptr<TriangleTree>> restTrees;
+    for (const MuscleState& s : states)
+    {
+      restTrees.push_back(std::make_unique<TriangleTree>(*s.input->muscle));
+    }
+    for (MuscleState& s : states)
+    {
+      const auto start = Clock::now();
+      for (size_t o = 0; o < states.size(); ++o)
+      {
+        const MuscleState& other = states[o];
+        if (&other == &s)
+        {
+          continue;
+        }
+#pragma omp parallel for schedule(dynamic, 64)
+        for (Eigen::Index i = 0; i < s.points.rows(); ++i)
+        {
+          const Eigen::Vector3d p = s.points.row(i).transpose(), rest = s.start.row(i).transpose();
+          if (s.frozen[i] || !other.tree->InBounds(p) || !other.tree->Inside(p) ||
+            (restTrees[o]->InBounds(rest) && restTrees[o]->Inside(rest)))
+          {
+            continue;
+          }
+          const TriangleTree::Closest closest = other.tree->ClosestPoint(p);
+          if (closest.distance > 0)
+          {
+            s.points.row(i) = (closest.point + (1e-6 * s.size / closest.distance) * (closest.point - p)).transpose();
+            s.touched[i] = 1;
+          }
+        }
+      }
+      s.tree->Refit(s.points);
+      s.time += Clock::now() - start;
+    }
+  }
+
+  // Fine phase: all muscles step in turn, each against the others' latest shape.
+  // (each muscle stops at its own limit: maximumIterations less its coarse iterations)
+  const int fineLimit = parameters.maximumIterations;
+  for (int k = 0; k < fineLimit; ++k)
+  {
+    bool anyActive = false;
+    for (size_t m = 0; m < states.size(); ++m)
+    {
+      MuscleState& s = states[m];
+      if (s.fineDone)
+      {
+        continue;
+      }
+      const auto start = Clock::now();
+      anyActive = true;
+      Points next;
+      if (parameters.preserveVolume)
+      {
+        Points gradient;
+        const double volume = FullVolume(s, gradient);
+        next = s.solver->Step(s.hull, s.targets, volume - s.restVolume, gradient, s.fineStep);
+      }
+      else
+      {
+        next = s.solver->Step(s.hull, s.targets, 0.0, Points(), s.fineStep);
+      }
+      if (!next.allFinite())
+      {
+        throw InputError("the deformation of muscle '" + s.input->name + "' diverged on its full mesh");
+      }
+      const Points change = next - s.hull;
+      const double largest = change.cwiseAbs().maxCoeff();
+      // Points held by obstacles make the full mesh's volume respond less
+      // than the step assumes, and full steps can then swing back and forth:
+      // a change larger than the last halves the step length.
+      if (largest > s.lastChange)
+      {
+        s.fineStep = std::max(0.5 * s.fineStep, 0.05);
+      }
+      s.lastChange = largest;
+      s.hull = next;
+      const Points candidate = s.points + *s.weights * change;
+      if (parameters.dynamicIntersections)
+      {
+        MoveWithObstacles(s, candidate, bones, OthersOf(s, states));
+        s.tree->Refit(s.points);
+      }
+      else
+      {
+        s.points = candidate;
+      }
+      ++s.result.iterations;
+      const int total = s.result.coarseIterations + s.result.iterations;
+      if (largest < parameters.convergenceTolerance)
+      {
+        // Converged: undo any fold, then let the volume settle again (a few times at most).
+        if (s.unfoldings < maximumUnfoldings && UnfoldFlippedTriangles(s, bones, parameters.dynamicIntersections))
+        {
+          ++s.unfoldings;
+          s.lastChange = std::numeric_limits<double>::max();
+          if (s.tree)
+          {
+            s.tree->Refit(s.points);
+          }
+        }
+        else
+        {
+          s.converged = s.fineDone = true;
+          s.flipsCheckedClean = s.unfoldings < maximumUnfoldings; // the check just found none, nothing moved since
+        }
+      }
+      else if (total >= parameters.maximumIterations)
+      {
+        s.fineDone = true;
+      }
+      s.time += Clock::now() - start;
+    }
+    report(0.5 + 0.5 * (k + 1) / std::max(1, fineLimit));
+    if (!anyActive)
+    {
+      break;
+    }
+  }
+
+  std::vector<DeformationResult> results;
+  for (MuscleState& s : states)
+  {
+    const auto start = Clock::now();
+    DeformationResult& r = s.result;
+    r.iterations += r.coarseIterations;
+    r.converged = s.converged;
+    r.points = s.points;
+    r.hullPoints = s.hull;
+    const double volume = EnclosedVolume(s.points, s.input->muscle->triangles);
+    r.volumeChangePercent = 100.0 * (volume - s.restVolume) / s.restVolume;
+    r.flippedTriangles =
+      s.flipsCheckedClean ? 0 : CountFlippedTriangles(s.start, s.points, s.input->muscle->triangles);
+    for (size_t i = 0; i < s.frozen.size(); ++i)
+    {
+      r.verticesFrozen += s.frozen[i];
+      r.verticesStopped += s.stopped[i];
+    }
+    Points restSamples, currentSamples;
+    SampleMatchedLines(s.input->lines, parameters.samplesPerSegment, restSamples, currentSamples);
+    const TriangleTree deformed(TriangleMesh{ s.points, s.input->muscle->triangles });
+    r.currentSamplesInside = FractionInside(deformed, currentSamples);
+    if (!r.converged)
+    {
+      r.warnings.push_back("muscle '" + s.input->name + "' did not converge in " +
+        std::to_string(parameters.maximumIterations) + " iterations");
+    }
+    s.time += Clock::now() - start;
+    r.seconds = std::chrono::duration<double>(s.time).count();
+    results.push_back(std::move(r));
+  }
+  report(1.0);
+  return results;
+}
+}

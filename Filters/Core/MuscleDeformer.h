@@ -1,0 +1,133 @@
+// One rest-pose -> current-pose pass of the muscle deformation (Kellnhofer &
+// Kohout, after Huang et al. 2006; METHOD.md sections 4 and 5 "Dynamic"):
+// least squares on the hull points, shape rows (cotangent Laplacian with
+// rotated Laplacian coordinates) and action-line rows, the volume held by
+// corrected Gauss-Newton steps, the full mesh following by mean value
+// coordinates, and vertices kept out of obstacles at every fine iteration.
+#pragma once
+
+#include "MeanValueCoordinates.h"
+#include "MeshTypes.h"
+#include "TriangleTree.h"
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace md
+{
+/// A matched action line (ActionLineMatching): the same number of points in
+/// both poses, point k of `rest` moving to point k of `current`.
+struct MatchedLine
+{
+  Points rest;
+  Points current;
+};
+
+struct DeformationParameters
+{
+  int maximumIterations = 200;       ///< both phases together
+  int maximumCoarseIterations = 100; ///< of them, at most this many on the hull alone
+  /// Converged when no hull coordinate moves more than this in an iteration
+  /// (data units; 0.01 mm in the original).
+  double convergenceTolerance = 0.01;
+  /// Gauss-Newton step length alpha in (0, 1]. The original damped with 0.1
+  /// falling to 0.025, which needs about 10x more iterations for the same
+  /// result: the energy is quadratic apart from the volume, and the corrected
+  /// step (VolumeConstrainedSolver) converges at full length.
+  double stepLength = 1.0;
+  bool preserveVolume = true;
+  bool dynamicIntersections = true;
+  int samplesPerSegment = 10; ///< action-line rows per segment of each matched line
+};
+
+/// One muscle to deform.
+struct MuscleToDeform
+{
+  std::string name;           ///< for messages
+  const TriangleMesh* muscle; ///< full mesh in the rest pose (any point order; unused points follow too)
+  const TriangleMesh* hull;   ///< rest-pose hull enclosing the muscle (BuildProgressiveHull)
+  std::vector<MatchedLine> lines;
+  /// Mean value coordinates of the muscle's points in the hull (one row per
+  /// point), when already known: they depend on the rest pose only, so
+  /// callers that deform the same muscle again keep them. Computed when null.
+  const WeightMatrix* weights = nullptr;
+};
+
+struct DeformationResult
+{
+  Points points;     ///< deformed full mesh
+  Points hullPoints; ///< deformed hull
+  int iterations = 0;
+  int coarseIterations = 0;
+  bool converged = false;
+  double volumeChangePercent = 0; ///< of the full mesh
+  std::int64_t flippedTriangles = 0;
+  /// Points left where they were because they were inside a bone when the
+  /// fine phase started (frozen), and points stopped at an obstacle's surface
+  /// in the last step.
+  std::int64_t verticesFrozen = 0;
+  std::int64_t verticesStopped = 0;
+  /// Action-line samples inside the muscle: rest samples in the rest-pose
+  /// muscle, current samples in the deformed muscle (fractions in [0, 1]).
+  double restSamplesInside = 0;
+  double currentSamplesInside = 0;
+  double seconds = 0; ///< this muscle's share of the pass (set-up and iterations)
+  std::vector<std::string> warnings;
+};
+
+/// An obstacle in the current pose (a bone, or any mesh the muscles may not
+/// enter). The muscles of a pass are obstacles for each other without being listed.
+struct Obstacle
+{
+  std::string name;
+  std::shared_ptr<const TriangleTree> tree;
+};
+
+/// Bounding-volume hierarchies of the obstacles, built in parallel.
+std::vector<Obstacle> BuildObstacles(const std::vector<std::string>& names, const std::vector<TriangleMesh>& meshes);
+
+/// Deforms every muscle from the rest pose to the current pose in one pass,
+/// all together.
+///
+/// Coarse phase: the hull alone, its own volume held, no obstacles. Fine
+/// phase, from the coarse result W X: the volume of the full mesh held and,
+/// with `dynamicIntersections`, every move that would enter an obstacle or
+/// another muscle stops at its surface, and a point inside a bone when the
+/// fine phase starts stays where it is (the paper's rule). Before the fine
+/// phase, a point the coarse phase put inside another muscle, where it was not
+/// in the rest pose, goes out to that muscle's nearest surface point. At
+/// convergence, triangles the mapping turned over are unfolded and the volume
+/// settles again.
+///
+/// Throws InputError naming the muscle for input that cannot give a sound
+/// result: an action line that does not pass through the hull, a muscle
+/// entirely inside an obstacle before it moves, no or unmatched action lines,
+/// non-finite coordinates, a least-squares system nothing fixes. The caller
+/// checks that a hull it was given encloses its muscle. `progress`
+/// (optional) receives fractions in [0, 1].
+std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& muscles,
+  const std::vector<Obstacle>& bones, const DeformationParameters& parameters,
+  const std::function<void(double)>& progress = {});
+
+/// Samples along matched lines: `samplesPerSegment` per segment plus the last
+/// point of each line, the same parameters on both poses.
+void SampleMatchedLines(
+  const std::vector<MatchedLine>& lines, int samplesPerSegment, Points& restSamples, Points& currentSamples);
+
+/// Triangles the deformation turned over: the deformed normal points against
+/// the rest normal carried by the rotation of the triangle's neighbourhood
+/// (the best rotation of the edges at its three points, rest to deformed).
+/// A rigid motion flips none, whatever the rotation.
+std::int64_t CountFlippedTriangles(const Points& rest, const Points& deformed, const Triangles& triangles);
+/// The same triangles, listed; only among `candidates` when given.
+std::vector<Eigen::Index> FlippedTriangles(const Points& rest, const Points& deformed, const Triangles& triangles,
+  const std::vector<Eigen::Index>* candidates = nullptr);
+
+/// The rotation closest to a 3 x 3 covariance sum(deformed edge * rest edge^T) (Kabsch).
+Eigen::Matrix3d BestRotation(const Eigen::Matrix3d& covariance);
+
+/// Number of `points` inside the closed surface of `tree` (bounding-box check first).
+std::int64_t CountInsideTree(const TriangleTree& tree, const Points& points);
+}

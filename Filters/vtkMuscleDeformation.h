@@ -1,0 +1,106 @@
+/**
+ * @class   vtkMuscleDeformation
+ * @brief   Deforms muscles from the rest pose to the current pose in one pass.
+ *
+ * The deformation of Kellnhofer & Kohout (after Huang et al. 2006), the
+ * paper's "original method": the unknowns are the points of each muscle's
+ * coarse hull (input 3, or built as HullDecimation does), the muscle follows
+ * by mean value coordinates. Least squares of the hull's cotangent Laplacian
+ * (its rest-pose Laplacian coordinates rotated as the nearest action-line
+ * segment turns) and of action-line rows (samples of each matched rest-pose
+ * line must reach the matching current-pose samples), with the volume held
+ * by Gauss-Newton steps with a Lagrange multiplier (the corrected form: the
+ * volume converges to the rest volume). A coarse phase on the hull, then a
+ * fine phase with the volume measured on the full mesh and dynamic
+ * intersections: a point that would enter an obstacle stops at its surface;
+ * one inside a bone stays where it is. Triangles the mapping turns over are
+ * unfolded (their neighbourhood takes back its rest shape).
+ *
+ * Inputs: 0 Input, muscles in the rest pose; 1 ActionLines, output 0 of
+ * ActionLineMatching (rest-pose lines with point array CurrentPosition), one
+ * block per muscle (by name, else by order); 2 Obstacles, any number of
+ * meshes in the current pose (optional); 3 Hull, optional, one per muscle.
+ * All muscles of the input are deformed together, each an obstacle for the
+ * others.
+ *
+ * Output: the muscles (same structure, cells and arrays) with moved points,
+ * point array Displacement, and field data VolumeChangePercent,
+ * NumberOfIterations, CoarseIterations, Converged, FlippedTriangleCount,
+ * PointsFrozenInObstacles, PointsStoppedAtObstacles,
+ * RestActionLineSamplesInside, CurrentActionLineSamplesInside,
+ * HullSeconds, ElapsedSeconds.
+ */
+#pragma once
+
+#include "MuscleDeformationFiltersModule.h"
+
+#include <vtkPassInputTypeAlgorithm.h>
+
+class MUSCLEDEFORMATIONFILTERS_EXPORT vtkMuscleDeformation : public vtkPassInputTypeAlgorithm
+{
+public:
+  static vtkMuscleDeformation* New();
+  vtkTypeMacro(vtkMuscleDeformation, vtkPassInputTypeAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// Connections: port 1 action lines, port 2 obstacles (repeatable), port 3 hull.
+  void SetActionLinesConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(1, output); }
+  void AddObstacleConnection(vtkAlgorithmOutput* output) { this->AddInputConnection(2, output); }
+  void RemoveAllObstacles() { this->SetInputConnection(2, nullptr); }
+  void SetHullConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(3, output); }
+
+  /// Iterations of both phases together. Default 200.
+  vtkSetClampMacro(MaximumNumberOfIterations, int, 1, 100000);
+  vtkGetMacro(MaximumNumberOfIterations, int);
+
+  /// Of them, at most this many on the hull alone. Default 100.
+  vtkSetClampMacro(MaximumCoarseIterations, int, 0, 100000);
+  vtkGetMacro(MaximumCoarseIterations, int);
+
+  /// Converged when no hull coordinate moves more than this in an iteration
+  /// (data units). Default 0.01.
+  vtkSetClampMacro(ConvergenceTolerance, double, 1e-12, VTK_DOUBLE_MAX);
+  vtkGetMacro(ConvergenceTolerance, double);
+
+  /// Gauss-Newton step length in (0, 1]. Default 1.
+  vtkSetClampMacro(StepLength, double, 0.01, 1.0);
+  vtkGetMacro(StepLength, double);
+
+  /// Action-line rows per segment of each matched line. Default 10.
+  vtkSetClampMacro(SamplesPerSegment, int, 1, 1000);
+  vtkGetMacro(SamplesPerSegment, int);
+
+  /// Hold the volume. Default on.
+  vtkSetMacro(PreserveVolume, bool);
+  vtkGetMacro(PreserveVolume, bool);
+  vtkBooleanMacro(PreserveVolume, bool);
+
+  /// Keep points out of the obstacles and the other muscles. Default on.
+  vtkSetMacro(DynamicIntersections, bool);
+  vtkGetMacro(DynamicIntersections, bool);
+  vtkBooleanMacro(DynamicIntersections, bool);
+
+  /// Points of the hulls built when input 3 is empty. Default 250.
+  vtkSetClampMacro(HullTargetNumberOfPoints, int, 4, VTK_INT_MAX);
+  vtkGetMacro(HullTargetNumberOfPoints, int);
+
+protected:
+  vtkMuscleDeformation();
+  ~vtkMuscleDeformation() override = default;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  int MaximumNumberOfIterations = 200;
+  int MaximumCoarseIterations = 100;
+  double ConvergenceTolerance = 0.01;
+  double StepLength = 1.0;
+  int SamplesPerSegment = 10;
+  bool PreserveVolume = true;
+  bool DynamicIntersections = true;
+  int HullTargetNumberOfPoints = 250;
+
+private:
+  vtkMuscleDeformation(const vtkMuscleDeformation&) = delete;
+  void operator=(const vtkMuscleDeformation&) = delete;
+};
