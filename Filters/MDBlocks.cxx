@@ -197,23 +197,28 @@ void AssignLeaves(
   });
 }
 
-Points ToPoints(vtkPoints* points)
+Points ToPoints(vtkDataArray* array)
 {
-  const vtkIdType n = points ? points->GetNumberOfPoints() : 0;
+  const vtkIdType n = array ? array->GetNumberOfTuples() : 0;
   Points out(n, 3);
   if (n == 0)
   {
     return out;
   }
   // One call into VTK per array rather than per point: VTK here is built -O0.
-  vtkSmartPointer<vtkDoubleArray> doubles = vtkDoubleArray::SafeDownCast(points->GetData());
+  vtkSmartPointer<vtkDoubleArray> doubles = vtkDoubleArray::SafeDownCast(array);
   if (!doubles)
   {
     doubles = vtkSmartPointer<vtkDoubleArray>::New();
-    doubles->DeepCopy(points->GetData());
+    doubles->DeepCopy(array);
   }
   std::copy(doubles->GetPointer(0), doubles->GetPointer(0) + 3 * n, out.data());
   return out;
+}
+
+Points ToPoints(vtkPoints* points)
+{
+  return ToPoints(points ? points->GetData() : nullptr);
 }
 
 vtkSmartPointer<vtkPoints> ToVtkPoints(const Points& points)
@@ -241,7 +246,7 @@ vtkSmartPointer<vtkPolyData> ToPolyData(const TriangleMesh& mesh)
   return polyData;
 }
 
-std::vector<Points> ToPolylines(vtkPolyData* polyData)
+std::vector<Points> ToPolylines(vtkPolyData* polyData, const Points* values)
 {
   std::vector<Points> lines;
   vtkCellArray* cells = polyData ? polyData->GetLines() : nullptr;
@@ -249,7 +254,8 @@ std::vector<Points> ToPolylines(vtkPolyData* polyData)
   {
     return lines;
   }
-  const Points all = ToPoints(polyData->GetPoints());
+  const Points all = values ? Points() : ToPoints(polyData->GetPoints());
+  const Points& source = values ? *values : all;
   auto it = vtk::TakeSmartPointer(cells->NewIterator());
   for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
   {
@@ -259,7 +265,7 @@ std::vector<Points> ToPolylines(vtkPolyData* polyData)
     Points line(size, 3);
     for (vtkIdType k = 0; k < size; ++k)
     {
-      line.row(k) = all.row(ids[k]);
+      line.row(k) = source.row(ids[k]);
     }
     lines.push_back(std::move(line));
   }

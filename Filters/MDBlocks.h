@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+class vtkDataArray;
 class vtkDataObject;
 class vtkFieldData;
 class vtkInformation;
@@ -58,11 +59,14 @@ void AcceptPolyDataOrMultiBlock(vtkInformation* info);
 
 /// Point coordinates in double precision.
 Points ToPoints(vtkPoints* points);
+/// The tuples of a 3-component array (such as CurrentPosition) in double precision.
+Points ToPoints(vtkDataArray* array);
 vtkSmartPointer<vtkPoints> ToVtkPoints(const Points& points);
 vtkSmartPointer<vtkPolyData> ToPolyData(const TriangleMesh& mesh);
 /// The polygons of `input` as triangles (polygons and strips triangulated),
 /// with all of its points. Returns the number of cells that were not triangles.
 vtkIdType ReadTriangles(vtkPolyData* input, TriangleMesh& mesh);
-/// The polylines of a polydata, each as its point coordinates.
-std::vector<Points> ToPolylines(vtkPolyData* polyData);
+/// The polylines of a polydata, each as its point coordinates, or as the rows
+/// of `values` (one per point of the polydata, e.g. a point array) when given.
+std::vector<Points> ToPolylines(vtkPolyData* polyData, const Points* values = nullptr);
 }

@@ -6,7 +6,6 @@
 #include <vtkAlgorithmOutput.h>
 #include <vtkCellArray.h>
 #include <vtkDataArray.h>
-#include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
 #include <vtkIdTypeArray.h>
 #include <vtkInformation.h>
@@ -134,11 +133,7 @@ bool vtkBoneInterpolation::ReadPoses(
                          "pose, or use port 0 of ActionLineMatching");
         return false;
       }
-      vtkNew<vtkDoubleArray> asDouble;
-      asDouble->DeepCopy(position);
-      pose.current.resize(asDouble->GetNumberOfTuples(), 3);
-      std::copy(asDouble->GetPointer(0), asDouble->GetPointer(0) + pose.current.size(),
-        pose.current.data());
+      pose.current = mdvtk::ToPoints(position);
     }
     if (!md::AllFinite(pose.rest))
     {

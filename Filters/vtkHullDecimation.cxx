@@ -101,8 +101,7 @@ int vtkHullDecimation::RequestData(
     }
     if (this->VerifyEnclosure)
     {
-      const double size = (muscle.points.colwise().maxCoeff() - muscle.points.colwise().minCoeff()).norm();
-      const std::int64_t outside = md::CountOutside(hull.hull, md::UsedPoints(muscle), 1e-9 * size);
+      const std::int64_t outside = md::CountPointsOutsideHull(hull.hull, muscle);
       const std::int64_t crossings = md::CountSelfIntersections(hull.hull);
       mdvtk::AddFieldValue(fieldData, "PointsOutsideHull", outside);
       mdvtk::AddFieldValue(fieldData, "HullSelfIntersections", crossings);

@@ -6,7 +6,6 @@
 #include "ProgressiveHull.h"
 
 #include <vtkCellArray.h>
-#include <vtkCellArrayIterator.h>
 #include <vtkDataArray.h>
 #include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
@@ -47,22 +46,12 @@ bool ReadMatchedLines(const mdvtk::Leaf& leaf, std::vector<md::MatchedLine>& lin
       " has no point array CurrentPosition (3 components): connect output 0 of ActionLineMatching";
     return false;
   }
-  const md::Points rest = mdvtk::ToPoints(data->GetPoints());
-  auto it = vtk::TakeSmartPointer(data->GetLines()->NewIterator());
-  for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
+  const md::Points currentPositions = mdvtk::ToPoints(current);
+  const std::vector<md::Points> rest = mdvtk::ToPolylines(data);
+  const std::vector<md::Points> moved = mdvtk::ToPolylines(data, &currentPositions);
+  for (size_t l = 0; l < rest.size(); ++l)
   {
-    vtkIdType size;
-    const vtkIdType* ids;
-    it->GetCurrentCell(size, ids);
-    md::MatchedLine line;
-    line.rest.resize(size, 3);
-    line.current.resize(size, 3);
-    for (vtkIdType k = 0; k < size; ++k)
-    {
-      line.rest.row(k) = rest.row(ids[k]);
-      current->GetTuple(ids[k], line.current.row(k).data());
-    }
-    lines.push_back(std::move(line));
+    lines.push_back({ rest[l], moved[l] });
   }
   return true;
 }
@@ -171,13 +160,11 @@ int vtkMuscleDeformation::RequestData(
                       << " is not a closed, outward-oriented manifold surface: build it with HullDecimation");
         return 0;
       }
-      const md::Points used = md::UsedPoints(surfaces[b]);
-      const double size = (used.colwise().maxCoeff() - used.colwise().minCoeff()).norm();
-      const std::int64_t outside = md::CountOutside(hulls[b], used, 1e-9 * size);
+      const std::int64_t outside = md::CountPointsOutsideHull(hulls[b], surfaces[b]);
       if (outside > 0)
       {
         vtkErrorMacro(<< hullLeaf.label << " does not enclose " << leaf.label << ": " << outside << " of "
-                      << used.rows()
+                      << md::UsedPoints(surfaces[b]).rows()
                       << " muscle points are outside it, where mean value coordinates extrapolate; build the "
                          "hull with HullDecimation or leave Hull empty");
         return 0;

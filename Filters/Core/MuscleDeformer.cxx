@@ -1,9 +1,8 @@
 #include "MuscleDeformer.h"
 
 #include "MeshChecks.h"
+#include "RigidMotion.h"
 #include "VolumeConstrainedSolver.h"
-
-#include <Eigen/SVD>
 
 #include <algorithm>
 #include <chrono>
@@ -24,46 +23,67 @@ double Diagonal(const Points& points)
   return (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
 }
 
-/// Distance from p to the segment ab.
-double SegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+/// The action-line segment nearest to p (over all lines), as line and index
+/// of its first point, with the parameter of p's foot on it in [0, 1].
+/// Segments of zero length in either pose carry no direction and are skipped.
+struct NearestSegment
 {
-  const Eigen::Vector3d ab = b - a;
-  const double length2 = ab.squaredNorm();
-  const double t = length2 > 0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
-}
+  const MatchedLine* line = nullptr;
+  Eigen::Index k = 0;
+  double t = 0;
 
-/// Rotation of each hull point: the one taking the rest direction of the
-/// nearest action-line segment to its current direction.
-std::vector<Eigen::Matrix3d> SegmentRotations(const Points& hull, const std::vector<MatchedLine>& lines)
-{
-  std::vector<Eigen::Matrix3d> rotations(static_cast<size_t>(hull.rows()), Eigen::Matrix3d::Identity());
-  for (Eigen::Index i = 0; i < hull.rows(); ++i)
+  NearestSegment(const Eigen::Vector3d& p, const std::vector<MatchedLine>& lines)
   {
-    const Eigen::Vector3d p = hull.row(i).transpose();
     double nearest = std::numeric_limits<double>::max();
-    for (const MatchedLine& line : lines)
+    for (const MatchedLine& candidate : lines)
     {
-      for (Eigen::Index k = 0; k + 1 < line.rest.rows(); ++k)
+      for (Eigen::Index s = 0; s + 1 < candidate.rest.rows(); ++s)
       {
-        const Eigen::Vector3d a = line.rest.row(k).transpose(), b = line.rest.row(k + 1).transpose();
-        const Eigen::Vector3d from = b - a;
-        const Eigen::Vector3d to = (line.current.row(k + 1) - line.current.row(k)).transpose();
-        if (from.norm() == 0 || to.norm() == 0)
+        const Eigen::Vector3d a = candidate.rest.row(s).transpose(), b = candidate.rest.row(s + 1).transpose();
+        if ((b - a).squaredNorm() == 0 || (candidate.current.row(s + 1) - candidate.current.row(s)).squaredNorm() == 0)
         {
-          continue; // a repeated point carries no direction
+          continue;
         }
-        const double d = SegmentDistance(p, a, b);
+        const double foot = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+        const double d = (a + foot * (b - a) - p).norm();
         if (d < nearest)
         {
           nearest = d;
-          rotations[i] = Eigen::Quaterniond::FromTwoVectors(from, to).toRotationMatrix();
+          this->line = &candidate;
+          this->k = s;
+          this->t = foot;
         }
       }
     }
   }
-  return rotations;
-}
+
+  /// The rotation taking the segment's rest direction to its current one.
+  Eigen::Matrix3d Rotation() const
+  {
+    if (!this->line)
+    {
+      return Eigen::Matrix3d::Identity();
+    }
+    return Eigen::Quaterniond::FromTwoVectors(
+      (this->line->rest.row(this->k + 1) - this->line->rest.row(this->k)).transpose(),
+      (this->line->current.row(this->k + 1) - this->line->current.row(this->k)).transpose())
+      .toRotationMatrix();
+  }
+
+  /// Where the segment's motion takes p: rotated about its foot on the
+  /// segment, which moves with the segment.
+  Eigen::Vector3d Follow(const Eigen::Vector3d& p) const
+  {
+    if (!this->line)
+    {
+      return p;
+    }
+    const auto at = [&](const Points& pose) {
+      return Eigen::Vector3d(((1 - this->t) * pose.row(this->k) + this->t * pose.row(this->k + 1)).transpose());
+    };
+    return at(this->line->current) + this->Rotation() * (p - at(this->line->rest));
+  }
+};
 
 /// Stacks the Laplacian rows, the dense action-line rows and one row per
 /// anchored point (its position).
@@ -132,34 +152,6 @@ std::vector<int> Components(const Triangles& triangles, Eigen::Index points, int
   return component;
 }
 
-/// Where the nearest action-line segment's motion takes p: the segment's
-/// rotation about the nearest point on it, which moves with the segment.
-Eigen::Vector3d FollowNearestSegment(const Eigen::Vector3d& p, const std::vector<MatchedLine>& lines)
-{
-  double nearest = std::numeric_limits<double>::max();
-  Eigen::Vector3d moved = p;
-  for (const MatchedLine& line : lines)
-  {
-    for (Eigen::Index k = 0; k + 1 < line.rest.rows(); ++k)
-    {
-      const Eigen::Vector3d a = line.rest.row(k).transpose(), b = line.rest.row(k + 1).transpose();
-      const Eigen::Vector3d a1 = line.current.row(k).transpose(), b1 = line.current.row(k + 1).transpose();
-      const double length2 = (b - a).squaredNorm();
-      const double t = length2 > 0 ? std::clamp((p - a).dot(b - a) / length2, 0.0, 1.0) : 0.0;
-      const Eigen::Vector3d on = a + t * (b - a);
-      if ((p - on).norm() < nearest)
-      {
-        nearest = (p - on).norm();
-        const Eigen::Matrix3d rotation = (b - a).norm() > 0 && (b1 - a1).norm() > 0
-          ? Eigen::Quaterniond::FromTwoVectors(b - a, b1 - a1).toRotationMatrix()
-          : Eigen::Matrix3d::Identity();
-        moved = a1 + t * (b1 - a1) + rotation * (p - on);
-      }
-    }
-  }
-  return moved;
-}
-
 /// Whether every point lies inside the tree's surface (a box test first).
 bool EntirelyInside(const TriangleTree& tree, const Points& points)
 {
@@ -187,6 +179,7 @@ struct MuscleState
   const WeightMatrix* weights = nullptr; // full mesh = weights * hull
   std::unique_ptr<VolumeConstrainedSolver> solver;
   Points targets;
+  Points currentSamples; // action-line samples in the current pose
   Points hull;    // X
   Points points;  // the full mesh as it moves (W X where nothing held it)
   Points start;   // rest pose
@@ -257,14 +250,17 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
   }
   s.weights = m.weights ? m.weights : &s.ownWeights;
 
-  Points restSamples, currentSamples;
+  Points restSamples;
+  Points& currentSamples = s.currentSamples;
   SampleMatchedLines(m.lines, parameters.samplesPerSegment, restSamples, currentSamples);
   const TriangleTree hullTree(hull);
+  Eigen::Index first = 0; // each line's samples follow the previous line's
   for (size_t l = 0; l < m.lines.size(); ++l)
   {
-    Points rest, current;
-    SampleMatchedLines({ m.lines[l] }, parameters.samplesPerSegment, rest, current);
-    if (CountInsideTree(hullTree, rest) == 0)
+    const Eigen::Index count = (m.lines[l].rest.rows() - 1) * std::max(1, parameters.samplesPerSegment) + 1;
+    const bool passes = CountInsideTree(hullTree, restSamples.middleRows(first, count)) > 0;
+    first += count;
+    if (!passes)
     {
       throw InputError("action line " + std::to_string(l + 1) + " of muscle '" + m.name +
         "' does not pass through the muscle (none of its rest-pose samples is inside the muscle's hull): "
@@ -283,7 +279,7 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
   {
     for (int c = 0; c < pieces; ++c)
     {
-      std::vector<Eigen::Index> members, faces;
+      std::vector<Eigen::Index> faces;
       for (Eigen::Index t = 0; t < hull.triangles.rows(); ++t)
       {
         if (piece[hull.triangles(t, 0)] == c)
@@ -322,17 +318,20 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
 
   const SparseMatrix laplacian = CotangentLaplacian(hull);
   const Points delta = laplacian * hull.points;
-  const std::vector<Eigen::Matrix3d> rotations = SegmentRotations(hull.points, m.lines);
   s.targets.resize(delta.rows() + currentSamples.rows() + static_cast<Eigen::Index>(anchored.size()), 3);
   for (Eigen::Index i = 0; i < delta.rows(); ++i)
   {
-    s.targets.row(i) = (rotations[i] * delta.row(i).transpose()).transpose();
+    // Rotated as the nearest action-line segment turns.
+    s.targets.row(i) =
+      (NearestSegment(hull.points.row(i).transpose(), m.lines).Rotation() * delta.row(i).transpose()).transpose();
   }
   s.targets.middleRows(delta.rows(), currentSamples.rows()) = currentSamples;
   for (size_t a = 0; a < anchored.size(); ++a)
   {
     s.targets.row(delta.rows() + currentSamples.rows() + static_cast<Eigen::Index>(a)) =
-      FollowNearestSegment(hull.points.row(anchored[a]).transpose(), m.lines).transpose();
+      NearestSegment(hull.points.row(anchored[a]).transpose(), m.lines)
+        .Follow(hull.points.row(anchored[a]).transpose())
+        .transpose();
   }
   s.solver =
     std::make_unique<VolumeConstrainedSolver>(StackRows(laplacian, sampleWeights, anchored), hull.triangles);
@@ -700,14 +699,6 @@ std::int64_t CountFlippedTriangles(const Points& rest, const Points& deformed, c
   return static_cast<std::int64_t>(FlippedTriangles(rest, deformed, triangles).size());
 }
 
-Eigen::Matrix3d BestRotation(const Eigen::Matrix3d& covariance)
-{
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-  d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
-  return svd.matrixU() * d * svd.matrixV().transpose();
-}
-
 std::int64_t CountInsideTree(const TriangleTree& tree, const Points& points)
 {
   std::int64_t inside = 0;
@@ -762,9 +753,10 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
     MuscleState& s = states[m];
     s.input = &muscles[m];
     Validate(muscles[m]);
+    const Points used = UsedPoints(*muscles[m].muscle);
     for (const Obstacle& bone : bones)
     {
-      if (EntirelyInside(*bone.tree, UsedPoints(*muscles[m].muscle)))
+      if (EntirelyInside(*bone.tree, used))
       {
         throw InputError("muscle '" + muscles[m].name + "' lies entirely inside obstacle '" + bone.name +
           "' before it moves: are the obstacles in the current pose, in the same units as the muscle?");
@@ -961,10 +953,8 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
       r.verticesFrozen += s.frozen[i];
       r.verticesStopped += s.stopped[i];
     }
-    Points restSamples, currentSamples;
-    SampleMatchedLines(s.input->lines, parameters.samplesPerSegment, restSamples, currentSamples);
     const TriangleTree deformed(TriangleMesh{ s.points, s.input->muscle->triangles });
-    r.currentSamplesInside = FractionInside(deformed, currentSamples);
+    r.currentSamplesInside = FractionInside(deformed, s.currentSamples);
     if (!r.converged)
     {
       r.warnings.push_back("muscle '" + s.input->name + "' did not converge in " +

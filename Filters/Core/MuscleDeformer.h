@@ -125,8 +125,6 @@ std::int64_t CountFlippedTriangles(const Points& rest, const Points& deformed, c
 std::vector<Eigen::Index> FlippedTriangles(const Points& rest, const Points& deformed, const Triangles& triangles,
   const std::vector<Eigen::Index>* candidates = nullptr);
 
-/// The rotation closest to a 3 x 3 covariance sum(deformed edge * rest edge^T) (Kabsch).
-Eigen::Matrix3d BestRotation(const Eigen::Matrix3d& covariance);
 
 /// Number of `points` inside the closed surface of `tree` (bounding-box check first).
 std::int64_t CountInsideTree(const TriangleTree& tree, const Points& points);

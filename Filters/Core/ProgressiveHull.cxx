@@ -1025,4 +1025,11 @@ MuscleHull BuildMuscleHull(const TriangleMesh& muscle, const HullParameters& par
   built.result = BuildProgressiveHull(built.clean, parameters, &built.report.pointsToEnclose);
   return built;
 }
+
+std::int64_t CountPointsOutsideHull(const TriangleMesh& hull, const TriangleMesh& muscle)
+{
+  const Points used = UsedPoints(muscle);
+  const double size = (used.colwise().maxCoeff() - used.colwise().minCoeff()).norm();
+  return CountOutside(hull, used, 1e-9 * size);
+}
 }

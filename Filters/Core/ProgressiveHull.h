@@ -59,4 +59,8 @@ struct MuscleHull
   HullResult result;
 };
 MuscleHull BuildMuscleHull(const TriangleMesh& muscle, const HullParameters& parameters);
+
+/// Points of `muscle` (those its triangles use) outside `hull`; points within
+/// 1e-9 of the muscle's size from the hull count as inside. Every point is tested.
+std::int64_t CountPointsOutsideHull(const TriangleMesh& hull, const TriangleMesh& muscle);
 }

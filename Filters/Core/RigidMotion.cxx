@@ -23,6 +23,14 @@ RigidTransform RigidTransform::AboutPoint(
   return t;
 }
 
+Eigen::Matrix3d BestRotation(const Eigen::Matrix3d& covariance)
+{
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d reflectionFix = Eigen::Matrix3d::Identity();
+  reflectionFix(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
+  return svd.matrixU() * reflectionFix * svd.matrixV().transpose();
+}
+
 RigidFit FitRigidTransform(const Points& from, const Points& to)
 {
   if (from.rows() != to.rows() || from.rows() == 0)
@@ -31,14 +39,8 @@ RigidFit FitRigidTransform(const Points& from, const Points& to)
   }
   const Eigen::RowVector3d cFrom = from.colwise().mean();
   const Eigen::RowVector3d cTo = to.colwise().mean();
-  const Eigen::Matrix3d covariance =
-    (from.rowwise() - cFrom).transpose() * (to.rowwise() - cTo);
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d reflectionFix = Eigen::Matrix3d::Identity();
-  reflectionFix(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
-
   RigidFit fit;
-  fit.transform.rotation = svd.matrixV() * reflectionFix * svd.matrixU().transpose();
+  fit.transform.rotation = BestRotation((to.rowwise() - cTo).transpose() * (from.rowwise() - cFrom));
   fit.transform.translation = cTo.transpose() - fit.transform.rotation * cFrom.transpose();
   const Points residual = to - fit.transform.Apply(from);
   const Eigen::VectorXd norms = residual.rowwise().norm();

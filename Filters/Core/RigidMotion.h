@@ -27,6 +27,10 @@ struct RigidFit
   double maxResidual = 0; ///< largest |to_i - T(from_i)|
 };
 
+/// The proper rotation R closest to a 3 x 3 covariance sum(to_i from_i^T) of
+/// centred point pairs, i.e. the R minimising sum |to_i - R from_i|^2 (Kabsch).
+Eigen::Matrix3d BestRotation(const Eigen::Matrix3d& covariance);
+
 /// Proper rotation and translation minimising sum |to_i - (R from_i + t)|^2
 /// (Kabsch / Horn). Both sets must have the same number of points (>= 1).
 RigidFit FitRigidTransform(const Points& from, const Points& to);

@@ -2,6 +2,7 @@
 #include "MeanValueCoordinates.h"
 #include "MeshChecks.h"
 #include "Phantom.h"
+#include "TestMeshes.h"
 #include "ProgressiveHull.h"
 #include "SurfaceRepair.h"
 #include "TriangleIntersection.h"
@@ -18,20 +19,6 @@ using md::Triangles;
 namespace
 {
 /// A closed, outward-oriented axis-aligned box of 8 points and 12 triangles.
-TriangleMesh Box(const Eigen::Vector3d& low, const Eigen::Vector3d& high)
-{
-  TriangleMesh box;
-  box.points.resize(8, 3);
-  for (int i = 0; i < 8; ++i)
-  {
-    box.points.row(i) << (i & 1 ? high[0] : low[0]), (i & 2 ? high[1] : low[1]), (i & 4 ? high[2] : low[2]);
-  }
-  box.triangles.resize(12, 3);
-  box.triangles << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5,
-    3, 7, 5;
-  return box;
-}
-
 TriangleMesh Octahedron()
 {
   TriangleMesh o;

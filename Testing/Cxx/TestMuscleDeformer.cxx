@@ -6,6 +6,7 @@
 #include "Phantom.h"
 #include "ProgressiveHull.h"
 #include "RigidMotion.h"
+#include "TestMeshes.h"
 
 #include <gtest/gtest.h>
 
@@ -226,17 +227,8 @@ TEST(MuscleDeformer, BadInputIsRefusedWithTheMuscleNamed)
     EXPECT_NE(std::string(e.what()).find("Iliopsoas"), std::string::npos) << e.what();
   }
   // A muscle lying entirely inside an obstacle (given in the wrong place).
-  const Eigen::RowVector3d low = c.muscles[0].muscle->points.colwise().minCoeff().array() - 10;
-  const Eigen::RowVector3d high = c.muscles[0].muscle->points.colwise().maxCoeff().array() + 10;
-  TriangleMesh box;
-  box.points.resize(8, 3);
-  for (int k = 0; k < 8; ++k)
-  {
-    box.points.row(k) << (k & 1 ? high : low)(0), (k & 2 ? high : low)(1), (k & 4 ? high : low)(2);
-  }
-  box.triangles.resize(12, 3);
-  box.triangles << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1,
-    3, 5, 3, 7, 5;
+  const TriangleMesh box = Box(c.muscles[0].muscle->points.colwise().minCoeff().transpose().array() - 10,
+    c.muscles[0].muscle->points.colwise().maxCoeff().transpose().array() + 10);
   ASSERT_GT(md::SignedVolume(box.points, box.triangles), 0);
   const auto swallowing = md::BuildObstacles({ "BigBone" }, { box });
   EXPECT_THROW(md::DeformMuscles({ c.muscles[0] }, swallowing, md::DeformationParameters{}), md::InputError);
