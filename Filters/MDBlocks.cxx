@@ -9,6 +9,7 @@
 #include <vtkIntArray.h>
 #include <vtkIdList.h>
 #include <vtkInformation.h>
+#include <vtkInformationVector.h>
 #include <vtkMultiBlockDataSet.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -302,5 +303,35 @@ vtkIdType ReadTriangles(vtkPolyData* input, TriangleMesh& mesh)
   mesh.triangles.resize(triangles->GetNumberOfPolys(), 3);
   std::copy(connectivity->GetPointer(0), connectivity->GetPointer(0) + mesh.triangles.size(), mesh.triangles.data());
   return converted;
+}
+bool ReadMeshes(vtkInformationVector* port, const std::string& portName, std::vector<std::string>& names,
+  std::vector<TriangleMesh>& meshes, std::string& error)
+{
+  for (int c = 0; c < port->GetNumberOfInformationObjects(); ++c)
+  {
+    std::vector<Leaf> leaves;
+    const std::string name = portName + " connection " + std::to_string(c + 1);
+    if (!CollectLeaves(vtkDataObject::GetData(port, c), name, leaves, error))
+    {
+      return false;
+    }
+    for (const Leaf& leaf : leaves)
+    {
+      if (!leaf.data)
+      {
+        continue;
+      }
+      TriangleMesh mesh;
+      ReadTriangles(leaf.data, mesh);
+      if (mesh.triangles.rows() == 0 || !md::AllFinite(mesh.points))
+      {
+        error = leaf.label + " is not a usable mesh: it needs triangles and finite coordinates";
+        return false;
+      }
+      names.push_back(leaf.name.empty() ? leaf.label : leaf.name);
+      meshes.push_back(std::move(mesh));
+    }
+  }
+  return true;
 }
 }

@@ -197,31 +197,10 @@ int vtkMuscleDeformation::RequestData(
   // Obstacles: every block of every connection of port 2.
   std::vector<std::string> obstacleNames;
   std::vector<md::TriangleMesh> obstacleMeshes;
-  for (int c = 0; c < inputVector[2]->GetNumberOfInformationObjects(); ++c)
+  if (!mdvtk::ReadMeshes(inputVector[2], "Obstacles", obstacleNames, obstacleMeshes, error))
   {
-    std::vector<mdvtk::Leaf> leaves;
-    const std::string name = "Obstacles connection " + std::to_string(c + 1);
-    if (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[2], c), name, leaves, error))
-    {
-      vtkErrorMacro(<< error);
-      return 0;
-    }
-    for (const mdvtk::Leaf& leaf : leaves)
-    {
-      if (!leaf.data)
-      {
-        continue;
-      }
-      md::TriangleMesh mesh;
-      mdvtk::ReadTriangles(leaf.data, mesh);
-      if (mesh.triangles.rows() == 0 || !md::AllFinite(mesh.points))
-      {
-        vtkErrorMacro(<< leaf.label << " is not a usable obstacle: it needs triangles and finite coordinates");
-        return 0;
-      }
-      obstacleNames.push_back(leaf.name.empty() ? leaf.label : leaf.name);
-      obstacleMeshes.push_back(std::move(mesh));
-    }
+    vtkErrorMacro(<< error);
+    return 0;
   }
 
   md::DeformationParameters parameters;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <unordered_map>
 #include <vector>
 
@@ -194,5 +195,90 @@ Points UsedPoints(const TriangleMesh& mesh)
 std::int64_t CountSelfIntersections(const TriangleMesh& surface)
 {
   return static_cast<std::int64_t>(FindSelfIntersections(surface.points, surface.triangles).size());
+}
+}
+
+namespace md
+{
+std::vector<int> Components(
+  const Triangles& triangles, Eigen::Index points, int& count, const std::vector<char>* member)
+{
+  auto isMember = [&](std::int64_t i) { return !member || (*member)[static_cast<size_t>(i)]; };
+  std::vector<int> parent(static_cast<size_t>(points));
+  std::iota(parent.begin(), parent.end(), 0);
+  auto root = [&](int x) {
+    while (parent[x] != x)
+    {
+      x = parent[x] = parent[parent[x]];
+    }
+    return x;
+  };
+  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      const std::int64_t a = triangles(t, k), b = triangles(t, (k + 1) % 3);
+      if (isMember(a) && isMember(b))
+      {
+        parent[root(static_cast<int>(b))] = root(static_cast<int>(a));
+      }
+    }
+  }
+  std::vector<int> label(static_cast<size_t>(points), -1), component(static_cast<size_t>(points), -1);
+  count = 0;
+  for (Eigen::Index i = 0; i < points; ++i)
+  {
+    if (!isMember(i))
+    {
+      continue;
+    }
+    int& l = label[root(static_cast<int>(i))];
+    if (l < 0)
+    {
+      l = count++;
+    }
+    component[i] = l;
+  }
+  return component;
+}
+
+std::int64_t CountNewSharpEdges(
+  const Points& rest, const Points& current, const Triangles& triangles, double angleDegrees)
+{
+  // The two triangles of each edge, keyed by its ordered point pair.
+  std::unordered_map<std::uint64_t, std::pair<Eigen::Index, Eigen::Index>> edges;
+  edges.reserve(static_cast<size_t>(triangles.rows()) * 2);
+  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      const auto a = static_cast<std::uint64_t>(triangles(t, k)), b = static_cast<std::uint64_t>(triangles(t, (k + 1) % 3));
+      auto [entry, added] = edges.try_emplace((std::min(a, b) << 32) | std::max(a, b), t, -1);
+      if (!added)
+      {
+        entry->second.second = entry->second.second < 0 ? t : -2; // -2: more than two triangles
+      }
+    }
+  }
+  auto normal = [&](const Points& p, Eigen::Index t) -> Eigen::Vector3d {
+    const Eigen::Vector3d a = p.row(triangles(t, 0)), b = p.row(triangles(t, 1)), c = p.row(triangles(t, 2));
+    return (b - a).cross(c - a);
+  };
+  const double limit = std::cos(angleDegrees * 3.14159265358979323846 / 180.0);
+  auto sharp = [&](const Points& p, Eigen::Index s, Eigen::Index t) {
+    const Eigen::Vector3d n = normal(p, s), m = normal(p, t);
+    const double norms = n.norm() * m.norm();
+    return norms > 0 && n.dot(m) < limit * norms;
+  };
+  std::int64_t count = 0;
+  for (const auto& entry : edges)
+  {
+    const auto [s, t] = entry.second;
+    if (t >= 0 && sharp(current, s, t) && !sharp(rest, s, t))
+    {
+      ++count;
+    }
+  }
+  return count;
 }
 }

@@ -3,6 +3,8 @@
 
 #include "MeshTypes.h"
 
+#include <vector>
+
 namespace md
 {
 struct EdgeReport
@@ -51,6 +53,18 @@ std::int64_t CountOutside(const TriangleMesh& surface, const Points& points, dou
 
 /// The points the triangles use, in order (mesh files may carry others).
 Points UsedPoints(const TriangleMesh& mesh);
+
+/// Connected component of every point, numbered from 0 (`count` of them),
+/// through the edges of the triangles. With `member`, only member points
+/// count and an edge joins two members only; other points get -1.
+std::vector<int> Components(
+  const Triangles& triangles, Eigen::Index points, int& count, const std::vector<char>* member = nullptr);
+
+/// Edges (between two triangles) whose dihedral angle, the angle between the
+/// normals of their triangles, exceeds `angleDegrees` in `current` but not in
+/// `rest` (same triangles): the pits and folds a deformation made.
+std::int64_t CountNewSharpEdges(
+  const Points& rest, const Points& current, const Triangles& triangles, double angleDegrees = 60.0);
 
 /// Number of pairs of triangles that intersect other than at what they share.
 std::int64_t CountSelfIntersections(const TriangleMesh& surface);

@@ -119,39 +119,6 @@ SparseMatrix StackRows(
   return rows;
 }
 
-/// Connected component of every point (through triangles), numbered from 0.
-std::vector<int> Components(const Triangles& triangles, Eigen::Index points, int& count)
-{
-  std::vector<int> parent(static_cast<size_t>(points));
-  std::iota(parent.begin(), parent.end(), 0);
-  auto root = [&](int x) {
-    while (parent[x] != x)
-    {
-      x = parent[x] = parent[parent[x]];
-    }
-    return x;
-  };
-  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
-  {
-    for (int k = 1; k < 3; ++k)
-    {
-      parent[root(static_cast<int>(triangles(t, k)))] = root(static_cast<int>(triangles(t, 0)));
-    }
-  }
-  std::vector<int> label(static_cast<size_t>(points), -1), component(static_cast<size_t>(points));
-  count = 0;
-  for (Eigen::Index i = 0; i < points; ++i)
-  {
-    int& l = label[root(static_cast<int>(i))];
-    if (l < 0)
-    {
-      l = count++;
-    }
-    component[i] = l;
-  }
-  return component;
-}
-
 /// Whether every point lies inside the tree's surface (a box test first).
 bool EntirelyInside(const TriangleTree& tree, const Points& points)
 {
@@ -243,6 +210,10 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
   if (m.weights && (m.weights->rows() != m.muscle->points.rows() || m.weights->cols() != hull.points.rows()))
   {
     throw InputError("the mean value coordinates given for muscle '" + m.name + "' do not fit its points and hull");
+  }
+  if (m.detail && m.detail->rows() != m.muscle->points.rows())
+  {
+    throw InputError("the detail given for muscle '" + m.name + "' does not fit its points");
   }
   if (!m.weights)
   {
@@ -340,12 +311,13 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
   s.start = m.muscle->points;
   s.points = s.start;
   s.hullVolume = EnclosedVolume(hull.points, hull.triangles);
-  s.restVolume = EnclosedVolume(s.start, m.muscle->triangles);
-  if (!(std::abs(s.restVolume) > 0))
+  const double ownVolume = EnclosedVolume(s.start, m.muscle->triangles);
+  if (!(std::abs(ownVolume) > 0))
   {
     throw InputError("muscle '" + m.name + "' encloses no volume");
   }
-  s.orientation = s.restVolume > 0 ? 1.0 : -1.0;
+  s.orientation = ownVolume > 0 ? 1.0 : -1.0;
+  s.restVolume = m.targetVolume != 0 ? m.targetVolume : ownVolume;
   s.frozen.assign(static_cast<size_t>(s.start.rows()), 0);
   s.stopped.assign(static_cast<size_t>(s.start.rows()), 0);
   s.touched.assign(static_cast<size_t>(s.start.rows()), 0);
@@ -778,6 +750,10 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
     const auto start = Clock::now();
     s.fineStep = parameters.stepLength;
     s.points = *s.weights * s.hull;
+    if (s.input->detail)
+    {
+      s.points += *s.input->detail;
+    }
     if (parameters.dynamicIntersections)
     {
       const std::int64_t used = UsedPoints(*s.input->muscle).rows();

@@ -53,6 +53,14 @@ struct MuscleToDeform
   /// point), when already known: they depend on the rest pose only, so
   /// callers that deform the same muscle again keep them. Computed when null.
   const WeightMatrix* weights = nullptr;
+  /// Per-point offset from weights * hull (one row per point), when the
+  /// muscle is not exactly the mapping of its hull: a step of the
+  /// interpolation method starts from a resolved mesh whose bone prints the
+  /// hull does not carry. The full mesh is then weights * hull + detail.
+  const Points* detail = nullptr;
+  /// Volume to hold, when not the muscle's own (a step of the interpolation
+  /// method holds the rest pose's volume, so that no error builds up); 0: its own.
+  double targetVolume = 0;
 };
 
 struct DeformationResult

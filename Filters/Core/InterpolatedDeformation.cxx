@@ -1,0 +1,446 @@
+#include "InterpolatedDeformation.h"
+
+#include "MeshChecks.h"
+#include "VolumeConstrainedSolver.h"
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+namespace md
+{
+namespace
+{
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start)
+{
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// The rest-pose hull of a muscle and its mean value coordinates.
+struct HullAndMapping
+{
+  TriangleMesh hull;
+  WeightMatrix weights;
+};
+
+HullAndMapping BuildHullAndMapping(const MuscleMotion& m, const Points& points, const HullParameters& parameters)
+{
+  HullAndMapping h;
+  try
+  {
+    h.hull = BuildMuscleHull(TriangleMesh{ points, m.muscle.triangles }, parameters).result.hull;
+  }
+  catch (const InputError& e)
+  {
+    throw InputError("muscle '" + m.name + "': " + e.what());
+  }
+  h.weights = MeanValueCoordinates(h.hull, points);
+  return h;
+}
+
+/// Smooths the per-point detail (a few halfway steps to the mean of the
+/// neighbours): the sharp rims of earlier steps' bone prints fade, as in
+/// elastic tissue once the bone has moved on; where the bone still is, the
+/// next static resolution makes the print again, a short way.
+void RelaxDetail(const Triangles& triangles, int iterations, Points& detail)
+{
+  const Eigen::Index n = detail.rows();
+  for (int k = 0; k < iterations; ++k)
+  {
+    Points sum = Points::Zero(n, 3);
+    Eigen::VectorXd count = Eigen::VectorXd::Zero(n);
+    for (Eigen::Index t = 0; t < triangles.rows(); ++t)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        sum.row(triangles(t, a)) += detail.row(triangles(t, (a + 1) % 3));
+        count(triangles(t, a)) += 1;
+      }
+    }
+    for (Eigen::Index i = 0; i < n; ++i)
+    {
+      if (count(i) > 0)
+      {
+        detail.row(i) = 0.5 * detail.row(i) + (0.5 / count(i)) * sum.row(i);
+      }
+    }
+  }
+}
+
+void Validate(const std::vector<MuscleMotion>& muscles, const std::vector<BoneMotion>& bones)
+{
+  if (muscles.empty())
+  {
+    throw InputError("there is no muscle to deform");
+  }
+  for (const MuscleMotion& m : muscles)
+  {
+    if (m.muscle.points.rows() == 0 || m.muscle.triangles.rows() == 0)
+    {
+      throw InputError("muscle '" + m.name + "' has no surface");
+    }
+    if (m.lines.empty())
+    {
+      throw InputError("muscle '" + m.name + "' has no action line: nothing says where it goes");
+    }
+  }
+  for (const BoneMotion& b : bones)
+  {
+    if (b.rest.points.rows() != b.current.rows())
+    {
+      throw InputError("bone '" + b.name + "' has " + std::to_string(b.rest.points.rows()) +
+        " points in the rest pose but " + std::to_string(b.current.rows()) +
+        " in the current pose: both poses must have the same points");
+    }
+    if (!AllFinite(b.rest.points) || !AllFinite(b.current))
+    {
+      throw InputError("bone '" + b.name + "' has non-finite coordinates (NaN or infinity)");
+    }
+    if (b.rest.triangles.rows() == 0)
+    {
+      throw InputError("bone '" + b.name + "' has no surface (no triangles)");
+    }
+  }
+}
+
+double LargestMotion(const std::vector<MuscleMotion>& muscles, const std::vector<BoneMotion>& bones)
+{
+  double largest = 0;
+  for (const BoneMotion& b : bones)
+  {
+    largest = std::max(largest, MaximumDisplacement(b.rest.points, b.current));
+  }
+  for (const MuscleMotion& m : muscles)
+  {
+    for (const MatchedLine& line : m.lines)
+    {
+      if (line.rest.rows() == line.current.rows())
+      {
+        largest = std::max(largest, MaximumDisplacement(line.rest, line.current));
+      }
+    }
+  }
+  return largest;
+}
+}
+
+struct HullRefitter::Factorisation
+{
+  Eigen::LDLT<Eigen::MatrixXd> ldlt;
+};
+
+HullRefitter::HullRefitter(const WeightMatrix& weights, const TriangleMesh& restHull, double regularisation)
+  : Weights(weights)
+{
+  Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(weights.cols(), weights.cols());
+  normal.selfadjointView<Eigen::Lower>().rankUpdate(weights.transpose());
+  normal = normal.selfadjointView<Eigen::Lower>();
+  const Eigen::MatrixXd laplacian = Eigen::MatrixXd(CotangentLaplacian(restHull));
+  const Eigen::MatrixXd shape = laplacian.transpose() * laplacian;
+  // Both terms pull towards the guess: the Laplacian one keeps the shape, the
+  // identity one holds the hull points the mesh hardly depends on (small
+  // columns of W), which the fit alone would send far away.
+  const double scale = regularisation * normal.trace();
+  this->Regulariser = (scale / std::max(shape.trace(), 1e-300)) * shape;
+  this->Regulariser.diagonal().array() += scale / static_cast<double>(normal.rows());
+  auto solver = std::make_shared<Factorisation>();
+  solver->ldlt.compute(normal + this->Regulariser);
+  this->Solver = solver;
+}
+
+Points HullRefitter::Fit(const Points& mesh, const Points& guess) const
+{
+  const Eigen::MatrixXd right = this->Weights.transpose() * mesh + this->Regulariser * guess;
+  return this->Solver->ldlt.solve(right);
+}
+
+int ResolveNumberOfSteps(const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters)
+{
+  if (parameters.numberOfSteps > 0)
+  {
+    return parameters.numberOfSteps;
+  }
+  double largest = 0;
+  for (const BoneMotion& b : bones)
+  {
+    if (b.rest.points.rows() == b.current.rows())
+    {
+      largest = std::max(largest, MaximumDisplacement(b.rest.points, b.current));
+    }
+  }
+  return AutomaticNumberOfSteps(largest, parameters.maximumStepDisplacement);
+}
+
+InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscles,
+  const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters,
+  const std::function<void(double)>& progress)
+{
+  const auto start = Clock::now();
+  auto report = [&](double fraction) {
+    if (progress)
+    {
+      progress(fraction);
+    }
+  };
+  Validate(muscles, bones);
+  const size_t count = muscles.size();
+  InterpolationResult result;
+  const int steps = ResolveNumberOfSteps(bones, parameters);
+  result.numberOfSteps = steps;
+  std::vector<Points> restPoints;
+  for (const MuscleMotion& m : muscles)
+  {
+    restPoints.push_back(m.muscle.points);
+  }
+  result.points.assign(1, restPoints);
+  result.measures.assign(1, std::vector<MuscleStepMeasures>(count));
+  result.stepSeconds.assign(1, 0.0);
+  result.restHullSeconds.assign(count, 0.0);
+
+  if (LargestMotion(muscles, bones) == 0)
+  {
+    // Nothing moves: every step is the rest pose, exactly.
+    result.zeroMotion = true;
+    result.warnings.push_back("the motion has zero length (the current pose equals the rest pose): "
+                              "the muscles are returned as they are");
+    for (int j = 1; j <= steps; ++j)
+    {
+      result.points.push_back(restPoints);
+      result.measures.push_back(result.measures[0]);
+      result.stepSeconds.push_back(0.0);
+    }
+    result.totalSeconds = SecondsSince(start);
+    report(1.0);
+    return result;
+  }
+
+  // Interpolators of the bones and of every matched action line (their
+  // construction checks the pairs).
+  std::vector<PoseInterpolator> boneMotions;
+  std::vector<std::string> boneNames;
+  for (const BoneMotion& b : bones)
+  {
+    boneMotions.emplace_back(b.rest.points, b.current, parameters.interpolationMode);
+    boneNames.push_back(b.name);
+  }
+  std::vector<std::vector<PoseInterpolator>> lineMotions(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    for (const MatchedLine& line : muscles[m].lines)
+    {
+      if (line.rest.rows() < 2 || line.rest.rows() != line.current.rows())
+      {
+        throw InputError("an action line of muscle '" + muscles[m].name +
+          "' is not matched: it needs at least two points, as many in the rest pose as in the current pose");
+      }
+      lineMotions[m].emplace_back(line.rest, line.current, parameters.interpolationMode);
+    }
+  }
+
+  // The rest-pose hulls and mappings, the muscles in parallel (each hull is
+  // built serially; the mappings parallelise inside).
+  std::vector<TriangleMesh> hulls(count);
+  std::vector<WeightMatrix> weights(count);
+  std::vector<std::string> errors(count);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int m = 0; m < static_cast<int>(count); ++m)
+  {
+    const auto hullStart = Clock::now();
+    try
+    {
+      hulls[m] = BuildMuscleHull(muscles[m].muscle, parameters.hull).result.hull;
+    }
+    catch (const InputError& e)
+    {
+      errors[m] = "muscle '" + muscles[m].name + "': " + e.what();
+    }
+    result.restHullSeconds[m] = SecondsSince(hullStart);
+  }
+  for (const std::string& error : errors)
+  {
+    if (!error.empty())
+    {
+      throw InputError(error);
+    }
+  }
+  std::vector<std::unique_ptr<HullRefitter>> refitters(count);
+  std::vector<Points> details(count);
+  std::vector<double> restVolumes(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    const auto mappingStart = Clock::now();
+    weights[m] = MeanValueCoordinates(hulls[m], muscles[m].muscle.points);
+    details[m] = muscles[m].muscle.points - weights[m] * hulls[m].points;
+    if (parameters.hullMode == HullMode::Refit)
+    {
+      refitters[m] = std::make_unique<HullRefitter>(weights[m], hulls[m], parameters.refitRegularisation);
+    }
+    restVolumes[m] = EnclosedVolume(muscles[m].muscle.points, muscles[m].muscle.triangles);
+    result.restHullSeconds[m] += SecondsSince(mappingStart);
+    report(0.2 * (m + 1) / count);
+  }
+
+  // Overlap the rest pose already has (the scans overlap the bones): left
+  // alone by the static resolution and not counted as new penetration.
+  const std::vector<Obstacle> restBones = BuildObstacles(boneNames, [&] {
+    std::vector<TriangleMesh> meshes;
+    for (const BoneMotion& b : bones)
+    {
+      meshes.push_back(b.rest);
+    }
+    return meshes;
+  }());
+  auto fixedObstacles = [](const std::vector<Obstacle>& obstacles) {
+    std::vector<FixedObstacle> fixed;
+    for (const Obstacle& o : obstacles)
+    {
+      fixed.push_back({ o.name, o.tree.get() });
+    }
+    return fixed;
+  };
+  std::vector<TriangleMesh> current(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    current[m] = muscles[m].muscle;
+  }
+  const OverlapMasks restOverlap = FindOverlaps(current, fixedObstacles(restBones));
+
+  double stepStart = 0.2;
+  const double stepShare = 0.8 / steps;
+  std::vector<MuscleStepMeasures> previous(count);
+  for (int j = 1; j <= steps; ++j)
+  {
+    const auto stepClock = Clock::now();
+    std::vector<TriangleMesh> boneMeshes;
+    for (size_t b = 0; b < bones.size(); ++b)
+    {
+      boneMeshes.push_back({ boneMotions[b].AtStep(j, steps), bones[b].rest.triangles });
+    }
+    const std::vector<Obstacle> obstacles = BuildObstacles(boneNames, boneMeshes);
+
+    std::vector<MuscleStepMeasures> measures(count);
+    std::vector<TriangleMesh> stepHulls(count);
+    std::vector<MuscleToDeform> toDeform(count);
+    for (size_t m = 0; m < count; ++m)
+    {
+      const auto hullStart = Clock::now();
+      if (parameters.hullMode == HullMode::Rebuild && j > 1)
+      {
+        try
+        {
+          HullAndMapping rebuilt = BuildHullAndMapping(muscles[m], current[m].points, parameters.hull);
+          if (!CheckEdges(rebuilt.hull.triangles).IsClosedOrientedManifold())
+          {
+            throw InputError("the rebuilt hull is not a closed manifold surface");
+          }
+          hulls[m] = std::move(rebuilt.hull);
+          weights[m] = std::move(rebuilt.weights);
+          details[m] = current[m].points - weights[m] * hulls[m].points;
+        }
+        catch (const InputError& e)
+        {
+          result.warnings.push_back("step " + std::to_string(j) + ": the hull of muscle '" + muscles[m].name +
+            "' could not be rebuilt (" + e.what() + "); the previous step's hull is kept");
+        }
+      }
+      measures[m].hullSeconds = SecondsSince(hullStart);
+      MuscleToDeform& d = toDeform[m];
+      d.name = muscles[m].name;
+      d.muscle = &current[m];
+      d.hull = &hulls[m];
+      d.weights = &weights[m];
+      d.detail = &details[m];
+      d.targetVolume = restVolumes[m];
+      for (const PoseInterpolator& line : lineMotions[m])
+      {
+        d.lines.push_back({ line.AtStep(j - 1, steps), line.AtStep(j, steps) });
+      }
+    }
+
+    const std::vector<DeformationResult> deformed =
+      DeformMuscles(toDeform, obstacles, parameters.deformation, [&](double fraction) {
+        report(stepStart + 0.9 * stepShare * fraction);
+      });
+    std::vector<TriangleMesh> next(count);
+    for (size_t m = 0; m < count; ++m)
+    {
+      next[m] = { deformed[m].points, muscles[m].muscle.triangles };
+      for (const std::string& warning : deformed[m].warnings)
+      {
+        result.warnings.push_back("step " + std::to_string(j) + ": " + warning);
+      }
+    }
+    const std::vector<FixedObstacle> fixed = fixedObstacles(obstacles);
+    StaticResolveResult resolved = ResolveStaticIntersections(next, fixed, &restOverlap, parameters.staticResolve);
+    std::vector<std::vector<char>> held(count);
+    for (size_t m = 0; m < count; ++m)
+    {
+      next[m].points = resolved.points[m];
+      held[m].resize(static_cast<size_t>(next[m].points.rows()));
+      for (Eigen::Index i = 0; i < next[m].points.rows(); ++i)
+      {
+        held[m][i] = resolved.shift[m].row(i).squaredNorm() > 0;
+        for (const std::vector<char>& overlap : restOverlap[m])
+        {
+          held[m][i] = held[m][i] || (!overlap.empty() && overlap[i]);
+        }
+      }
+    }
+    if (parameters.deformation.preserveVolume)
+    {
+      RestoreVolumes(next, restVolumes, fixed, held);
+    }
+    for (size_t m = 0; m < count; ++m)
+    {
+      const auto hullStart = Clock::now();
+      hulls[m].points = parameters.hullMode == HullMode::Refit
+        ? refitters[m]->Fit(next[m].points, deformed[m].hullPoints)
+        : deformed[m].hullPoints;
+      details[m] = next[m].points - weights[m] * hulls[m].points;
+      RelaxDetail(muscles[m].muscle.triangles, parameters.detailRelaxation, details[m]);
+      measures[m].hullSeconds += SecondsSince(hullStart);
+    }
+    const std::vector<Penetration> penetration = MeasureNewPenetration(next, fixed, &restOverlap);
+
+    std::vector<Points> stepPoints(count);
+    for (size_t m = 0; m < count; ++m)
+    {
+      MuscleStepMeasures& s = measures[m];
+      const TriangleMesh& rest = muscles[m].muscle;
+      s.volumeChangePercent =
+        100.0 * (EnclosedVolume(next[m].points, rest.triangles) - restVolumes[m]) / restVolumes[m];
+      s.newPenetrationCount = penetration[m].count;
+      s.maxNewPenetrationDepth = penetration[m].maxDepth;
+      s.newBonePenetrationCount = penetration[m].fixedCount;
+      s.maxNewBonePenetrationDepth = penetration[m].fixedMaxDepth;
+      s.stepStaticShift = resolved.reports[m].maxShift;
+      s.maxStaticShift = std::max(previous[m].maxStaticShift, s.stepStaticShift);
+      s.staticallyMovedPoints = resolved.reports[m].penetratingPoints;
+      s.sharpEdgeCount = CountNewSharpEdges(rest.points, next[m].points, rest.triangles);
+      s.flippedTriangleCount = CountFlippedTriangles(rest.points, next[m].points, rest.triangles);
+      s.stepIterations = deformed[m].iterations;
+      s.iterations = previous[m].iterations + s.stepIterations;
+      s.converged = previous[m].converged && deformed[m].converged;
+      s.pointsFrozenInObstacles = deformed[m].verticesFrozen;
+      s.deformationSeconds = deformed[m].seconds;
+      s.staticShift = std::move(resolved.shift[m]);
+      stepPoints[m] = next[m].points;
+    }
+    current = std::move(next);
+    previous = measures;
+    result.points.push_back(std::move(stepPoints));
+    result.measures.push_back(std::move(measures));
+    result.stepSeconds.push_back(SecondsSince(stepClock));
+    stepStart += stepShare;
+    report(stepStart);
+  }
+  result.totalSeconds = SecondsSince(start);
+  report(1.0);
+  return result;
+}
+}

@@ -1,0 +1,128 @@
+// The interpolation method (Hajkova & Kohout sec. 4.3; METHOD.md section 6):
+// the motion split into N steps, bones and matched action lines interpolated
+// at every step, each step deformed from the previous result (all muscles
+// together, obstacles for each other) and then statically resolved.
+//
+// Beyond the paper (HullMode::Refit): the rest-pose hull and its mean value
+// coordinates are kept for the whole motion. After each step's static
+// resolution the hull is refitted to the resolved mesh by least squares with a
+// fixed matrix, and what the hull cannot carry (the bone prints) is kept as
+// per-point detail; the paper rebuilt the hull before every step
+// (HullMode::Rebuild, kept for comparison).
+#pragma once
+
+#include "BoneInterpolation.h"
+#include "MeanValueCoordinates.h"
+#include "MuscleDeformer.h"
+#include "ProgressiveHull.h"
+#include "StaticIntersections.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace md
+{
+enum class HullMode
+{
+  Refit = 0,   ///< keep the rest-pose hull and mapping, refit after each step
+  Rebuild = 1, ///< the paper: a new hull and mapping before each step
+};
+
+/// The least-squares inverse of a mean value mapping: the hull points X that
+/// best reproduce a full mesh V, argmin |W X - V|^2 + lambda |L (X - X0)|^2
+/// + mu |X - X0|^2, with L the rest hull's cotangent Laplacian and X0 a guess
+/// (the hull the deformation produced) that keeps the shape where W says little. W and the
+/// normal matrix are fixed, so the factorisation is done once.
+class HullRefitter
+{
+public:
+  /// `regularisation` is relative to trace(W^T W): it weighs the Laplacian
+  /// term (over trace(L^T L)) and an identity term (over the number of hull
+  /// points) that holds the hull points the mesh hardly depends on.
+  HullRefitter(const WeightMatrix& weights, const TriangleMesh& restHull, double regularisation = 1e-2);
+  Points Fit(const Points& mesh, const Points& guess) const;
+
+private:
+  struct Factorisation;
+  const WeightMatrix& Weights;
+  Eigen::MatrixXd Regulariser; // lambda L^T L
+  std::shared_ptr<const Factorisation> Solver;
+};
+
+/// One muscle to move: its rest-pose surface and its matched action lines
+/// (rest -> current).
+struct MuscleMotion
+{
+  std::string name;
+  TriangleMesh muscle;
+  std::vector<MatchedLine> lines;
+};
+
+/// One bone: the same points in the rest pose and the current pose.
+struct BoneMotion
+{
+  std::string name;
+  TriangleMesh rest;
+  Points current;
+};
+
+struct InterpolationParameters
+{
+  int numberOfSteps = 4;                ///< N; 0: automatic
+  double maximumStepDisplacement = 20;  ///< largest bone-point move per step when N is automatic
+  InterpolationMode interpolationMode = InterpolationMode::Rigid; ///< bones and action lines
+  HullMode hullMode = HullMode::Refit;
+  double refitRegularisation = 1e-2; ///< HullRefitter's, relative
+  /// Halfway smoothing steps of the per-point detail after each step (Refit):
+  /// the rims of earlier bone prints fade (0: the detail is kept as it is).
+  int detailRelaxation = 2;
+  StaticResolveParameters staticResolve;
+  DeformationParameters deformation;
+  HullParameters hull;
+};
+
+/// The measures of one muscle after step j (METHOD.md, "Measures of quality").
+struct MuscleStepMeasures
+{
+  double volumeChangePercent = 0;         ///< against the rest pose
+  std::int64_t newPenetrationCount = 0;   ///< inside a bone or another muscle, not so in the rest pose
+  double maxNewPenetrationDepth = 0;
+  std::int64_t newBonePenetrationCount = 0; ///< the same, bones only
+  double maxNewBonePenetrationDepth = 0;
+  double stepStaticShift = 0;             ///< largest move of this step's static resolution
+  double maxStaticShift = 0;              ///< largest over steps 1..j
+  std::int64_t staticallyMovedPoints = 0; ///< points this step's static resolution moved
+  std::int64_t sharpEdgeCount = 0;        ///< dihedral angle > 60 degrees, not so in the rest pose
+  std::int64_t flippedTriangleCount = 0;  ///< against the rest pose
+  int stepIterations = 0;
+  int iterations = 0;                     ///< steps 1..j
+  bool converged = true;                  ///< every step so far
+  std::int64_t pointsFrozenInObstacles = 0; ///< this step
+  double hullSeconds = 0;                 ///< this step's hull work: refit, or rebuild and mapping
+  double deformationSeconds = 0;          ///< this step's deformation and static resolution (its share)
+  Points staticShift;                     ///< this step's static move, per point
+};
+
+struct InterpolationResult
+{
+  int numberOfSteps = 0;
+  bool zeroMotion = false;                          ///< RP = CP: every step is the input
+  std::vector<std::vector<Points>> points;          ///< [step][muscle], step 0 the rest pose
+  std::vector<std::vector<MuscleStepMeasures>> measures; ///< [step][muscle]
+  std::vector<double> restHullSeconds;              ///< per muscle: rest hull and mapping
+  std::vector<double> stepSeconds;                  ///< [step], 0 for step 0
+  double totalSeconds = 0;
+  std::vector<std::string> warnings;
+};
+
+/// Number of steps: `parameters.numberOfSteps`, or when 0 enough steps that no
+/// bone point moves more than `parameters.maximumStepDisplacement` in one.
+int ResolveNumberOfSteps(const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters);
+
+/// Runs the whole method. Throws InputError naming the muscle or bone for
+/// input it cannot use. `progress` (optional) receives fractions in [0, 1].
+InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscles,
+  const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters,
+  const std::function<void(double)>& progress = {});
+}

@@ -1,0 +1,92 @@
+// Static intersection resolution (Hajkova & Kohout sec. 3.1; METHOD.md
+// section 5 "Static"), once after a deformation, on the full meshes: the
+// vertices of deformable meshes (muscles) that lie inside an obstacle (a bone,
+// or another of the deformable meshes) go out to the obstacle's surface.
+#pragma once
+
+#include "MeshTypes.h"
+#include "TriangleTree.h"
+
+#include <string>
+#include <vector>
+
+namespace md
+{
+/// A fixed obstacle of the static resolution: only the deformable meshes move.
+struct FixedObstacle
+{
+  std::string name;
+  const TriangleTree* tree = nullptr;
+};
+
+/// overlap[m][o][i] != 0: point i of deformable mesh m lies inside obstacle o,
+/// where o counts the fixed obstacles first, then the deformable meshes (a
+/// mesh's own entry is empty). Used for the overlap a rest pose already has.
+using OverlapMasks = std::vector<std::vector<std::vector<char>>>;
+
+/// Which points of each mesh (those its triangles use) lie inside each
+/// obstacle (see OverlapMasks), from trees of the meshes as they are.
+OverlapMasks FindOverlaps(const std::vector<TriangleMesh>& meshes, const std::vector<FixedObstacle>& fixed);
+
+struct Penetration
+{
+  std::int64_t count = 0;      ///< points inside an obstacle
+  double maxDepth = 0;         ///< the largest distance of one of them to that obstacle's surface
+  std::int64_t fixedCount = 0; ///< of them, inside a fixed obstacle (a bone)
+  double fixedMaxDepth = 0;
+};
+
+/// New penetration of each mesh: its points inside an obstacle that are not
+/// marked in `existing` (the rest pose's overlap; none when null). A point
+/// in a bone and a muscle counts with the bone.
+std::vector<Penetration> MeasureNewPenetration(
+  const std::vector<TriangleMesh>& meshes, const std::vector<FixedObstacle>& fixed, const OverlapMasks* existing);
+
+struct StaticResolveParameters
+{
+  /// Share of the correction a deformable mesh takes when its obstacle is
+  /// another deformable mesh (which takes its own share from its side): 0.6
+  /// in the original, so that neither is pushed all the way.
+  double deformableShare = 0.6;
+  /// The moves spread to the points this many edges around the moved ones,
+  /// falling to zero, so that the print has a smooth rim (0: the paper's
+  /// rule, only the penetrating points move).
+  int falloffRings = 3;
+};
+
+struct StaticResolveReport
+{
+  std::int64_t penetratingPoints = 0; ///< new penetration found (points moved)
+  int groups = 0;                     ///< edge-connected groups of them
+  double maxDepth = 0;                ///< deepest point found, distance to the surface
+  double maxShift = 0;                ///< largest move applied (of a penetrating point, or spread)
+};
+
+struct StaticResolveResult
+{
+  std::vector<Points> points; ///< each mesh resolved
+  std::vector<Points> shift;  ///< each mesh's move, per point
+  std::vector<StaticResolveReport> reports;
+};
+
+/// Moves the points of every mesh that lie inside an obstacle (and are not
+/// marked in `existing`) out to its surface. Each point goes with the
+/// obstacle it is deepest in, a fixed one (a bone) before a mesh; the points with the same obstacle form
+/// edge-connected groups, and a group moves along one direction, the mean of
+/// its points' ways to their nearest surface points, each point to where that
+/// direction leaves the obstacle (to its nearest surface point when that exit
+/// is more than twice as far: a thin part of the obstacle). All meshes are
+/// resolved against the obstacles as they are on entry (the result does not
+/// depend on the meshes' order).
+StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& meshes,
+  const std::vector<FixedObstacle>& fixed, const OverlapMasks* existing, const StaticResolveParameters& parameters);
+
+/// Gives the meshes back their target volumes after a static resolution (which
+/// flattens them where it pushes): the points that are free (`held` is 0:
+/// not moved by the resolution, not in the rest pose's overlap) move along the volume
+/// gradient, a few Newton steps on one scale factor, a move that would enter
+/// an obstacle or another mesh stopping at its surface. Returns the volume
+/// change left, in percent of each target.
+std::vector<double> RestoreVolumes(std::vector<TriangleMesh>& meshes, const std::vector<double>& targetVolumes,
+  const std::vector<FixedObstacle>& fixed, const std::vector<std::vector<char>>& held);
+}

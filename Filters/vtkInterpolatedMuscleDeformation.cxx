@@ -1,0 +1,355 @@
+#include "vtkInterpolatedMuscleDeformation.h"
+
+#include "ActionLineMatching.h"
+#include "InterpolatedDeformation.h"
+#include "MDBlocks.h"
+
+#include <vtkAlgorithmOutput.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
+#include <vtkObjectFactory.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
+
+#include <algorithm>
+#include <cmath>
+
+vtkStandardNewMacro(vtkInterpolatedMuscleDeformation);
+
+/// Every step of the last run, kept for the animation, with what it was computed from.
+struct vtkInterpolatedMuscleDeformation::Cache
+{
+  vtkMTimeType inputsTime = 0;
+  vtkMTimeType filterTime = 0;
+  std::vector<size_t> blockOf; // block of each muscle
+  md::InterpolationResult result;
+};
+
+namespace
+{
+const char* const PortNames[] = { "Input", "BonesRest", "BonesCurrent", "ActionLinesRest", "ActionLinesCurrent" };
+
+/// The bones in both poses, paired.
+bool ReadBones(vtkDataObject* rest, vtkDataObject* current, std::vector<md::BoneMotion>& bones, std::string& error)
+{
+  std::vector<mdvtk::Leaf> restLeaves, currentLeaves;
+  std::vector<size_t> partner;
+  if (!mdvtk::CollectLeaves(rest, PortNames[1], restLeaves, error) ||
+    !mdvtk::CollectLeaves(current, PortNames[2], currentLeaves, error) ||
+    !mdvtk::PairLeaves(restLeaves, PortNames[1], currentLeaves, PortNames[2], partner, error))
+  {
+    return false;
+  }
+  for (size_t b = 0; b < restLeaves.size(); ++b)
+  {
+    const mdvtk::Leaf& r = restLeaves[b];
+    const mdvtk::Leaf& c = currentLeaves[partner[b]];
+    if (!r.data || !c.data)
+    {
+      continue;
+    }
+    md::BoneMotion bone;
+    bone.name = r.name.empty() ? r.label : r.name;
+    mdvtk::ReadTriangles(r.data, bone.rest);
+    bone.current = mdvtk::ToPoints(c.data->GetPoints());
+    if (bone.rest.points.rows() != bone.current.rows())
+    {
+      error = r.label + " has " + std::to_string(bone.rest.points.rows()) + " points but " + c.label + " has " +
+        std::to_string(bone.current.rows()) + ": a bone must have the same points in both poses";
+      return false;
+    }
+    if (bone.rest.triangles.rows() == 0)
+    {
+      error = r.label + " has no surface (no polygons)";
+      return false;
+    }
+    bones.push_back(std::move(bone));
+  }
+  return true;
+}
+}
+
+vtkInterpolatedMuscleDeformation::vtkInterpolatedMuscleDeformation()
+  : Computed(std::make_unique<Cache>())
+{
+  this->SetNumberOfInputPorts(5);
+}
+
+vtkInterpolatedMuscleDeformation::~vtkInterpolatedMuscleDeformation() = default;
+
+int vtkInterpolatedMuscleDeformation::FillInputPortInformation(int, vtkInformation* info)
+{
+  mdvtk::AcceptPolyDataOrMultiBlock(info);
+  return 1;
+}
+
+int vtkInterpolatedMuscleDeformation::RequestInformation(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  int steps = this->NumberOfSteps;
+  if (steps == 0)
+  {
+    // The automatic count depends on the bones, which the pipeline only
+    // produces after this pass: bring those inputs up to date first.
+    for (int port = 1; port <= 2; ++port)
+    {
+      if (this->GetNumberOfInputConnections(port) > 0)
+      {
+        this->GetInputAlgorithm(port, 0)->Update(this->GetInputConnection(port, 0)->GetIndex());
+      }
+    }
+    std::vector<md::BoneMotion> bones;
+    std::string error;
+    if (!ReadBones(vtkDataObject::GetData(inputVector[1], 0), vtkDataObject::GetData(inputVector[2], 0), bones, error))
+    {
+      vtkErrorMacro(<< error);
+      return 0;
+    }
+    md::InterpolationParameters parameters;
+    parameters.numberOfSteps = 0;
+    parameters.maximumStepDisplacement = this->MaximumStepDisplacement;
+    try
+    {
+      steps = md::ResolveNumberOfSteps(bones, parameters);
+    }
+    catch (const md::InputError& e)
+    {
+      vtkErrorMacro(<< e.what());
+      return 0;
+    }
+  }
+  this->ResolvedNumberOfSteps = steps;
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  std::vector<double> times(static_cast<size_t>(steps) + 1);
+  for (int j = 0; j <= steps; ++j)
+  {
+    times[j] = j;
+  }
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), steps + 1);
+  const double range[2] = { 0.0, static_cast<double>(steps) };
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+  return 1;
+}
+
+int vtkInterpolatedMuscleDeformation::RequestUpdateExtent(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
+{
+  // Our time is the interpolation step, not a time of the inputs.
+  for (int port = 0; port < 5; ++port)
+  {
+    for (int i = 0; i < inputVector[port]->GetNumberOfInformationObjects(); ++i)
+    {
+      inputVector[port]->GetInformationObject(i)->Remove(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+    }
+  }
+  return 1;
+}
+
+int vtkInterpolatedMuscleDeformation::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkDataObject* input = vtkDataObject::GetData(inputVector[0], 0);
+  vtkDataObject* inputs[5];
+  vtkMTimeType inputsTime = 0;
+  for (int port = 0; port < 5; ++port)
+  {
+    inputs[port] = vtkDataObject::GetData(inputVector[port], 0);
+    inputsTime = std::max(inputsTime, inputs[port] ? inputs[port]->GetMTime() : 0);
+  }
+  std::vector<mdvtk::Leaf> muscles;
+  std::string error;
+  if (!mdvtk::CollectLeaves(input, PortNames[0], muscles, error))
+  {
+    vtkErrorMacro(<< error);
+    return 0;
+  }
+
+  Cache& cache = *this->Computed;
+  if (cache.result.points.empty() || cache.inputsTime != inputsTime || cache.filterTime != this->GetMTime() ||
+    cache.result.numberOfSteps != this->ResolvedNumberOfSteps)
+  {
+    cache = Cache{};
+    // Everything is read and checked before any work.
+    std::vector<mdvtk::Leaf> restLines, currentLines;
+    std::vector<size_t> restLinesOf, currentLinesOf;
+    std::vector<md::BoneMotion> bones;
+    if (!mdvtk::CollectLeaves(inputs[3], PortNames[3], restLines, error) ||
+      !mdvtk::CollectLeaves(inputs[4], PortNames[4], currentLines, error) ||
+      !mdvtk::PairLeaves(muscles, PortNames[0], restLines, PortNames[3], restLinesOf, error) ||
+      !mdvtk::PairLeaves(restLines, PortNames[3], currentLines, PortNames[4], currentLinesOf, error) ||
+      !ReadBones(inputs[1], inputs[2], bones, error))
+    {
+      vtkErrorMacro(<< error);
+      return 0;
+    }
+    std::vector<md::MuscleMotion> motions;
+    for (size_t b = 0; b < muscles.size(); ++b)
+    {
+      const mdvtk::Leaf& leaf = muscles[b];
+      if (!leaf.data)
+      {
+        continue;
+      }
+      md::MuscleMotion motion;
+      motion.name = leaf.name.empty() ? leaf.label : leaf.name;
+      mdvtk::ReadTriangles(leaf.data, motion.muscle);
+      if (motion.muscle.triangles.rows() == 0)
+      {
+        vtkErrorMacro(<< leaf.label << " has no surface (no polygons); a muscle must be a closed triangle surface");
+        return 0;
+      }
+      if (!md::AllFinite(motion.muscle.points))
+      {
+        vtkErrorMacro(<< leaf.label << " has non-finite coordinates (NaN or infinity)");
+        return 0;
+      }
+      const mdvtk::Leaf& restLeaf = restLines[restLinesOf[b]];
+      const mdvtk::Leaf& currentLeaf = currentLines[currentLinesOf[restLinesOf[b]]];
+      const std::vector<md::Points> rest = restLeaf.data ? mdvtk::ToPolylines(restLeaf.data) : std::vector<md::Points>{};
+      const std::vector<md::Points> current =
+        currentLeaf.data ? mdvtk::ToPolylines(currentLeaf.data) : std::vector<md::Points>{};
+      if (rest.empty())
+      {
+        vtkErrorMacro(<< restLeaf.label << " has no polylines: muscle " << leaf.label
+                      << " needs its action lines, or nothing says where it goes");
+        return 0;
+      }
+      if (rest.size() != current.size())
+      {
+        vtkErrorMacro(<< restLeaf.label << " has " << rest.size() << " action lines but " << currentLeaf.label
+                      << " has " << current.size() << ": the lines of a muscle pair by order");
+        return 0;
+      }
+      try
+      {
+        for (size_t l = 0; l < rest.size(); ++l)
+        {
+          const md::MatchedActionLines matched = md::MatchActionLines(rest[l], current[l], this->MatchingTolerance);
+          motion.lines.push_back({ matched.rest, matched.current });
+        }
+      }
+      catch (const md::InputError& e)
+      {
+        vtkErrorMacro(<< "an action line of " << restLeaf.label << " or " << currentLeaf.label << ": " << e.what());
+        return 0;
+      }
+      motions.push_back(std::move(motion));
+      cache.blockOf.push_back(b);
+    }
+
+    md::InterpolationParameters parameters;
+    parameters.numberOfSteps = this->ResolvedNumberOfSteps;
+    parameters.maximumStepDisplacement = this->MaximumStepDisplacement;
+    parameters.interpolationMode = static_cast<md::InterpolationMode>(this->BoneInterpolationMode);
+    parameters.hullMode = static_cast<md::HullMode>(this->HullMode);
+    parameters.refitRegularisation = this->RefitRegularisation;
+    parameters.staticResolve.deformableShare = this->DeformableShare;
+    parameters.deformation.maximumIterations = this->MaximumNumberOfIterations;
+    parameters.deformation.convergenceTolerance = this->ConvergenceTolerance;
+    parameters.deformation.preserveVolume = this->PreserveVolume;
+    parameters.hull.targetNumberOfPoints = this->HullTargetNumberOfPoints;
+    try
+    {
+      cache.result =
+        md::DeformByInterpolation(motions, bones, parameters, [this](double f) { this->UpdateProgress(f); });
+    }
+    catch (const md::InputError& e)
+    {
+      vtkErrorMacro(<< e.what());
+      cache = Cache{};
+      return 0;
+    }
+    for (const std::string& warning : cache.result.warnings)
+    {
+      vtkWarningMacro(<< warning);
+    }
+    cache.inputsTime = inputsTime;
+    cache.filterTime = this->GetMTime();
+  }
+
+  const md::InterpolationResult& r = cache.result;
+  const int steps = r.numberOfSteps;
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  int step = steps;
+  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
+  {
+    const double time = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+    step = static_cast<int>(std::lround(std::clamp(time, 0.0, static_cast<double>(steps))));
+  }
+  std::vector<vtkSmartPointer<vtkPolyData>> outputs(muscles.size());
+  for (size_t m = 0; m < cache.blockOf.size(); ++m)
+  {
+    const size_t b = cache.blockOf[m];
+    const md::Points& points = r.points[step][m];
+    const md::Points& rest = r.points[0][m];
+    const md::MuscleStepMeasures& s = r.measures[step][m];
+    auto output = vtkSmartPointer<vtkPolyData>::New();
+    output->ShallowCopy(muscles[b].data);
+    output->SetPoints(mdvtk::ToVtkPoints(points));
+    auto addVectors = [&](const char* name, const md::Points& values) {
+      vtkNew<vtkDoubleArray> array;
+      array->SetName(name);
+      array->SetNumberOfComponents(3);
+      array->SetNumberOfTuples(points.rows());
+      for (Eigen::Index i = 0; i < points.rows(); ++i)
+      {
+        const Eigen::RowVector3d v = values.rows() ? Eigen::RowVector3d(values.row(i)) : Eigen::RowVector3d::Zero();
+        array->SetTuple(i, v.data());
+      }
+      output->GetPointData()->AddArray(array);
+    };
+    addVectors("Displacement", points - rest);
+    addVectors("StaticShift", s.staticShift);
+    double hullSeconds = r.restHullSeconds[m];
+    for (int j = 1; j <= step; ++j)
+    {
+      hullSeconds += r.measures[j][m].hullSeconds;
+    }
+    vtkNew<vtkFieldData> fieldData;
+    fieldData->DeepCopy(muscles[b].data->GetFieldData());
+    mdvtk::AddFieldValue(fieldData, "VolumeChangePercent", s.volumeChangePercent);
+    mdvtk::AddFieldValue(fieldData, "NewPenetrationCount", s.newPenetrationCount);
+    mdvtk::AddFieldValue(fieldData, "MaxNewPenetrationDepth", s.maxNewPenetrationDepth);
+    mdvtk::AddFieldValue(fieldData, "NewBonePenetrationCount", s.newBonePenetrationCount);
+    mdvtk::AddFieldValue(fieldData, "MaxNewBonePenetrationDepth", s.maxNewBonePenetrationDepth);
+    mdvtk::AddFieldValue(fieldData, "MaxStaticShift", s.maxStaticShift);
+    mdvtk::AddFieldValue(fieldData, "StepStaticShift", s.stepStaticShift);
+    mdvtk::AddFieldValue(fieldData, "SharpEdgeCount", s.sharpEdgeCount);
+    mdvtk::AddFieldValue(fieldData, "FlippedTriangleCount", s.flippedTriangleCount);
+    mdvtk::AddFieldValue(fieldData, "NumberOfIterations", s.iterations);
+    mdvtk::AddFieldValue(fieldData, "Converged", s.converged ? 1 : 0);
+    mdvtk::AddFieldValue(fieldData, "PointsFrozenInObstacles", s.pointsFrozenInObstacles);
+    mdvtk::AddFieldValue(fieldData, "InterpolationStep", step);
+    mdvtk::AddFieldValue(fieldData, "NumberOfSteps", steps);
+    mdvtk::AddFieldValue(fieldData, "HullSeconds", hullSeconds);
+    mdvtk::AddFieldValue(fieldData, "StepSeconds", r.stepSeconds[step]);
+    mdvtk::AddFieldValue(fieldData, "ElapsedSeconds", r.totalSeconds);
+    output->SetFieldData(fieldData);
+    outputs[b] = output;
+  }
+  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
+  mdvtk::AssignLeaves(input, output, outputs);
+  output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), static_cast<double>(step));
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+void vtkInterpolatedMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "NumberOfSteps: " << this->NumberOfSteps << "\n";
+  os << indent << "MaximumStepDisplacement: " << this->MaximumStepDisplacement << "\n";
+  os << indent << "BoneInterpolationMode: " << this->BoneInterpolationMode << "\n";
+  os << indent << "HullMode: " << this->HullMode << "\n";
+  os << indent << "MatchingTolerance: " << this->MatchingTolerance << "\n";
+  os << indent << "DeformableShare: " << this->DeformableShare << "\n";
+  os << indent << "MaximumNumberOfIterations: " << this->MaximumNumberOfIterations << "\n";
+  os << indent << "ConvergenceTolerance: " << this->ConvergenceTolerance << "\n";
+  os << indent << "PreserveVolume: " << this->PreserveVolume << "\n";
+  os << indent << "HullTargetNumberOfPoints: " << this->HullTargetNumberOfPoints << "\n";
+  os << indent << "RefitRegularisation: " << this->RefitRegularisation << "\n";
+  os << indent << "ResolvedNumberOfSteps: " << this->ResolvedNumberOfSteps << "\n";
+}

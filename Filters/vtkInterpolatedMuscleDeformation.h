@@ -1,0 +1,130 @@
+/**
+ * @class   vtkInterpolatedMuscleDeformation
+ * @brief   Deforms muscles from the rest pose to the current pose by the interpolation method.
+ *
+ * Hajkova & Kohout's interpolation method: the motion is split into
+ * NumberOfSteps steps; at each step the bones and the matched action lines
+ * are interpolated (BoneInterpolationMode), the muscles are deformed from
+ * the previous step's result (all together, obstacles for each other and
+ * for no bone to enter), then the static intersections are resolved and
+ * the volume each muscle had in the rest pose is given back. Overlap the
+ * rest pose already has (scans overlap the bones) is left alone.
+ *
+ * HullMode Refit (default) keeps each muscle's rest-pose hull and mean value
+ * coordinates for the whole motion and refits the hull to the resolved mesh
+ * by least squares after each step, keeping the residual as per-point
+ * detail; Rebuild builds a new hull and mapping before every step, as the
+ * paper did.
+ *
+ * Inputs: 0 Input, muscles in the rest pose; 1 BonesRest and 2 BonesCurrent,
+ * the bones in both poses (blocks paired by name, else by order; the same
+ * points); 3 ActionLinesRest and 4 ActionLinesCurrent, the raw action lines
+ * in both poses, one block per muscle (by name, else by order), polylines
+ * paired by order inside a block and matched as ActionLineMatching does.
+ *
+ * Output: the muscles at the requested time step j (0 = rest pose, N =
+ * current pose; every step is computed once and kept), point arrays
+ * Displacement (from the rest pose) and StaticShift (step j's static
+ * resolution), and field data per muscle: VolumeChangePercent,
+ * NewPenetrationCount, MaxNewPenetrationDepth, NewBonePenetrationCount,
+ * MaxNewBonePenetrationDepth, MaxStaticShift (steps 1..j), StepStaticShift,
+ * SharpEdgeCount, FlippedTriangleCount, NumberOfIterations (steps 1..j),
+ * Converged, PointsFrozenInObstacles, InterpolationStep, NumberOfSteps,
+ * HullSeconds, StepSeconds, ElapsedSeconds (the whole run).
+ */
+#pragma once
+
+#include "MuscleDeformationFiltersModule.h"
+
+#include <vtkPassInputTypeAlgorithm.h>
+
+#include <memory>
+
+class MUSCLEDEFORMATIONFILTERS_EXPORT vtkInterpolatedMuscleDeformation : public vtkPassInputTypeAlgorithm
+{
+public:
+  static vtkInterpolatedMuscleDeformation* New();
+  vtkTypeMacro(vtkInterpolatedMuscleDeformation, vtkPassInputTypeAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  void SetBonesRestConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(1, output); }
+  void SetBonesCurrentConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(2, output); }
+  void SetActionLinesRestConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(3, output); }
+  void SetActionLinesCurrentConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(4, output); }
+
+  enum InterpolationModes
+  {
+    LINEAR = 0,
+    RIGID = 1,
+  };
+  enum HullModes
+  {
+    REFIT = 0,
+    REBUILD = 1,
+  };
+
+  /// N; 0 = automatic from MaximumStepDisplacement. Default 4.
+  vtkSetClampMacro(NumberOfSteps, int, 0, 10000);
+  vtkGetMacro(NumberOfSteps, int);
+  /// Largest move of a bone point in one step when NumberOfSteps is 0 (data units). Default 20.
+  vtkSetClampMacro(MaximumStepDisplacement, double, 1e-9, VTK_DOUBLE_MAX);
+  vtkGetMacro(MaximumStepDisplacement, double);
+  /// LINEAR (the paper's eq. 1) or RIGID (default), for bones and action lines.
+  vtkSetClampMacro(BoneInterpolationMode, int, LINEAR, RIGID);
+  vtkGetMacro(BoneInterpolationMode, int);
+  /// REFIT (default) or REBUILD.
+  vtkSetClampMacro(HullMode, int, REFIT, REBUILD);
+  vtkGetMacro(HullMode, int);
+  /// Action-line matching tolerance (normalised arc length). Default 0.01.
+  vtkSetClampMacro(MatchingTolerance, double, 0.0, 0.5);
+  vtkGetMacro(MatchingTolerance, double);
+  /// Share of the static correction each muscle takes against another. Default 0.6.
+  vtkSetClampMacro(DeformableShare, double, 0.0, 1.0);
+  vtkGetMacro(DeformableShare, double);
+  /// Iterations of one step's deformation. Default 200.
+  vtkSetClampMacro(MaximumNumberOfIterations, int, 1, 100000);
+  vtkGetMacro(MaximumNumberOfIterations, int);
+  /// Default 0.01 (data units).
+  vtkSetClampMacro(ConvergenceTolerance, double, 1e-12, VTK_DOUBLE_MAX);
+  vtkGetMacro(ConvergenceTolerance, double);
+  /// Default on.
+  vtkSetMacro(PreserveVolume, bool);
+  vtkGetMacro(PreserveVolume, bool);
+  vtkBooleanMacro(PreserveVolume, bool);
+  /// Points of each muscle's hull. Default 250.
+  vtkSetClampMacro(HullTargetNumberOfPoints, int, 8, 1000000);
+  vtkGetMacro(HullTargetNumberOfPoints, int);
+  /// Shape regularisation of the Refit least squares (relative). Default 1e-3.
+  vtkSetClampMacro(RefitRegularisation, double, 1e-9, 1e3);
+  vtkGetMacro(RefitRegularisation, double);
+
+  /// N as resolved by the last RequestInformation.
+  vtkGetMacro(ResolvedNumberOfSteps, int);
+
+protected:
+  vtkInterpolatedMuscleDeformation();
+  ~vtkInterpolatedMuscleDeformation() override;
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  int NumberOfSteps = 4;
+  double MaximumStepDisplacement = 20.0;
+  int BoneInterpolationMode = RIGID;
+  int HullMode = REFIT;
+  double MatchingTolerance = 0.01;
+  double DeformableShare = 0.6;
+  int MaximumNumberOfIterations = 200;
+  double ConvergenceTolerance = 0.01;
+  bool PreserveVolume = true;
+  int HullTargetNumberOfPoints = 250;
+  double RefitRegularisation = 1e-3;
+  int ResolvedNumberOfSteps = 4;
+
+private:
+  vtkInterpolatedMuscleDeformation(const vtkInterpolatedMuscleDeformation&) = delete;
+  void operator=(const vtkInterpolatedMuscleDeformation&) = delete;
+  struct Cache;
+  std::unique_ptr<Cache> Computed;
+};

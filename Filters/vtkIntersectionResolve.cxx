@@ -1,0 +1,215 @@
+#include "vtkIntersectionResolve.h"
+
+#include "MDBlocks.h"
+#include "MuscleDeformer.h"
+#include "StaticIntersections.h"
+
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
+#include <vtkObjectFactory.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+
+#include <algorithm>
+
+vtkStandardNewMacro(vtkIntersectionResolve);
+
+vtkIntersectionResolve::vtkIntersectionResolve()
+{
+  this->SetNumberOfInputPorts(4);
+}
+
+int vtkIntersectionResolve::FillInputPortInformation(int port, vtkInformation* info)
+{
+  mdvtk::AcceptPolyDataOrMultiBlock(info);
+  if (port > 0)
+  {
+    info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  }
+  if (port == 1 || port == 3)
+  {
+    info->Set(vtkAlgorithm::INPUT_IS_REPEATABLE(), 1);
+  }
+  return 1;
+}
+
+namespace
+{
+/// The meshes of the leaves (null leaves stay empty), checked.
+bool ReadLeafMeshes(const std::vector<mdvtk::Leaf>& leaves, std::vector<md::TriangleMesh>& meshes, std::string& error)
+{
+  meshes.resize(leaves.size());
+  for (size_t b = 0; b < leaves.size(); ++b)
+  {
+    if (!leaves[b].data)
+    {
+      continue;
+    }
+    mdvtk::ReadTriangles(leaves[b].data, meshes[b]);
+    if (meshes[b].triangles.rows() == 0 || !md::AllFinite(meshes[b].points))
+    {
+      error = leaves[b].label + " is not a usable surface: it needs triangles and finite coordinates";
+      return false;
+    }
+  }
+  return true;
+}
+}
+
+int vtkIntersectionResolve::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkDataObject* input = vtkDataObject::GetData(inputVector[0], 0);
+  std::vector<mdvtk::Leaf> leaves;
+  std::vector<md::TriangleMesh> meshes;
+  std::vector<std::string> obstacleNames, restObstacleNames;
+  std::vector<md::TriangleMesh> obstacles, restObstacles;
+  std::string error;
+  if (!mdvtk::CollectLeaves(input, "Input", leaves, error) || !ReadLeafMeshes(leaves, meshes, error) ||
+    !mdvtk::ReadMeshes(inputVector[1], "Obstacles", obstacleNames, obstacles, error) ||
+    !mdvtk::ReadMeshes(inputVector[3], "ObstaclesRest", restObstacleNames, restObstacles, error))
+  {
+    vtkErrorMacro(<< error);
+    return 0;
+  }
+  const bool restGiven = inputVector[2]->GetNumberOfInformationObjects() > 0;
+  if (!restGiven && !restObstacles.empty())
+  {
+    vtkWarningMacro(<< "ObstaclesRest is connected but InputRest is not: all penetration is resolved");
+  }
+  if (restGiven && !restObstacles.empty())
+  {
+    if (restObstacles.size() != obstacles.size())
+    {
+      vtkErrorMacro(<< "ObstaclesRest has " << restObstacles.size() << " meshes but Obstacles has "
+                    << obstacles.size() << ": connect the same obstacles in both poses, in the same order");
+      return 0;
+    }
+    for (size_t o = 0; o < obstacles.size(); ++o)
+    {
+      if (restObstacles[o].points.rows() != obstacles[o].points.rows())
+      {
+        vtkErrorMacro(<< "obstacle '" << obstacleNames[o] << "' has " << obstacles[o].points.rows()
+                      << " points but its rest pose '" << restObstacleNames[o] << "' has "
+                      << restObstacles[o].points.rows() << ": both poses must have the same points");
+        return 0;
+      }
+    }
+  }
+
+  // Only the leaves with data take part; `used[k]` is the leaf of mesh k.
+  std::vector<md::TriangleMesh> deformable, deformableRest;
+  std::vector<size_t> used;
+  std::vector<mdvtk::Leaf> restLeaves;
+  std::vector<size_t> restOf;
+  std::vector<md::TriangleMesh> restMeshes;
+  if (restGiven &&
+    (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[2], 0), "InputRest", restLeaves, error) ||
+      !mdvtk::PairLeaves(leaves, "Input", restLeaves, "InputRest", restOf, error) ||
+      !ReadLeafMeshes(restLeaves, restMeshes, error)))
+  {
+    vtkErrorMacro(<< error);
+    return 0;
+  }
+  for (size_t b = 0; b < leaves.size(); ++b)
+  {
+    if (!leaves[b].data)
+    {
+      continue;
+    }
+    if (restGiven)
+    {
+      const md::TriangleMesh& rest = restMeshes[restOf[b]];
+      if (rest.points.rows() != meshes[b].points.rows())
+      {
+        vtkErrorMacro(<< restLeaves[restOf[b]].label << " has " << rest.points.rows() << " points but "
+                      << leaves[b].label << " has " << meshes[b].points.rows()
+                      << ": InputRest must be the Input in the rest pose, with the same points");
+        return 0;
+      }
+      deformableRest.push_back({ rest.points, meshes[b].triangles });
+    }
+    deformable.push_back(meshes[b]);
+    used.push_back(b);
+  }
+
+  md::OverlapMasks existing;
+  std::vector<md::Obstacle> trees, restTrees;
+  auto fixedOf = [](const std::vector<md::Obstacle>& list) {
+    std::vector<md::FixedObstacle> fixed;
+    for (const md::Obstacle& o : list)
+    {
+      fixed.push_back({ o.name, o.tree.get() });
+    }
+    return fixed;
+  };
+  md::StaticResolveResult resolved;
+  std::vector<md::Penetration> left;
+  try
+  {
+    trees = md::BuildObstacles(obstacleNames, obstacles);
+    this->UpdateProgress(0.2);
+    if (restGiven)
+    {
+      restTrees = restObstacles.empty() ? trees : md::BuildObstacles(restObstacleNames, restObstacles);
+      existing = md::FindOverlaps(deformableRest, fixedOf(restTrees));
+    }
+    this->UpdateProgress(0.4);
+    md::StaticResolveParameters parameters;
+    parameters.deformableShare = this->DeformableShare;
+    const std::vector<md::FixedObstacle> fixed = fixedOf(trees);
+    resolved = md::ResolveStaticIntersections(deformable, fixed, restGiven ? &existing : nullptr, parameters);
+    this->UpdateProgress(0.8);
+    std::vector<md::TriangleMesh> after = deformable;
+    for (size_t k = 0; k < after.size(); ++k)
+    {
+      after[k].points = resolved.points[k];
+    }
+    left = md::MeasureNewPenetration(after, fixed, restGiven ? &existing : nullptr);
+  }
+  catch (const md::InputError& e)
+  {
+    vtkErrorMacro(<< e.what());
+    return 0;
+  }
+
+  std::vector<vtkSmartPointer<vtkPolyData>> outputs(leaves.size());
+  for (size_t k = 0; k < used.size(); ++k)
+  {
+    const size_t b = used[k];
+    auto output = vtkSmartPointer<vtkPolyData>::New();
+    output->ShallowCopy(leaves[b].data);
+    output->SetPoints(mdvtk::ToVtkPoints(resolved.points[k]));
+    vtkNew<vtkDoubleArray> shift;
+    shift->SetName("StaticShift");
+    shift->SetNumberOfComponents(3);
+    shift->SetNumberOfTuples(resolved.shift[k].rows());
+    for (Eigen::Index i = 0; i < resolved.shift[k].rows(); ++i)
+    {
+      shift->SetTuple(i, resolved.shift[k].row(i).data());
+    }
+    output->GetPointData()->AddArray(shift);
+    vtkNew<vtkFieldData> fieldData;
+    fieldData->DeepCopy(leaves[b].data->GetFieldData());
+    const md::StaticResolveReport& r = resolved.reports[k];
+    mdvtk::AddFieldValue(fieldData, "PenetratingPointCount", r.penetratingPoints);
+    mdvtk::AddFieldValue(fieldData, "PenetratingGroupCount", r.groups);
+    mdvtk::AddFieldValue(fieldData, "MaxPenetrationDepth", r.maxDepth);
+    mdvtk::AddFieldValue(fieldData, "MaxStaticShift", r.maxShift);
+    mdvtk::AddFieldValue(fieldData, "NewPenetrationCount", left[k].count);
+    mdvtk::AddFieldValue(fieldData, "MaxNewPenetrationDepth", left[k].maxDepth);
+    output->SetFieldData(fieldData);
+    outputs[b] = output;
+  }
+  mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), outputs);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+void vtkIntersectionResolve::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "DeformableShare: " << this->DeformableShare << "\n";
+}

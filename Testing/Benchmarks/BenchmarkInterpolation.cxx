@@ -1,0 +1,89 @@
+// The whole interpolation method (Filters/Core/InterpolatedDeformation.h) on
+// the phantom at 60 degrees of flexion and, when present, the LHDL right hip at
+// hip flexion 60 degrees: the one-pass method (one step, then the static
+// resolution), the interpolation method with the hull refitted (Refit) and
+// rebuilt before every step (Rebuild, the paper), side by side. Per muscle and
+// in total: hull time, per-step time, total, and every quality measure.
+// Prints figures; asserts nothing (see the tests).
+//
+//   BenchmarkInterpolation [data folder] [number of steps]
+#include "MotionCases.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+namespace
+{
+void Run(const MotionCase& c, const char* label, int steps, md::HullMode mode)
+{
+  md::InterpolationParameters parameters;
+  parameters.numberOfSteps = steps;
+  parameters.hullMode = mode;
+  const md::InterpolationResult r = md::DeformByInterpolation(c.muscles, c.bones, parameters);
+  std::printf("\n%s, %s (N = %d): total %.2f s\n", c.name.c_str(), label, r.numberOfSteps, r.totalSeconds);
+  double restHulls = 0;
+  for (double s : r.restHullSeconds)
+  {
+    restHulls += s;
+  }
+  std::printf("  rest hulls and mappings %.2f s; steps:", restHulls);
+  for (int j = 1; j <= r.numberOfSteps; ++j)
+  {
+    double hull = 0;
+    for (const md::MuscleStepMeasures& m : r.measures[j])
+    {
+      hull += m.hullSeconds;
+    }
+    std::printf(" %.2f s (hull %.3f s)", r.stepSeconds[j], hull);
+  }
+  std::printf("\n  %-18s %7s %7s %7s %6s %7s %6s %8s %6s %6s %5s %5s %6s\n", "muscle", "hull s", "dV %", "newPen",
+    "depth", "bonePen", "depth", "maxShift", "sharp", "flips", "iter", "conv", "frozen");
+  for (size_t m = 0; m < c.muscles.size(); ++m)
+  {
+    const md::MuscleStepMeasures& f = r.measures.back()[m];
+    double hull = r.restHullSeconds[m];
+    std::int64_t frozen = 0;
+    for (int j = 1; j <= r.numberOfSteps; ++j)
+    {
+      hull += r.measures[j][m].hullSeconds;
+      frozen += r.measures[j][m].pointsFrozenInObstacles;
+    }
+    std::printf("  %-18s %7.3f %7.4f %7lld %6.2f %7lld %6.2f %8.3f %6lld %6lld %5d %5s %6lld\n",
+      c.muscles[m].name.c_str(), hull, f.volumeChangePercent, static_cast<long long>(f.newPenetrationCount),
+      f.maxNewPenetrationDepth, static_cast<long long>(f.newBonePenetrationCount), f.maxNewBonePenetrationDepth,
+      f.maxStaticShift, static_cast<long long>(f.sharpEdgeCount), static_cast<long long>(f.flippedTriangleCount),
+      f.iterations, f.converged ? "yes" : "no", static_cast<long long>(frozen));
+  }
+  for (const std::string& w : r.warnings)
+  {
+    std::printf("  warning: %s\n", w.c_str());
+  }
+}
+
+void Compare(const MotionCase& c, int steps)
+{
+  Run(c, "one-pass method", 1, md::HullMode::Refit);
+  Run(c, "interpolation, Refit", steps, md::HullMode::Refit);
+  Run(c, "interpolation, Rebuild", steps, md::HullMode::Rebuild);
+}
+}
+
+int main(int argc, char* argv[])
+{
+  const std::string folder = argc > 1 ? argv[1] : "";
+  const int steps = argc > 2 ? std::atoi(argv[2]) : 4;
+  std::printf("Columns (final step): hull time (rest hull + per-step refit or rebuild), volume change %%, new\n"
+              "penetration of bones and other muscles, count and deepest (mm), the same of bones only, largest static shift over the steps (mm), new sharp edges\n"
+              "(> 60 deg), flipped triangles, iterations, converged in every step, points frozen in bones\n"
+              "(summed over steps).\n");
+  Compare(PhantomMotion(argc > 3 ? std::atof(argv[3]) : 30), steps);
+  MotionCase lhdl;
+  if (!LhdlMotion("hip_flexion", 35, lhdl, folder))
+  {
+    std::printf("\nLHDL data not found: skipped (pass the data folder or set MUSCLEDEFORMATION_DATA_DIR)\n");
+    return 0;
+  }
+  Compare(lhdl, steps);
+  return 0;
+}
