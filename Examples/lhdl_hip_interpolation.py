@@ -1,4 +1,4 @@
-"""The LHDL right hip (real scans): action-line matching and bone interpolation through a motion.
+"""The LHDL right hip (real scans): the whole interpolation method against the one-pass method.
 
 Run with pvpython (under xvfb-run on a machine without a display):
 
@@ -6,9 +6,14 @@ Run with pvpython (under xvfb-run on a machine without a display):
 
 Reads ../shared/data/lhdl_hip_r (or --data / $MUSCLEDEFORMATION_DATA_DIR); the pelvis bones stay,
 the femur and the action-line points fixed to it move by the frame's transform
-(femur_transforms.csv; frame 35 of hip_flexion is 60 degrees). Writes lhdl_rest.png,
-lhdl_current.png, lhdl_hulls.png, lhdl_step_<j>.png, the meshes as .vtp and figures.json. Exits with code 77
-(skipped) when the data is absent.
+(femur_transforms.csv; frame 35 of hip_flexion is 60 degrees). The four muscles are deformed
+together by InterpolatedMuscleDeformation (N steps, obstacles the iliac bone, the sacrum and the
+femur) and by the one-pass method (one step, the same static resolution). Writes lhdl_rest.png,
+lhdl_current.png, lhdl_hulls.png, lhdl_step_<j>.png (bones and action lines),
+lhdl_method_step_<j>.png (the muscles at every step of the method), lhdl_one_pass_resolved.png,
+lhdl_deformed_one_pass.png (MuscleDeformation alone), the meshes as .vtp and figures.json (every
+measure of METHOD.md per muscle and step), and prints the comparison. Exits with code 77 (skipped)
+when the data is absent.
 """
 import argparse
 import json
@@ -60,6 +65,7 @@ def main(argv=None):
           "the meshes written to %s" % (frame.motion, frame.index, frame.hip_flexion, frame.hip_adduction,
                                         figures["number_of_steps"], args.mode, len(images),
                                         os.path.abspath(args.output)))
+    print(mdexamples.method_summary(figures))
     return 0
 
 

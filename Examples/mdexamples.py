@@ -170,6 +170,13 @@ def interpolation_pipeline(inputs, steps=4, mode="Rigid"):
     # move with different bodies, so they are interpolated linearly.
     pipeline["lines"] = simple.BoneInterpolation(Input=simple.OutputPort(pipeline["matching"], 0),
                                                  NumberOfSteps=steps, InterpolationMode="Linear")
+    # The whole method (the paper's interpolation), and the one-pass method with the same static
+    # resolution and measures (one step) to compare with.
+    method_inputs = dict(Input=inputs["muscles"], BonesRest=inputs["bones_rest"],
+                         BonesCurrent=inputs["bones_current"], ActionLinesRest=inputs["lines_rest"],
+                         ActionLinesCurrent=inputs["lines_current"], BoneInterpolationMode=mode)
+    pipeline["interpolated"] = simple.InterpolatedMuscleDeformation(NumberOfSteps=steps, **method_inputs)
+    pipeline["one_pass"] = simple.InterpolatedMuscleDeformation(NumberOfSteps=1, **method_inputs)
     pipeline["hulls"] = simple.HullDecimation(Input=inputs["muscles"])
     # One pass RP -> CP (the paper's original method), every muscle together, bones in the CP.
     pipeline["deformation"] = simple.MuscleDeformation(Input=inputs["muscles"],
@@ -213,6 +220,46 @@ def show_steps(view, pipeline):
     show_surface(pipeline["bones"], view, BONE_COLOUR)
     show_surface(pipeline["muscles"], view, MUSCLE_COLOURS[0], opacity=0.3)
     show_lines(pipeline["lines"], view, LINE_COLOUR)
+
+
+def show_method(view, pipeline, result="interpolated"):
+    """A result of the whole method (its time is the step) with the bones and action lines of
+    the same step; the one-pass result is shown with the current-pose bones."""
+    hide_all(view)
+    show_surface(pipeline["bones"] if result == "interpolated" else pipeline["bones_current"], view, BONE_COLOUR)
+    show_surface(pipeline["muscles"], view, MUSCLE_COLOURS[1], opacity=0.12)
+    show_surface(pipeline[result], view, MUSCLE_COLOURS[0])
+    show_lines(pipeline["lines"] if result == "interpolated" else pipeline["lines_current"], view,
+               CURRENT_LINE_COLOUR)
+
+
+METHOD_MEASURES = ("VolumeChangePercent", "NewPenetrationCount", "MaxNewPenetrationDepth", "NewBonePenetrationCount",
+                   "MaxNewBonePenetrationDepth", "MaxStaticShift", "StepStaticShift", "SharpEdgeCount",
+                   "FlippedTriangleCount", "NumberOfIterations", "Converged", "HullSeconds", "StepSeconds",
+                   "ElapsedSeconds")
+
+
+def method_figures(source, time):
+    """{muscle: {measure: value}} of an InterpolatedMuscleDeformation output at step `time`."""
+    source.UpdatePipeline(time)
+    data = servermanager.Fetch(source)
+    return {name: {field: _field_value(data, field).get(name) for field in METHOD_MEASURES}
+            for name in _field_value(data, "VolumeChangePercent")}
+
+
+def method_summary(figures):
+    """Lines comparing the whole method's last step with the one-pass method, per muscle."""
+    method = figures["interpolation_method"]
+    final, one_pass = method["steps"][-1]["muscles"], figures["one_pass_method"]
+    lines = ["%-18s %22s %22s %14s %12s" % ("muscle (N = %d)" % method["number_of_steps"],
+                                            "MaxStaticShift 1 / N", "SharpEdgeCount 1 / N", "dV % (N)",
+                                            "seconds 1 / N")]
+    for name in sorted(final):
+        a, b = one_pass[name], final[name]
+        lines.append("%-18s %10.2f / %9.2f %10d / %9d %14.5f %5.1f / %4.1f" % (
+            name, a["MaxStaticShift"], b["MaxStaticShift"], a["SharpEdgeCount"], b["SharpEdgeCount"],
+            b["VolumeChangePercent"], a["ElapsedSeconds"], b["ElapsedSeconds"]))
+    return "\n".join(lines)
 
 
 def _field_value(data, name):
@@ -278,6 +325,22 @@ def run(pipeline, view, camera, output, prefix):
                              "PointsFrozenInObstacles", "PointsStoppedAtObstacles", "RestActionLineSamplesInside",
                              "CurrentActionLineSamplesInside", "DeformationSeconds", "ElapsedSeconds")}
         for name in _field_value(deformed, "VolumeChangePercent")}
+    # The whole method: every step, then the one-pass method for comparison.
+    method, one_pass = pipeline["interpolated"], pipeline["one_pass"]
+    method.UpdatePipelineInformation()
+    method_steps = int(list(method.TimestepValues)[-1])
+    figures["interpolation_method"] = {"number_of_steps": method_steps, "steps": []}
+    show_method(view, pipeline)
+    camera(view)
+    for step in range(method_steps + 1):
+        images.append(screenshot(view, os.path.join(output, "%s_method_step_%d.png" % (prefix, step)), time=step))
+        figures["interpolation_method"]["steps"].append({"step": step, "muscles": method_figures(method, step)})
+        write_blocks(method, output, "muscles_method_step_%d" % step, time=step)
+    show_method(view, pipeline, "one_pass")
+    camera(view)
+    images.append(screenshot(view, os.path.join(output, "%s_one_pass_resolved.png" % prefix), time=1))
+    figures["one_pass_method"] = method_figures(one_pass, 1)
+    write_blocks(one_pass, output, "muscles_one_pass_resolved", time=1)
     write_blocks(pipeline["bones_rest"], output, "bones_rest")
     write_blocks(pipeline["bones_current"], output, "bones_current")
     write_blocks(matching, output, "action_lines_matched_rest", port=0)

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <set>
 
 namespace md
 {
@@ -313,6 +314,7 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
   double stepStart = 0.2;
   const double stepShare = 0.8 / steps;
   std::vector<MuscleStepMeasures> previous(count);
+  std::set<std::string> warned;
   for (int j = 1; j <= steps; ++j)
   {
     const auto stepClock = Clock::now();
@@ -372,7 +374,10 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
       next[m] = { deformed[m].points, muscles[m].muscle.triangles };
       for (const std::string& warning : deformed[m].warnings)
       {
-        result.warnings.push_back("step " + std::to_string(j) + ": " + warning);
+        if (warned.insert(warning).second) // said once, at the first step that has it
+        {
+          result.warnings.push_back("step " + std::to_string(j) + ": " + warning);
+        }
       }
     }
     const std::vector<FixedObstacle> fixed = fixedObstacles(obstacles);

@@ -7,7 +7,7 @@
 // Prints figures; asserts nothing (see the tests).
 //
 //   BenchmarkInterpolation [data folder] [number of steps]
-#include "MotionCases.h"
+#include "RealData.h"
 
 #include <cstdio>
 #include <cstdlib>

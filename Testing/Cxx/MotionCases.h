@@ -1,12 +1,11 @@
 // The inputs of the interpolation method (InterpolatedDeformation.h) for the
-// phantom and the LHDL right hip, with their action lines matched as
-// ActionLineMatching does: shared by the tests and the benchmark.
+// phantom, with its action lines matched as ActionLineMatching does (the LHDL
+// right hip: LhdlMotion in RealData.h). Shared by the tests and the benchmark.
 #pragma once
 
 #include "ActionLineMatching.h"
 #include "InterpolatedDeformation.h"
 #include "Phantom.h"
-#include "RealData.h"
 
 #include <string>
 #include <vector>
@@ -47,24 +46,4 @@ inline MotionCase PhantomMotion(double flexionDegrees, int resolution = 24)
     c.bones.push_back({ bone.name, bone.rest, bone.currentPoints });
   }
   return c;
-}
-
-/// False when the data is absent.
-inline bool LhdlMotion(const std::string& motion, int frame, MotionCase& c, const std::string& folder = "")
-{
-  LhdlCase lhdl;
-  if (!LoadLhdlCase(motion, frame, lhdl, folder))
-  {
-    return false;
-  }
-  c.name = "LHDL " + motion + " frame " + std::to_string(frame);
-  for (const LhdlCase::Muscle& muscle : lhdl.muscles)
-  {
-    c.muscles.push_back({ muscle.name, muscle.surface, MatchLines(muscle.linesRest, muscle.linesCurrent) });
-  }
-  for (size_t b = 0; b < lhdl.boneNames.size(); ++b)
-  {
-    c.bones.push_back({ lhdl.boneNames[b], lhdl.bonesRest[b], lhdl.bonesCurrent[b].points });
-  }
-  return true;
 }

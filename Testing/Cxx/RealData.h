@@ -2,6 +2,7 @@
 #pragma once
 
 #include "MeshTypes.h"
+#include "MotionCases.h"
 
 #include <vtkCellArray.h>
 #include <vtkIdTypeArray.h>
@@ -237,6 +238,26 @@ inline bool LoadLhdlCase(const std::string& motion, int frameIndex, LhdlCase& ou
       muscle.linesCurrent.push_back(c);
     }
     out.muscles.push_back(std::move(muscle));
+  }
+  return true;
+}
+
+/// The LHDL case as inputs of the interpolation method. False when the data is absent.
+inline bool LhdlMotion(const std::string& motion, int frame, MotionCase& c, const std::string& folder = "")
+{
+  LhdlCase lhdl;
+  if (!LoadLhdlCase(motion, frame, lhdl, folder))
+  {
+    return false;
+  }
+  c.name = "LHDL " + motion + " frame " + std::to_string(frame);
+  for (const LhdlCase::Muscle& muscle : lhdl.muscles)
+  {
+    c.muscles.push_back({ muscle.name, muscle.surface, MatchLines(muscle.linesRest, muscle.linesCurrent) });
+  }
+  for (size_t b = 0; b < lhdl.boneNames.size(); ++b)
+  {
+    c.bones.push_back({ lhdl.boneNames[b], lhdl.bonesRest[b], lhdl.bonesCurrent[b].points });
   }
   return true;
 }

@@ -39,7 +39,8 @@ class PhantomExample(unittest.TestCase):
         self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
         self.assertIn(os.path.abspath(output), result.stdout)
         pictures = sorted(glob.glob(os.path.join(output, "phantom_*.png")))
-        self.assertEqual(len(pictures), 4 + 4, pictures)  # rest, current, hulls, one-pass deformation, steps
+        # rest, current, hulls, one-pass deformation, 4 steps of the bones, 4 of the whole method, one-pass resolved
+        self.assertEqual(len(pictures), 4 + 4 + 4 + 1, pictures)
         for picture in pictures:
             self.assertGreater(non_white_fraction(picture), 0.02, picture)
         with open(os.path.join(output, "figures.json")) as f:
@@ -54,6 +55,12 @@ class PhantomExample(unittest.TestCase):
             self.assertEqual(deformed["FlippedTriangleCount"], 0, name)
             self.assertEqual(deformed["Converged"], 1, name)
         self.assertTrue(os.path.isfile(os.path.join(output, "muscles_deformed_one_pass_RectusFemoris.vtp")))
+        method = figures["interpolation_method"]
+        self.assertEqual([step["step"] for step in method["steps"]], [0, 1, 2, 3])
+        for name, measures in method["steps"][-1]["muscles"].items():
+            self.assertLessEqual(abs(measures["VolumeChangePercent"]), 0.1, name)
+            self.assertLessEqual(measures["MaxNewBonePenetrationDepth"], 0.5, name)
+        self.assertTrue(os.path.isfile(os.path.join(output, "muscles_method_step_3_RectusFemoris.vtp")))
         reader = vtkXMLPolyDataReader()
         reader.SetFileName(os.path.join(output, "bones_step_3_Femur.vtp"))
         reader.Update()

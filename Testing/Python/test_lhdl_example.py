@@ -18,7 +18,8 @@ class LhdlExample(unittest.TestCase):
         result = run_example("lhdl_hip_interpolation.py", output, "--motion", "hip_flexion", "--frame", "35")
         self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
         pictures = sorted(glob.glob(os.path.join(output, "lhdl_*.png")))
-        self.assertEqual(len(pictures), 4 + 5)  # rest, current, hulls, one-pass deformation, steps
+        # rest, current, hulls, one-pass deformation, 5 steps of the bones, 5 of the whole method, one-pass resolved
+        self.assertEqual(len(pictures), 4 + 5 + 5 + 1)
         for picture in pictures:
             self.assertGreater(non_white_fraction(picture), 0.02, picture)
         with open(os.path.join(output, "figures.json")) as f:
@@ -36,6 +37,18 @@ class LhdlExample(unittest.TestCase):
             self.assertLessEqual(abs(deformed["VolumeChangePercent"]), 0.05, name)
             self.assertEqual(deformed["FlippedTriangleCount"], 0, name)
             self.assertEqual(deformed["Converged"], 1, name)
+        # The whole method in 4 steps against the one-pass method (METHOD.md measures).
+        method = figures["interpolation_method"]
+        self.assertEqual(method["number_of_steps"], 4)
+        final, one_pass = method["steps"][-1]["muscles"], figures["one_pass_method"]
+        self.assertEqual(set(final), set(figures["hulls"]))
+        for name, measures in final.items():
+            self.assertLessEqual(abs(measures["VolumeChangePercent"]), 0.1, name)
+            self.assertLessEqual(measures["MaxNewBonePenetrationDepth"], 0.5, name)
+            self.assertLess(measures["MaxStaticShift"], one_pass[name]["MaxStaticShift"], name)
+        self.assertLessEqual(max(m["MaxStaticShift"] for m in final.values()),
+                             0.6 * max(m["MaxStaticShift"] for m in one_pass.values()))
+        self.assertTrue(os.path.isfile(os.path.join(output, "muscles_method_step_4_iliacus_r.vtp")))
         # psoas and iliacus lose their conditional via point beyond 40 and 54 degrees of flexion.
         rest, current = figures["action_line_points_rest"], figures["action_line_points_current"]
         matched = figures["matched_action_line_points"]

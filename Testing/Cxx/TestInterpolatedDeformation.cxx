@@ -1,0 +1,136 @@
+// The interpolation method on the phantom: the hull refit, a motion of zero
+// length, bad input, and the paper's failure case (a bone swallowing part of
+// a muscle in one step) reproduced by the one-pass method and fixed by the
+// interpolation.
+#include "InterpolatedDeformation.h"
+#include "MotionCases.h"
+#include "TestMeshes.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace
+{
+std::string ErrorOf(const std::vector<md::MuscleMotion>& muscles, const std::vector<md::BoneMotion>& bones)
+{
+  try
+  {
+    md::DeformByInterpolation(muscles, bones, md::InterpolationParameters{});
+  }
+  catch (const md::InputError& e)
+  {
+    return e.what();
+  }
+  return "";
+}
+}
+
+TEST(HullRefitter, RecoversTheHullThatMapsToTheMesh)
+{
+  const md::TriangleMesh muscle = Sphere(Eigen::Vector3d::Zero(), 10, 3);
+  const md::TriangleMesh hull = Sphere(Eigen::Vector3d::Zero(), 12, 1);
+  const md::WeightMatrix weights = md::MeanValueCoordinates(hull, muscle.points);
+  // A hull deformed unevenly, and the mesh it maps to.
+  md::Points deformed = hull.points;
+  for (Eigen::Index i = 0; i < deformed.rows(); ++i)
+  {
+    deformed(i, 0) *= 1.3;
+    deformed(i, 2) += 0.02 * deformed(i, 1) * deformed(i, 1);
+  }
+  const md::HullRefitter refitter(weights, hull, 1e-6);
+  const md::Points fitted = refitter.Fit(weights * deformed, hull.points);
+  EXPECT_LT((weights * fitted - weights * deformed).cwiseAbs().maxCoeff(), 0.05);
+  EXPECT_LT((fitted - deformed).rowwise().norm().maxCoeff(), 1.0);
+  // The guess is kept where the mesh says nothing new.
+  const md::Points same = refitter.Fit(weights * hull.points, hull.points);
+  EXPECT_LT((same - hull.points).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+TEST(InterpolatedDeformation, AMotionOfZeroLengthReturnsTheInput)
+{
+  MotionCase c = PhantomMotion(60, 12);
+  for (md::MuscleMotion& m : c.muscles)
+  {
+    for (md::MatchedLine& line : m.lines)
+    {
+      line.current = line.rest;
+    }
+  }
+  for (md::BoneMotion& b : c.bones)
+  {
+    b.current = b.rest.points;
+  }
+  const md::InterpolationResult r = md::DeformByInterpolation(c.muscles, c.bones, md::InterpolationParameters{});
+  EXPECT_TRUE(r.zeroMotion);
+  ASSERT_EQ(r.points.size(), 5u);
+  for (size_t m = 0; m < c.muscles.size(); ++m)
+  {
+    EXPECT_EQ(r.points.back()[m], c.muscles[m].muscle.points);
+  }
+  ASSERT_FALSE(r.warnings.empty());
+  EXPECT_NE(r.warnings[0].find("zero length"), std::string::npos);
+}
+
+TEST(InterpolatedDeformation, BadInputIsRefusedByName)
+{
+  const MotionCase c = PhantomMotion(30, 12);
+  std::vector<md::MuscleMotion> muscles = c.muscles;
+  muscles[1].lines.clear();
+  std::string error = ErrorOf(muscles, c.bones);
+  EXPECT_NE(error.find("'GluteusMaximus'"), std::string::npos) << error;
+  EXPECT_NE(error.find("no action line"), std::string::npos) << error;
+
+  std::vector<md::BoneMotion> bones = c.bones;
+  bones[1].current.conservativeResize(bones[1].current.rows() - 3, 3);
+  error = ErrorOf(c.muscles, bones);
+  EXPECT_NE(error.find("'Femur'"), std::string::npos) << error;
+  EXPECT_NE(error.find("same points"), std::string::npos) << error;
+
+  muscles = c.muscles;
+  muscles[0].lines[0].current.conservativeResize(muscles[0].lines[0].current.rows() - 1, 3);
+  error = ErrorOf(muscles, c.bones);
+  EXPECT_NE(error.find("'Iliopsoas'"), std::string::npos) << error;
+  EXPECT_NE(error.find("not matched"), std::string::npos) << error;
+
+  EXPECT_NE(ErrorOf({}, c.bones).find("no muscle"), std::string::npos);
+}
+
+// Paper Figs. 5-6: at 30 degrees of flexion the femur sweeps into the rest
+// place of the rectus femoris. In one pass the points it swallowed stay inside
+// it (the dynamic rule cannot move them: "fixed on the bone") and the static
+// resolution then has to throw them far; in small steps the femur pushes the
+// muscle along a little at a time.
+TEST(InterpolatedDeformation, TheMuscleTheFemurSwallowsIsNotFixedOnTheBoneWhenInterpolated)
+{
+  const MotionCase c = PhantomMotion(30);
+  md::InterpolationParameters onePass, interpolated;
+  onePass.numberOfSteps = 1;
+  interpolated.numberOfSteps = 8;
+  const md::InterpolationResult one = md::DeformByInterpolation(c.muscles, c.bones, onePass);
+  const md::InterpolationResult steps = md::DeformByInterpolation(c.muscles, c.bones, interpolated);
+  ASSERT_EQ(steps.points.size(), 9u);
+  const size_t rectus = 2;
+  ASSERT_EQ(c.muscles[rectus].name, "RectusFemoris");
+  const md::MuscleStepMeasures& a = one.measures.back()[rectus];
+  const md::MuscleStepMeasures& b = steps.measures.back()[rectus];
+  EXPECT_GT(a.pointsFrozenInObstacles, 100); // the one pass leaves them in the bone...
+  EXPECT_GT(a.maxStaticShift, 15.0);         // ...and the static resolution throws them far
+  EXPECT_LE(b.maxStaticShift, 0.6 * a.maxStaticShift);
+  EXPECT_LT(b.flippedTriangleCount, a.flippedTriangleCount);
+  EXPECT_LT(b.sharpEdgeCount, a.sharpEdgeCount);
+  for (const md::InterpolationResult* r : { &one, &steps })
+  {
+    for (const md::MuscleStepMeasures& m : r->measures.back())
+    {
+      EXPECT_LE(std::abs(m.volumeChangePercent), 0.1);
+      EXPECT_LE(m.maxNewBonePenetrationDepth, 0.5);
+    }
+  }
+  // Every step is there, the rest pose first.
+  EXPECT_EQ(steps.points[0][rectus], c.muscles[rectus].muscle.points);
+  for (int j = 1; j <= 8; ++j)
+  {
+    EXPECT_GT((steps.points[j][rectus] - steps.points[j - 1][rectus]).cwiseAbs().maxCoeff(), 0.0);
+  }
+}

@@ -1,0 +1,129 @@
+// Static intersection resolution and the quality measures it is judged by.
+#include "MeshChecks.h"
+#include "MuscleDeformer.h"
+#include "StaticIntersections.h"
+#include "TestMeshes.h"
+
+#include <gtest/gtest.h>
+
+namespace
+{
+md::FixedObstacle Fixed(const md::TriangleTree& tree)
+{
+  return { "box", &tree };
+}
+
+/// A sphere of radius 10 about the origin and a box over x > 7: the sphere's cap pokes 3 into the box.
+struct CapInBox : public ::testing::Test
+{
+  md::TriangleMesh sphere = Sphere(Eigen::Vector3d::Zero(), 10, 3);
+  md::TriangleTree box{ Box(Eigen::Vector3d(7, -20, -20), Eigen::Vector3d(30, 20, 20)) };
+};
+}
+
+TEST_F(CapInBox, ThePenetratingCapGoesOutToTheSurfaceAsOneGroup)
+{
+  const auto before = md::MeasureNewPenetration({ sphere }, { Fixed(box) }, nullptr);
+  ASSERT_GT(before[0].count, 10);
+  EXPECT_NEAR(before[0].maxDepth, 3.0, 0.05);
+  EXPECT_EQ(before[0].fixedCount, before[0].count);
+
+  md::StaticResolveParameters parameters;
+  parameters.falloffRings = 0; // the paper's rule: only the penetrating points move
+  const md::StaticResolveResult r = md::ResolveStaticIntersections({ sphere }, { Fixed(box) }, nullptr, parameters);
+  EXPECT_EQ(r.reports[0].penetratingPoints, before[0].count);
+  EXPECT_EQ(r.reports[0].groups, 1);
+  EXPECT_NEAR(r.reports[0].maxShift, 3.0, 0.05);
+  md::TriangleMesh resolved = sphere;
+  resolved.points = r.points[0];
+  EXPECT_EQ(md::MeasureNewPenetration({ resolved }, { Fixed(box) }, nullptr)[0].count, 0);
+  for (Eigen::Index i = 0; i < sphere.points.rows(); ++i)
+  {
+    if (sphere.points(i, 0) < 7)
+    {
+      EXPECT_EQ(r.shift[0].row(i).norm(), 0.0) << "point " << i << " was outside and moved";
+    }
+    else
+    {
+      EXPECT_NEAR(r.points[0](i, 0), 7.0, 1e-3); // flattened against the box's face, along -x
+      EXPECT_NEAR(r.shift[0](i, 1), 0.0, 1e-9);
+    }
+  }
+}
+
+TEST_F(CapInBox, TheMoveSpreadsToASmoothRimWithFewerSharpEdges)
+{
+  md::StaticResolveParameters paper, smooth;
+  paper.falloffRings = 0;
+  smooth.falloffRings = 3;
+  const auto sharp = md::ResolveStaticIntersections({ sphere }, { Fixed(box) }, nullptr, paper);
+  const auto soft = md::ResolveStaticIntersections({ sphere }, { Fixed(box) }, nullptr, smooth);
+  EXPECT_NEAR(soft.reports[0].maxShift, sharp.reports[0].maxShift, 1e-9);
+  md::TriangleMesh resolved = sphere;
+  resolved.points = soft.points[0];
+  EXPECT_EQ(md::MeasureNewPenetration({ resolved }, { Fixed(box) }, nullptr)[0].count, 0);
+  std::int64_t moved = 0;
+  for (Eigen::Index i = 0; i < sphere.points.rows(); ++i)
+  {
+    moved += soft.shift[0].row(i).norm() > 0;
+  }
+  EXPECT_GT(moved, soft.reports[0].penetratingPoints); // the rim moved too
+  EXPECT_LE(md::CountNewSharpEdges(sphere.points, soft.points[0], sphere.triangles),
+    md::CountNewSharpEdges(sphere.points, sharp.points[0], sphere.triangles));
+}
+
+TEST_F(CapInBox, OverlapOfTheRestPoseIsLeftAlone)
+{
+  const md::OverlapMasks rest = md::FindOverlaps({ sphere }, { Fixed(box) });
+  const md::StaticResolveResult r =
+    md::ResolveStaticIntersections({ sphere }, { Fixed(box) }, &rest, md::StaticResolveParameters{});
+  EXPECT_EQ(r.reports[0].penetratingPoints, 0);
+  EXPECT_EQ(r.reports[0].maxShift, 0.0);
+  EXPECT_EQ(md::MeasureNewPenetration({ sphere }, { Fixed(box) }, &rest)[0].count, 0);
+}
+
+TEST(StaticIntersections, TwoDeformableMeshesEachTakeTheirShare)
+{
+  // Two spheres overlapping by 2 along x: each point of one inside the other
+  // moves 0.6 of its way out, from both sides.
+  const md::TriangleMesh a = Sphere(Eigen::Vector3d::Zero(), 10, 3);
+  const md::TriangleMesh b = Sphere(Eigen::Vector3d(18, 0, 0), 10, 3);
+  md::StaticResolveParameters parameters;
+  parameters.falloffRings = 0;
+  const auto before = md::MeasureNewPenetration({ a, b }, {}, nullptr);
+  ASSERT_GT(before[0].count, 0);
+  ASSERT_GT(before[1].count, 0);
+  EXPECT_EQ(before[0].fixedCount, 0);
+  const md::StaticResolveResult r = md::ResolveStaticIntersections({ a, b }, {}, nullptr, parameters);
+  for (int m = 0; m < 2; ++m)
+  {
+    EXPECT_GT(r.reports[m].maxShift, 0.5 * before[m].maxDepth);
+    EXPECT_LT(r.reports[m].maxShift, 0.7 * before[m].maxDepth);
+  }
+}
+
+TEST(StaticIntersections, AMoveOutOfAMuscleStopsAtABone)
+{
+  // The muscle's cap is inside another muscle, with a bone right behind it
+  // in the way out: the bone wins, no point ends in it.
+  const md::TriangleMesh muscle = Sphere(Eigen::Vector3d::Zero(), 10, 3);
+  const md::TriangleMesh other = Sphere(Eigen::Vector3d(17, 0, 0), 10, 3);
+  const md::TriangleTree bone(Box(Eigen::Vector3d(-30, -30, -30), Eigen::Vector3d(-10.5, 30, 30)));
+  md::StaticResolveParameters parameters;
+  parameters.deformableShare = 1.0;
+  const auto r = md::ResolveStaticIntersections({ muscle, other }, { Fixed(bone) }, nullptr, parameters);
+  md::TriangleMesh resolved = muscle;
+  resolved.points = r.points[0];
+  EXPECT_EQ(md::MeasureNewPenetration({ resolved }, { Fixed(bone) }, nullptr)[0].fixedCount, 0);
+}
+
+TEST(SharpEdges, NoneUnderARigidMotionSomeWhereAPointIsPushedIn)
+{
+  const md::TriangleMesh sphere = Sphere(Eigen::Vector3d::Zero(), 10, 2);
+  const Eigen::Matrix3d rotation = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const md::Points moved = (sphere.points * rotation.transpose()).rowwise() + Eigen::RowVector3d(5, 6, 7);
+  EXPECT_EQ(md::CountNewSharpEdges(sphere.points, moved, sphere.triangles), 0);
+  md::Points pit = sphere.points;
+  pit.row(0) *= 0.5; // a pit half the radius deep
+  EXPECT_GE(md::CountNewSharpEdges(sphere.points, pit, sphere.triangles), 5);
+}

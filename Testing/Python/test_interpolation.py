@@ -1,0 +1,155 @@
+"""The interpolation method and the static intersection resolution as a pvpython user drives them."""
+import unittest
+
+import numpy
+import mdtesting
+from paraview import servermanager, simple
+from vtkmodules.util.numpy_support import vtk_to_numpy
+
+mdtesting.load_plugin()
+
+MUSCLES = ("Iliopsoas", "GluteusMaximus", "RectusFemoris")
+
+
+def points(data):
+    return vtk_to_numpy(data.GetPoints().GetData()).astype(numpy.float64)
+
+
+def block(data, name):
+    for index in range(data.GetNumberOfBlocks()):
+        if data.GetMetaData(index).Get(data.NAME()) == name:
+            return data.GetBlock(index)
+    raise KeyError(name)
+
+
+def field(data, name):
+    array = data.GetFieldData().GetArray(name)
+    if array is None:
+        raise KeyError(name)
+    return array.GetValue(0)
+
+
+class Interpolation(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.phantom = simple.MusculoskeletalPhantom(Flexion=30)
+        cls.phantom.UpdatePipeline()
+
+    def method(self, **properties):
+        port = lambda k: simple.OutputPort(self.phantom, k)  # noqa: E731
+        values = dict(Input=port(0), BonesRest=port(1), BonesCurrent=port(2), ActionLinesRest=port(3),
+                      ActionLinesCurrent=port(4))
+        values.update(properties)
+        return simple.InterpolatedMuscleDeformation(**values)
+
+    def test_names_and_defaults(self):
+        method = simple.InterpolatedMuscleDeformation()
+        self.assertEqual(method.NumberOfSteps, 4)
+        self.assertEqual(method.BoneInterpolationMode, "Rigid")
+        self.assertEqual(method.HullMode, "Refit")
+        self.assertEqual(method.PreserveVolume, 1)
+        resolve = simple.IntersectionResolve()
+        self.assertAlmostEqual(resolve.DeformableShare, 0.6)
+        simple.Delete(resolve)
+        simple.Delete(method)
+
+    def test_every_step_is_a_time_step_with_every_measure(self):
+        method = self.method(NumberOfSteps=2)
+        with mdtesting.CapturedMessages() as messages:
+            method.UpdatePipelineInformation()
+            self.assertEqual(list(method.TimestepValues), [0.0, 1.0, 2.0])
+            method.UpdatePipeline(0)
+        self.assertEqual(messages.text, "")
+        rest = servermanager.Fetch(simple.OutputPort(self.phantom, 0))
+        first = servermanager.Fetch(method)
+        for name in MUSCLES:
+            self.assertTrue(numpy.array_equal(points(block(first, name)), points(block(rest, name))), name)
+            self.assertEqual(field(block(first, name), "InterpolationStep"), 0)
+        elapsed = field(block(first, "RectusFemoris"), "ElapsedSeconds")
+        method.UpdatePipeline(2)
+        last = servermanager.Fetch(method)
+        for name in MUSCLES:
+            muscle = block(last, name)
+            self.assertEqual(field(muscle, "InterpolationStep"), 2, name)
+            self.assertEqual(field(muscle, "NumberOfSteps"), 2, name)
+            self.assertLessEqual(abs(field(muscle, "VolumeChangePercent")), 0.1, name)
+            self.assertLessEqual(field(muscle, "MaxNewBonePenetrationDepth"), 0.5, name)
+            for measure in ("NewPenetrationCount", "MaxNewPenetrationDepth", "MaxStaticShift", "SharpEdgeCount",
+                            "FlippedTriangleCount", "NumberOfIterations", "ElapsedSeconds", "HullSeconds"):
+                field(muscle, measure)
+            displacement = vtk_to_numpy(muscle.GetPointData().GetArray("Displacement"))
+            self.assertTrue(numpy.allclose(points(block(rest, name)) + displacement, points(muscle)), name)
+            self.assertIsNotNone(muscle.GetPointData().GetArray("StaticShift"), name)
+        self.assertGreater(field(block(last, "RectusFemoris"), "MaxStaticShift"), 0.0)
+        # Every step was computed once: the run behind step 2 is the one behind step 0.
+        self.assertEqual(field(block(last, "RectusFemoris"), "ElapsedSeconds"), elapsed)
+        simple.Delete(method)
+
+    def test_a_motion_of_zero_length_returns_the_input(self):
+        port = lambda k: simple.OutputPort(self.phantom, k)  # noqa: E731
+        method = self.method(BonesCurrent=port(1), ActionLinesCurrent=port(3))
+        with mdtesting.CapturedMessages() as messages:
+            method.UpdatePipeline(4)
+        self.assertIn("zero length", messages.text)
+        rest = servermanager.Fetch(port(0))
+        result = servermanager.Fetch(method)
+        for name in MUSCLES:
+            self.assertTrue(numpy.array_equal(points(block(result, name)), points(block(rest, name))), name)
+        simple.Delete(method)
+
+    def test_bad_input_names_the_input(self):
+        port = lambda k: simple.OutputPort(self.phantom, k)  # noqa: E731
+        # Muscles without action lines: surfaces given as lines.
+        method = self.method(ActionLinesRest=port(0), ActionLinesCurrent=port(0))
+        with mdtesting.CapturedMessages() as messages:
+            method.UpdatePipeline(1)
+        self.assertIn("ActionLinesRest block 'Iliopsoas' has no polylines", messages.text)
+        simple.Delete(method)
+        # Bone blocks that do not pair.
+        method = self.method(BonesCurrent=port(0))
+        with mdtesting.CapturedMessages() as messages:
+            method.UpdatePipeline(1)
+        self.assertIn("BonesRest block 'Pelvis' has no block of the same name in BonesCurrent", messages.text)
+        method.BonesCurrent = port(2)
+        with mdtesting.CapturedMessages() as messages:
+            method.UpdatePipeline(1)
+        self.assertNotIn("ERROR", messages.text)
+        simple.Delete(method)
+
+
+class StaticResolution(unittest.TestCase):
+    def test_the_one_pass_result_comes_out_of_the_femur_and_rest_overlap_stays(self):
+        phantom = simple.MusculoskeletalPhantom(Flexion=30)
+        port = lambda k: simple.OutputPort(phantom, k)  # noqa: E731
+        matching = simple.ActionLineMatching(Input=port(3), CurrentPose=port(4))
+        deformed = simple.MuscleDeformation(Input=port(0), ActionLines=simple.OutputPort(matching, 0),
+                                            Obstacles=[port(2)])
+        resolve = simple.IntersectionResolve(Input=deformed, Obstacles=[port(2)], InputRest=port(0),
+                                             ObstaclesRest=[port(1)])
+        with mdtesting.CapturedMessages() as messages:
+            resolve.UpdatePipeline()
+        self.assertNotIn("ERROR", messages.text)
+        before = servermanager.Fetch(deformed)
+        after = servermanager.Fetch(resolve)
+        rectus = block(after, "RectusFemoris")
+        self.assertGreater(field(rectus, "PenetratingPointCount"), 100)
+        self.assertGreater(field(rectus, "MaxStaticShift"), 10.0)
+        for name in MUSCLES:
+            muscle = block(after, name)
+            self.assertEqual(field(muscle, "NewPenetrationCount"), 0, name)
+            shift = vtk_to_numpy(muscle.GetPointData().GetArray("StaticShift"))
+            self.assertTrue(numpy.allclose(points(block(before, name)) + shift, points(muscle)), name)
+        # Without the rest pose, overlap the scans had would move too: never less.
+        resolve.InputRest = None
+        resolve.ObstaclesRest = []
+        resolve.UpdatePipeline()
+        everything = servermanager.Fetch(resolve)
+        for name in MUSCLES:
+            self.assertGreaterEqual(field(block(everything, name), "PenetratingPointCount"),
+                                    field(block(after, name), "PenetratingPointCount"), name)
+        for proxy in (resolve, deformed, matching, phantom):
+            simple.Delete(proxy)
+
+
+if __name__ == "__main__":
+    mdtesting.main()
