@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs what is missing (Debian 12), builds, and runs the main job: the interpolation of bones
-# and action lines on the MusculoskeletalPhantom and, when present, on the real LHDL hip data.
+# Installs what is missing (Debian 12), builds, and runs the main job: the whole interpolation
+# method against the one-pass method on the MusculoskeletalPhantom and, when present, on the real
+# LHDL hip data (60 degrees of hip flexion, 4 steps).
 #   bash Examples/run_main_job.sh [output folder, default results/]
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../Testing/bootstrap.sh"
@@ -10,8 +11,9 @@ md_install_dependencies
 md_build
 mkdir -p "$OUTPUT"
 
-echo "== Phantom"
-md_with_display pvpython "$MD_SOURCE_DIR/Examples/phantom_interpolation.py" --output "$OUTPUT/phantom"
+echo "== Phantom, 30 degrees of hip flexion in 8 steps (the femur sweeps into the rectus femoris)"
+md_with_display pvpython "$MD_SOURCE_DIR/Examples/phantom_interpolation.py" --output "$OUTPUT/phantom" \
+  --flexion 30 --steps 8
 if [ -d "$MD_DATA_DIR/lhdl_hip_r" ]; then
   echo "== LHDL right hip (real data), 60 degrees of hip flexion"
   md_with_display pvpython "$MD_SOURCE_DIR/Examples/lhdl_hip_interpolation.py" --data "$MD_DATA_DIR" \
