@@ -9,7 +9,9 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <numeric>
 #include <set>
+
 
 namespace md
 {
@@ -22,26 +24,38 @@ double SecondsSince(Clock::time_point start)
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-/// The rest-pose hull of a muscle and its mean value coordinates.
-struct HullAndMapping
+/// The hulls of the muscles with their points at `points[m]` (the muscles'
+/// triangles), built in parallel, the largest muscle first so that the cores
+/// finish together. A hull that cannot be built is left empty and its muscle
+/// gets the message in `errors`; `seconds` receives each build's time.
+std::vector<TriangleMesh> BuildHulls(const std::vector<MuscleMotion>& muscles, const std::vector<const Points*>& points,
+  const HullParameters& parameters, std::vector<std::string>& errors, std::vector<double>& seconds)
 {
-  TriangleMesh hull;
-  WeightMatrix weights;
-};
-
-HullAndMapping BuildHullAndMapping(const MuscleMotion& m, const Points& points, const HullParameters& parameters)
-{
-  HullAndMapping h;
-  try
+  const size_t count = muscles.size();
+  std::vector<size_t> order(count);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return muscles[a].muscle.triangles.rows() > muscles[b].muscle.triangles.rows();
+  });
+  std::vector<TriangleMesh> hulls(count);
+  errors.assign(count, std::string());
+  seconds.assign(count, 0.0);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int k = 0; k < static_cast<int>(count); ++k)
   {
-    h.hull = BuildMuscleHull(TriangleMesh{ points, m.muscle.triangles }, parameters).result.hull;
+    const size_t m = order[k];
+    const auto start = Clock::now();
+    try
+    {
+      hulls[m] = BuildMuscleHull(TriangleMesh{ *points[m], muscles[m].muscle.triangles }, parameters).result.hull;
+    }
+    catch (const InputError& e)
+    {
+      errors[m] = "muscle '" + muscles[m].name + "': " + e.what();
+    }
+    seconds[m] = SecondsSince(start);
   }
-  catch (const InputError& e)
-  {
-    throw InputError("muscle '" + m.name + "': " + e.what());
-  }
-  h.weights = MeanValueCoordinates(h.hull, points);
-  return h;
+  return hulls;
 }
 
 /// Smooths the per-point detail (a few halfway steps to the mean of the
@@ -51,25 +65,24 @@ HullAndMapping BuildHullAndMapping(const MuscleMotion& m, const Points& points, 
 void RelaxDetail(const Triangles& triangles, int iterations, Points& detail)
 {
   const Eigen::Index n = detail.rows();
+  const std::vector<std::vector<std::int64_t>> neighbours = PointNeighbours(triangles, n);
   for (int k = 0; k < iterations; ++k)
   {
-    Points sum = Points::Zero(n, 3);
-    Eigen::VectorXd count = Eigen::VectorXd::Zero(n);
-    for (Eigen::Index t = 0; t < triangles.rows(); ++t)
-    {
-      for (int a = 0; a < 3; ++a)
-      {
-        sum.row(triangles(t, a)) += detail.row(triangles(t, (a + 1) % 3));
-        count(triangles(t, a)) += 1;
-      }
-    }
+    Points relaxed = detail;
     for (Eigen::Index i = 0; i < n; ++i)
     {
-      if (count(i) > 0)
+      if (neighbours[i].empty())
       {
-        detail.row(i) = 0.5 * detail.row(i) + (0.5 / count(i)) * sum.row(i);
+        continue;
       }
+      Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+      for (std::int64_t j : neighbours[i])
+      {
+        sum += detail.row(j);
+      }
+      relaxed.row(i) = 0.5 * detail.row(i) + (0.5 / static_cast<double>(neighbours[i].size())) * sum;
     }
+    detail = std::move(relaxed);
   }
 }
 
@@ -243,25 +256,15 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
     }
   }
 
-  // The rest-pose hulls and mappings, the muscles in parallel (each hull is
-  // built serially; the mappings parallelise inside).
-  std::vector<TriangleMesh> hulls(count);
-  std::vector<WeightMatrix> weights(count);
-  std::vector<std::string> errors(count);
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int m = 0; m < static_cast<int>(count); ++m)
+  // The rest-pose hulls (the muscles in parallel) and mappings (each in parallel inside).
+  std::vector<const Points*> restPointers(count);
+  for (size_t m = 0; m < count; ++m)
   {
-    const auto hullStart = Clock::now();
-    try
-    {
-      hulls[m] = BuildMuscleHull(muscles[m].muscle, parameters.hull).result.hull;
-    }
-    catch (const InputError& e)
-    {
-      errors[m] = "muscle '" + muscles[m].name + "': " + e.what();
-    }
-    result.restHullSeconds[m] = SecondsSince(hullStart);
+    restPointers[m] = &muscles[m].muscle.points;
   }
+  std::vector<std::string> errors;
+  std::vector<TriangleMesh> hulls = BuildHulls(muscles, restPointers, parameters.hull, errors, result.restHullSeconds);
+  std::vector<WeightMatrix> weights(count);
   for (const std::string& error : errors)
   {
     if (!error.empty())
@@ -286,9 +289,12 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
     report(0.2 * (m + 1) / count);
   }
 
-  // Overlap the rest pose already has (the scans overlap the bones): left
-  // alone by the static resolution and not counted as new penetration.
-  const std::vector<Obstacle> restBones = BuildObstacles(boneNames, [&] {
+  // The bones' hierarchies, built once in the rest pose and refitted to the
+  // pose of each step: the bones move rigidly, or nearly so, which keeps the
+  // boxes tight, and a refit costs far less than a build. Overlap the rest
+  // pose already has (the scans overlap the bones) is left alone by the
+  // static resolution and not counted as new penetration.
+  const std::vector<Obstacle> obstacles = BuildObstacles(boneNames, [&] {
     std::vector<TriangleMesh> meshes;
     for (const BoneMotion& b : bones)
     {
@@ -309,8 +315,11 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
   {
     current[m] = muscles[m].muscle;
   }
-  const OverlapMasks restOverlap = FindOverlaps(current, fixedObstacles(restBones));
+  const OverlapMasks restOverlap = FindOverlaps(current, fixedObstacles(obstacles));
+  const std::vector<FixedObstacle> fixed = fixedObstacles(obstacles);
 
+  DeformationParameters stepParameters = parameters.deformation;
+  stepParameters.measureSamplesInside = false; // not part of the method's measures
   double stepStart = 0.2;
   const double stepShare = 0.8 / steps;
   std::vector<MuscleStepMeasures> previous(count);
@@ -318,39 +327,48 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
   for (int j = 1; j <= steps; ++j)
   {
     const auto stepClock = Clock::now();
-    std::vector<TriangleMesh> boneMeshes;
-    for (size_t b = 0; b < bones.size(); ++b)
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int b = 0; b < static_cast<int>(bones.size()); ++b)
     {
-      boneMeshes.push_back({ boneMotions[b].AtStep(j, steps), bones[b].rest.triangles });
+      obstacles[b].tree->Refit(boneMotions[b].AtStep(j, steps));
     }
-    const std::vector<Obstacle> obstacles = BuildObstacles(boneNames, boneMeshes);
 
     std::vector<MuscleStepMeasures> measures(count);
-    std::vector<TriangleMesh> stepHulls(count);
+    if (parameters.hullMode == HullMode::Rebuild && j > 1)
+    {
+      // The paper: a new hull and mapping of each muscle as it is now.
+      std::vector<const Points*> currentPointers(count);
+      for (size_t m = 0; m < count; ++m)
+      {
+        currentPointers[m] = &current[m].points;
+      }
+      std::vector<std::string> failures;
+      std::vector<double> seconds;
+      std::vector<TriangleMesh> rebuilt = BuildHulls(muscles, currentPointers, parameters.hull, failures, seconds);
+      for (size_t m = 0; m < count; ++m)
+      {
+        const auto mappingStart = Clock::now();
+        if (failures[m].empty() && !CheckEdges(rebuilt[m].triangles).IsClosedOrientedManifold())
+        {
+          failures[m] = "the rebuilt hull is not a closed manifold surface";
+        }
+        if (failures[m].empty())
+        {
+          hulls[m] = std::move(rebuilt[m]);
+          weights[m] = MeanValueCoordinates(hulls[m], current[m].points);
+          details[m] = current[m].points - weights[m] * hulls[m].points;
+        }
+        else
+        {
+          result.warnings.push_back("step " + std::to_string(j) + ": the hull of muscle '" + muscles[m].name +
+            "' could not be rebuilt (" + failures[m] + "); the previous step's hull is kept");
+        }
+        measures[m].hullSeconds = seconds[m] + SecondsSince(mappingStart);
+      }
+    }
     std::vector<MuscleToDeform> toDeform(count);
     for (size_t m = 0; m < count; ++m)
     {
-      const auto hullStart = Clock::now();
-      if (parameters.hullMode == HullMode::Rebuild && j > 1)
-      {
-        try
-        {
-          HullAndMapping rebuilt = BuildHullAndMapping(muscles[m], current[m].points, parameters.hull);
-          if (!CheckEdges(rebuilt.hull.triangles).IsClosedOrientedManifold())
-          {
-            throw InputError("the rebuilt hull is not a closed manifold surface");
-          }
-          hulls[m] = std::move(rebuilt.hull);
-          weights[m] = std::move(rebuilt.weights);
-          details[m] = current[m].points - weights[m] * hulls[m].points;
-        }
-        catch (const InputError& e)
-        {
-          result.warnings.push_back("step " + std::to_string(j) + ": the hull of muscle '" + muscles[m].name +
-            "' could not be rebuilt (" + e.what() + "); the previous step's hull is kept");
-        }
-      }
-      measures[m].hullSeconds = SecondsSince(hullStart);
       MuscleToDeform& d = toDeform[m];
       d.name = muscles[m].name;
       d.muscle = &current[m];
@@ -358,6 +376,7 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
       d.weights = &weights[m];
       d.detail = &details[m];
       d.targetVolume = restVolumes[m];
+      d.reference = &muscles[m].muscle.points; // folds an earlier step left are undone too
       for (const PoseInterpolator& line : lineMotions[m])
       {
         d.lines.push_back({ line.AtStep(j - 1, steps), line.AtStep(j, steps) });
@@ -365,7 +384,7 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
     }
 
     const std::vector<DeformationResult> deformed =
-      DeformMuscles(toDeform, obstacles, parameters.deformation, [&](double fraction) {
+      DeformMuscles(toDeform, obstacles, stepParameters, [&](double fraction) {
         report(stepStart + 0.9 * stepShare * fraction);
       });
     std::vector<TriangleMesh> next(count);
@@ -380,19 +399,20 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
         }
       }
     }
-    const std::vector<FixedObstacle> fixed = fixedObstacles(obstacles);
     StaticResolveResult resolved = ResolveStaticIntersections(next, fixed, &restOverlap, parameters.staticResolve);
+    // The volume is given back over the whole surface, except at the overlap
+    // the rest pose has (which stays where it is); a point against an obstacle
+    // cannot move outwards through it anyway.
     std::vector<std::vector<char>> held(count);
     for (size_t m = 0; m < count; ++m)
     {
       next[m].points = resolved.points[m];
-      held[m].resize(static_cast<size_t>(next[m].points.rows()));
-      for (Eigen::Index i = 0; i < next[m].points.rows(); ++i)
+      held[m].assign(static_cast<size_t>(next[m].points.rows()), 0);
+      for (const std::vector<char>& overlap : restOverlap[m])
       {
-        held[m][i] = resolved.shift[m].row(i).squaredNorm() > 0;
-        for (const std::vector<char>& overlap : restOverlap[m])
+        for (size_t i = 0; i < overlap.size(); ++i)
         {
-          held[m][i] = held[m][i] || (!overlap.empty() && overlap[i]);
+          held[m][i] = held[m][i] || overlap[i];
         }
       }
     }

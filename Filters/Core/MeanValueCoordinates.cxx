@@ -2,7 +2,9 @@
 
 #include <Eigen/LU>
 
+#include <array>
 #include <cmath>
+#include <map>
 #include <vector>
 
 namespace md
@@ -23,6 +25,31 @@ MeanValueCoordinateCalculator::MeanValueCoordinateCalculator(const TriangleMesh&
   gram.bottomLeftCorner<1, 3>() = this->Centred.colwise().sum();
   gram(3, 3) = static_cast<double>(cage.points.rows());
   this->ConstraintGramInverse = gram.inverse();
+
+  // The cage's edges, each once, and for each triangle the edge opposite each corner.
+  std::map<std::pair<std::int64_t, std::int64_t>, Eigen::Index> index;
+  std::vector<std::array<std::int64_t, 2>> edges;
+  this->TriangleEdges.resize(cage.triangles.rows(), 3);
+  for (Eigen::Index t = 0; t < cage.triangles.rows(); ++t)
+  {
+    for (int i = 0; i < 3; ++i)
+    {
+      const std::int64_t a = cage.triangles(t, (i + 1) % 3), b = cage.triangles(t, (i + 2) % 3);
+      const auto [entry, added] =
+        index.emplace(std::make_pair(std::min(a, b), std::max(a, b)), static_cast<Eigen::Index>(edges.size()));
+      if (added)
+      {
+        edges.push_back({ a, b });
+      }
+      this->TriangleEdges(t, i) = entry->second;
+    }
+  }
+  this->Edges.resize(static_cast<Eigen::Index>(edges.size()), 2);
+  for (size_t e = 0; e < edges.size(); ++e)
+  {
+    this->Edges(static_cast<Eigen::Index>(e), 0) = edges[e][0];
+    this->Edges(static_cast<Eigen::Index>(e), 1) = edges[e][1];
+  }
 }
 
 void MeanValueCoordinateCalculator::Compute(const Eigen::Vector3d& x, Eigen::Ref<Eigen::RowVectorXd> weights) const
@@ -32,24 +59,42 @@ void MeanValueCoordinateCalculator::Compute(const Eigen::Vector3d& x, Eigen::Ref
   weights.setZero();
   const double onCage = 1e-12 * this->Size;
 
-  std::vector<Eigen::Vector3d> toPoint(static_cast<size_t>(n)); // p_j - x
-  std::vector<double> distance(static_cast<size_t>(n));
+  // Per cage point: p_j - x, its length and direction; per cage edge: the
+  // angle it subtends at x and the cross product of its directions (each
+  // edge serves the two triangles on either side). Buffers per thread:
+  // this runs for every point of a muscle.
+  thread_local Points toPoint, unit, edgeCross;
+  thread_local Eigen::VectorXd distance, edgeAngle;
+  toPoint.resize(n, 3);
+  unit.resize(n, 3);
+  distance.resize(n);
   for (Eigen::Index j = 0; j < n; ++j)
   {
-    toPoint[j] = cage.points.row(j).transpose() - x;
-    distance[j] = toPoint[j].norm();
-    if (distance[j] <= onCage)
+    toPoint.row(j) = cage.points.row(j) - x.transpose();
+    distance(j) = toPoint.row(j).norm();
+    if (distance(j) <= onCage)
     {
       weights(j) = 1.0;
       return;
     }
+    unit.row(j) = toPoint.row(j) / distance(j);
+  }
+  const Eigen::Index edges = this->Edges.rows();
+  edgeCross.resize(edges, 3);
+  edgeAngle.resize(edges);
+  for (Eigen::Index e = 0; e < edges; ++e)
+  {
+    const auto u1 = unit.row(this->Edges(e, 0)), u2 = unit.row(this->Edges(e, 1));
+    edgeCross.row(e) = u1.cross(u2);
+    edgeAngle(e) = 2.0 * std::asin(std::min(1.0, 0.5 * (u1 - u2).norm()));
   }
 
   for (Eigen::Index t = 0; t < cage.triangles.rows(); ++t)
   {
     const std::int64_t p[3] = { cage.triangles(t, 0), cage.triangles(t, 1), cage.triangles(t, 2) };
-    const Eigen::Vector3d& a = toPoint[p[0]];
-    const Eigen::Vector3d normal = (toPoint[p[1]] - a).cross(toPoint[p[2]] - a); // the triangle's own normal
+    const Eigen::Vector3d a = toPoint.row(p[0]).transpose();
+    const Eigen::Vector3d normal =
+      (toPoint.row(p[1]).transpose() - a).cross(toPoint.row(p[2]).transpose() - a); // the triangle's own normal
     const double normalLength = normal.norm();
     if (normalLength == 0)
     {
@@ -63,7 +108,7 @@ void MeanValueCoordinateCalculator::Compute(const Eigen::Vector3d& x, Eigen::Ref
       double area[3];
       for (int i = 0; i < 3; ++i)
       {
-        area[i] = toPoint[p[(i + 1) % 3]].cross(toPoint[p[(i + 2) % 3]]).dot(normal) / normalLength;
+        area[i] = toPoint.row(p[(i + 1) % 3]).cross(toPoint.row(p[(i + 2) % 3])).dot(normal.transpose()) / normalLength;
       }
       const double total = area[0] + area[1] + area[2];
       if (area[0] >= -onCage * normalLength && area[1] >= -onCage * normalLength &&
@@ -81,28 +126,24 @@ void MeanValueCoordinateCalculator::Compute(const Eigen::Vector3d& x, Eigen::Ref
     }
     // det(e1, e2, e3) of the unit directions, from the signed distance.
     const double determinant =
-      signedDistance * normalLength / (distance[p[0]] * distance[p[1]] * distance[p[2]]);
-    Eigen::Vector3d unit[3], cross[3];
-    for (int i = 0; i < 3; ++i)
-    {
-      unit[i] = toPoint[p[i]] / distance[p[i]];
-    }
+      signedDistance * normalLength / (distance(p[0]) * distance(p[1]) * distance(p[2]));
+    Eigen::Vector3d cross[3];
     Eigen::Vector3d mean = Eigen::Vector3d::Zero(); // integral of u over the spherical triangle
     for (int i = 0; i < 3; ++i)
     {
-      const Eigen::Vector3d& u1 = unit[(i + 1) % 3];
-      const Eigen::Vector3d& u2 = unit[(i + 2) % 3];
-      cross[i] = u1.cross(u2);
+      // The edge opposite corner i, from corner i + 1 to corner i + 2.
+      const Eigen::Index edge = this->TriangleEdges(t, i);
+      const double sign = this->Edges(edge, 0) == p[(i + 1) % 3] ? 1.0 : -1.0;
+      cross[i] = sign * edgeCross.row(edge).transpose();
       const double sine = cross[i].norm();
-      const double angle = 2.0 * std::asin(std::min(1.0, 0.5 * (u1 - u2).norm()));
       if (sine > 0)
       {
-        mean += (0.5 * angle / sine) * cross[i];
+        mean += (0.5 * edgeAngle(edge) / sine) * cross[i];
       }
     }
     for (int i = 0; i < 3; ++i)
     {
-      weights(p[i]) += cross[i].dot(mean) / (determinant * distance[p[i]]);
+      weights(p[i]) += cross[i].dot(mean) / (determinant * distance(p[i]));
     }
   }
   weights /= weights.sum();

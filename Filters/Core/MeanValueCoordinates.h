@@ -37,6 +37,8 @@ private:
   Points Centred;                    // cage points minus Centre
   Eigen::Matrix4d ConstraintGramInverse; // (A A^T)^-1, A = [centred^T; 1^T]
   double Size = 0;
+  Eigen::Matrix<std::int64_t, Eigen::Dynamic, 2, Eigen::RowMajor> Edges; // each cage edge once: its two points
+  Triangles TriangleEdges; // per triangle, the edge opposite each corner (an index into Edges)
 };
 
 /// Convenience: the weights of every point in `cage`.

@@ -200,6 +200,25 @@ std::int64_t CountSelfIntersections(const TriangleMesh& surface)
 
 namespace md
 {
+std::vector<std::vector<std::int64_t>> PointNeighbours(const Triangles& triangles, Eigen::Index points)
+{
+  std::vector<std::vector<std::int64_t>> neighbours(static_cast<size_t>(points));
+  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      neighbours[triangles(t, k)].push_back(triangles(t, (k + 1) % 3));
+      neighbours[triangles(t, (k + 1) % 3)].push_back(triangles(t, k));
+    }
+  }
+  for (auto& list : neighbours)
+  {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return neighbours;
+}
+
 std::vector<int> Components(
   const Triangles& triangles, Eigen::Index points, int& count, const std::vector<char>* member)
 {
@@ -242,7 +261,7 @@ std::vector<int> Components(
   return component;
 }
 
-std::int64_t CountNewSharpEdges(
+std::vector<std::pair<Eigen::Index, Eigen::Index>> NewSharpEdges(
   const Points& rest, const Points& current, const Triangles& triangles, double angleDegrees)
 {
   // The two triangles of each edge, keyed by its ordered point pair.
@@ -270,15 +289,22 @@ std::int64_t CountNewSharpEdges(
     const double norms = n.norm() * m.norm();
     return norms > 0 && n.dot(m) < limit * norms;
   };
-  std::int64_t count = 0;
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> found;
   for (const auto& entry : edges)
   {
     const auto [s, t] = entry.second;
     if (t >= 0 && sharp(current, s, t) && !sharp(rest, s, t))
     {
-      ++count;
+      found.emplace_back(s, t);
     }
   }
-  return count;
+  std::sort(found.begin(), found.end()); // a fixed order, whatever the hashing
+  return found;
+}
+
+std::int64_t CountNewSharpEdges(
+  const Points& rest, const Points& current, const Triangles& triangles, double angleDegrees)
+{
+  return static_cast<std::int64_t>(NewSharpEdges(rest, current, triangles, angleDegrees).size());
 }
 }

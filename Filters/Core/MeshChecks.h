@@ -3,6 +3,7 @@
 
 #include "MeshTypes.h"
 
+#include <utility>
 #include <vector>
 
 namespace md
@@ -60,10 +61,17 @@ Points UsedPoints(const TriangleMesh& mesh);
 std::vector<int> Components(
   const Triangles& triangles, Eigen::Index points, int& count, const std::vector<char>* member = nullptr);
 
+/// The distinct neighbours of every point through the edges of the triangles,
+/// each list in increasing order (a fixed order: sums over it are reproducible).
+std::vector<std::vector<std::int64_t>> PointNeighbours(const Triangles& triangles, Eigen::Index points);
+
 /// Edges (between two triangles) whose dihedral angle, the angle between the
 /// normals of their triangles, exceeds `angleDegrees` in `current` but not in
 /// `rest` (same triangles): the pits and folds a deformation made.
 std::int64_t CountNewSharpEdges(
+  const Points& rest, const Points& current, const Triangles& triangles, double angleDegrees = 60.0);
+/// Those edges, as the pairs of triangles on either side (sorted).
+std::vector<std::pair<Eigen::Index, Eigen::Index>> NewSharpEdges(
   const Points& rest, const Points& current, const Triangles& triangles, double angleDegrees = 60.0);
 
 /// Number of pairs of triangles that intersect other than at what they share.

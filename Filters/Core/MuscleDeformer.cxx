@@ -4,6 +4,8 @@
 #include "RigidMotion.h"
 #include "VolumeConstrainedSolver.h"
 
+#include <Eigen/SparseCholesky>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -17,6 +19,9 @@ namespace
 using Clock = std::chrono::steady_clock;
 /// Unfold, let the volume settle, check again: at most this many times.
 constexpr int maximumUnfoldings = 8;
+/// A muscle whose span grows beyond this factor in the fine phase is being
+/// torn apart (its volume is held): the phase stops there.
+constexpr double maximumGrowth = 1.5;
 
 double Diagonal(const Points& points)
 {
@@ -119,7 +124,8 @@ SparseMatrix StackRows(
   return rows;
 }
 
-/// Whether every point lies inside the tree's surface (a box test first).
+/// Whether every point lies inside the tree's surface (box tests first; the
+/// first point outside decides).
 bool EntirelyInside(const TriangleTree& tree, const Points& points)
 {
   for (Eigen::Index i = 0; i < points.rows(); ++i)
@@ -129,7 +135,14 @@ bool EntirelyInside(const TriangleTree& tree, const Points& points)
       return false;
     }
   }
-  return CountInsideTree(tree, points) == points.rows();
+  for (Eigen::Index i = 0; i < points.rows(); ++i)
+  {
+    if (!tree.Inside(points.row(i).transpose()))
+    {
+      return false;
+    }
+  }
+  return true;
 }
 
 double FractionInside(const TriangleTree& tree, const Points& points)
@@ -149,16 +162,20 @@ struct MuscleState
   Points currentSamples; // action-line samples in the current pose
   Points hull;    // X
   Points points;  // the full mesh as it moves (W X where nothing held it)
-  Points start;   // rest pose
+  Points start;   // where the pass starts
+  const Points* reference = nullptr; // the shape folds are judged against (MuscleToDeform::reference)
   double hullVolume = 0, restVolume = 0;
   std::vector<char> frozen;  // inside a bone before a step: stays
   std::vector<char> stopped; // held at an obstacle in the last move
   std::vector<char> touched; // held at an obstacle in any move: left out of the volume gradient, which
                              // would otherwise swing as points come off the obstacle and back
   std::unique_ptr<TriangleTree> tree; // of `points`, for the other muscles
+  std::vector<std::vector<std::int64_t>> neighbours; // of the full mesh's points, when first needed
   double orientation = 1; // +1 when the triangles face outwards
   bool converged = false;
   bool fineDone = false;
+  bool fellBack = false;  // the fine phase tore the muscle apart: it keeps its coarse result
+  Points fineStartPoints, fineStartHull;
   int unfoldings = 0;
   bool flipsCheckedClean = false;
   double fineStep = 1;                                   // step length of the fine phase
@@ -310,6 +327,11 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
   s.hull = hull.points;
   s.start = m.muscle->points;
   s.points = s.start;
+  if (m.reference && m.reference->rows() != s.start.rows())
+  {
+    throw InputError("the reference shape given for muscle '" + m.name + "' does not fit its points");
+  }
+  s.reference = m.reference ? m.reference : &s.start;
   s.hullVolume = EnclosedVolume(hull.points, hull.triangles);
   const double ownVolume = EnclosedVolume(s.start, m.muscle->triangles);
   if (!(std::abs(ownVolume) > 0))
@@ -322,8 +344,10 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
   s.stopped.assign(static_cast<size_t>(s.start.rows()), 0);
   s.touched.assign(static_cast<size_t>(s.start.rows()), 0);
 
-  const TriangleTree muscleTree(*m.muscle);
-  s.result.restSamplesInside = FractionInside(muscleTree, restSamples);
+  if (parameters.measureSamplesInside)
+  {
+    s.result.restSamplesInside = FractionInside(TriangleTree(*m.muscle), restSamples);
+  }
 }
 
 /// Coarse phase: the hull alone, its own volume held, no obstacles.
@@ -411,31 +435,41 @@ void MoveWithObstacles(MuscleState& s, const Points& candidate, const std::vecto
 
 /// Undoes folds of the full mesh (triangles the mapping turned over, where
 /// the hull deformed too unevenly for its mean value coordinates): the points
-/// around the flipped triangles take back the rest shape of their
-/// neighbourhood (as-rigid-as-possible: local rotations, one small sparse
-/// solve with the region's border fixed), the region growing until nothing is
-/// flipped. Returns whether any point moved.
+/// around the flipped triangles take back the shape their neighbourhood has
+/// in the reference shape (as-rigid-as-possible: local rotations, one small
+/// sparse solve with the region's border fixed), the region growing until
+/// nothing is flipped. Returns whether any point moved.
 bool UnfoldFlippedTriangles(MuscleState& s, const std::vector<Obstacle>& bones, bool dynamicIntersections)
 {
   const Triangles& triangles = s.input->muscle->triangles;
-  std::vector<Eigen::Index> flipped = FlippedTriangles(s.start, s.points, triangles);
+  const Points& reference = *s.reference;
+  std::vector<Eigen::Index> flipped = FlippedTriangles(reference, s.points, triangles);
   if (flipped.empty())
   {
     return false;
   }
   const Eigen::Index n = s.points.rows();
-  std::vector<std::vector<std::int64_t>> ring(static_cast<size_t>(n));
+  if (s.neighbours.empty())
+  {
+    s.neighbours = PointNeighbours(triangles, n);
+  }
+  const std::vector<std::vector<std::int64_t>>& ring = s.neighbours;
+  std::vector<std::vector<Eigen::Index>> trianglesOf(static_cast<size_t>(n));
   for (Eigen::Index t = 0; t < triangles.rows(); ++t)
   {
     for (int k = 0; k < 3; ++k)
     {
-      ring[triangles(t, k)].push_back(triangles(t, (k + 1) % 3)); // each edge twice: uniform weights
-      ring[triangles(t, k)].push_back(triangles(t, (k + 2) % 3));
+      trianglesOf[triangles(t, k)].push_back(t);
     }
   }
   std::vector<char> region(static_cast<size_t>(n), 0);
+  std::vector<Eigen::Index> members;
+  std::vector<Eigen::Matrix3d> rotation(static_cast<size_t>(n));
   for (int attempt = 0; attempt < 8 && !flipped.empty(); ++attempt)
   {
+    // The region: the region of the attempts before and the corners of the
+    // flipped triangles, grown by two rings (so that an attempt that left
+    // the same triangles flipped works on a wider region).
     for (Eigen::Index t : flipped)
     {
       for (int k = 0; k < 3; ++k)
@@ -443,19 +477,32 @@ bool UnfoldFlippedTriangles(MuscleState& s, const std::vector<Obstacle>& bones, 
         region[triangles(t, k)] = 1;
       }
     }
+    std::vector<Eigen::Index> frontier;
+    for (Eigen::Index i = 0; i < n; ++i)
+    {
+      if (region[i])
+      {
+        frontier.push_back(i);
+      }
+    }
     for (int grow = 0; grow < 2; ++grow)
     {
-      std::vector<char> grown = region;
-      for (Eigen::Index i = 0; i < n; ++i)
+      std::vector<Eigen::Index> next;
+      for (Eigen::Index i : frontier)
       {
         for (std::int64_t j : ring[i])
         {
-          grown[i] |= region[j];
+          if (!region[j])
+          {
+            region[j] = 1;
+            next.push_back(j);
+          }
         }
       }
-      region.swap(grown);
+      frontier = std::move(next);
     }
-    std::vector<Eigen::Index> members, slot(static_cast<size_t>(n), -1);
+    members.clear();
+    std::vector<Eigen::Index> slot(static_cast<size_t>(n), -1);
     for (Eigen::Index i = 0; i < n; ++i)
     {
       if (region[i] && !ring[i].empty())
@@ -481,35 +528,36 @@ bool UnfoldFlippedTriangles(MuscleState& s, const std::vector<Obstacle>& bones, 
     Eigen::SparseMatrix<double> system(k, k);
     system.setFromTriplets(entries.begin(), entries.end());
     const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(system);
-    Points shape = s.points; // the region reshaped, the rest unchanged
+    Points& shape = s.points; // the region reshaped, the rest unchanged
+    Eigen::MatrixXd rhs(k, 3);
     for (int local = 0; local < 5 && solver.info() == Eigen::Success; ++local)
     {
-      std::vector<Eigen::Matrix3d> rotation(static_cast<size_t>(n));
-      auto rotationOf = [&](Eigen::Index i) {
-        Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-        for (std::int64_t j : ring[i])
-        {
-          covariance += (shape.row(j) - shape.row(i)).transpose() * (s.start.row(j) - s.start.row(i));
-        }
-        return BestRotation(covariance);
-      };
-      for (Eigen::Index i : members)
-      {
-        rotation[i] = rotationOf(i);
-      }
-      Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(k, 3);
+#pragma omp parallel for schedule(static)
       for (Eigen::Index a = 0; a < k; ++a)
       {
         const Eigen::Index i = members[a];
+        Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+        for (std::int64_t j : ring[i])
+        {
+          covariance += (shape.row(j) - shape.row(i)).transpose() * (reference.row(j) - reference.row(i));
+        }
+        rotation[i] = BestRotation(covariance);
+      }
+#pragma omp parallel for schedule(static)
+      for (Eigen::Index a = 0; a < k; ++a)
+      {
+        const Eigen::Index i = members[a];
+        Eigen::RowVector3d row = Eigen::RowVector3d::Zero();
         for (std::int64_t j : ring[i])
         {
           const Eigen::Matrix3d r = slot[j] >= 0 ? Eigen::Matrix3d(0.5 * (rotation[i] + rotation[j])) : rotation[i];
-          rhs.row(a) += (r * (s.start.row(i) - s.start.row(j)).transpose()).transpose();
+          row += (r * (reference.row(i) - reference.row(j)).transpose()).transpose();
           if (slot[j] < 0)
           {
-            rhs.row(a) += shape.row(j);
+            row += shape.row(j);
           }
         }
+        rhs.row(a) = row;
       }
       const Eigen::MatrixXd solved = solver.solve(rhs);
       for (Eigen::Index a = 0; a < k; ++a)
@@ -517,44 +565,50 @@ bool UnfoldFlippedTriangles(MuscleState& s, const std::vector<Obstacle>& bones, 
         shape.row(members[a]) = solved.row(a);
       }
     }
-    // Unfolding is not held by obstacles (a fold is the worse defect): a
-    // point it moves into a bone is frozen there like any point found inside
-    // a bone, for the static resolution to settle.
-    s.points = shape;
-    if (dynamicIntersections)
+    // Only triangles with a corner in the region or next to it can have changed.
+    std::vector<char> candidate(static_cast<size_t>(triangles.rows()), 0);
+    for (Eigen::Index i : members)
     {
-#pragma omp parallel for schedule(dynamic, 16)
-      for (Eigen::Index a = 0; a < k; ++a)
+      for (Eigen::Index t : trianglesOf[i])
       {
-        const Eigen::Index i = members[a];
-        const Eigen::Vector3d p = s.points.row(i).transpose();
-        for (const Obstacle& bone : bones)
-        {
-          if (!s.frozen[i] && bone.tree->InBounds(p) && bone.tree->Inside(p))
-          {
-            s.frozen[i] = 1;
-          }
-        }
+        candidate[t] = 1;
       }
-    }
-    // Only triangles whose corners' neighbourhoods changed can have changed.
-    std::vector<char> near = region;
-    for (Eigen::Index i = 0; i < n; ++i)
-    {
       for (std::int64_t j : ring[i])
       {
-        near[i] |= region[j];
+        for (Eigen::Index t : trianglesOf[j])
+        {
+          candidate[t] = 1;
+        }
       }
     }
     std::vector<Eigen::Index> candidates;
     for (Eigen::Index t = 0; t < triangles.rows(); ++t)
     {
-      if (near[triangles(t, 0)] || near[triangles(t, 1)] || near[triangles(t, 2)])
+      if (candidate[t])
       {
         candidates.push_back(t);
       }
     }
-    flipped = FlippedTriangles(s.start, s.points, triangles, &candidates);
+    flipped = FlippedTriangles(reference, s.points, triangles, &candidates);
+  }
+  // Unfolding is not held by obstacles (a fold is the worse defect): a point
+  // it moved into a bone is frozen there like any point found inside a bone,
+  // for the static resolution to settle.
+  if (dynamicIntersections)
+  {
+#pragma omp parallel for schedule(dynamic, 16)
+    for (Eigen::Index a = 0; a < static_cast<Eigen::Index>(members.size()); ++a)
+    {
+      const Eigen::Index i = members[a];
+      const Eigen::Vector3d p = s.points.row(i).transpose();
+      for (const Obstacle& bone : bones)
+      {
+        if (!s.frozen[i] && bone.tree->InBounds(p) && bone.tree->Inside(p))
+        {
+          s.frozen[i] = 1;
+        }
+      }
+    }
   }
   return true;
 }
@@ -623,18 +677,35 @@ void SampleMatchedLines(
 std::vector<Eigen::Index> FlippedTriangles(const Points& rest, const Points& deformed, const Triangles& triangles,
   const std::vector<Eigen::Index>* candidates)
 {
-  // Each point's local motion: the covariance of its edges, rest against deformed.
+  // Each point's local motion: the covariance of its edges, rest against
+  // deformed (only at the corners of the triangles to check).
   const Eigen::Index n = rest.rows(), m = triangles.rows();
+  std::vector<char> needed(static_cast<size_t>(n), candidates ? 0 : 1);
+  if (candidates)
+  {
+    for (Eigen::Index t : *candidates)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        needed[triangles(t, k)] = 1;
+      }
+    }
+  }
   std::vector<Eigen::Matrix3d> covariance(static_cast<size_t>(n), Eigen::Matrix3d::Zero());
   for (Eigen::Index t = 0; t < m; ++t)
   {
     for (int k = 0; k < 3; ++k)
     {
       const std::int64_t a = triangles(t, k), b = triangles(t, (k + 1) % 3);
+      if (!needed[a] && !needed[b])
+      {
+        continue;
+      }
       const Eigen::Vector3d e0 = (rest.row(b) - rest.row(a)).transpose();
       const Eigen::Vector3d e1 = (deformed.row(b) - deformed.row(a)).transpose();
-      covariance[a] += e1 * e0.transpose();
-      covariance[b] += e1 * e0.transpose();
+      const Eigen::Matrix3d product = e1 * e0.transpose();
+      covariance[a] += product;
+      covariance[b] += product;
     }
   }
   std::vector<char> flipped(static_cast<size_t>(m), 0);
@@ -829,6 +900,11 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
 
   // Fine phase: all muscles step in turn, each against the others' latest shape.
   // (each muscle stops at its own limit: maximumIterations less its coarse iterations)
+  for (MuscleState& s : states)
+  {
+    s.fineStartPoints = s.points;
+    s.fineStartHull = s.hull;
+  }
   const int fineLimit = parameters.maximumIterations;
   for (int k = 0; k < fineLimit; ++k)
   {
@@ -880,7 +956,24 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
       }
       ++s.result.iterations;
       const int total = s.result.coarseIterations + s.result.iterations;
-      if (largest < parameters.convergenceTolerance)
+      if (Diagonal(s.points) > maximumGrowth * Diagonal(s.start))
+      {
+        // With many points held by obstacles the hull, which knows nothing of
+        // them, can run on through a bone while the volume held on the full
+        // mesh inflates the rest: the muscle is torn apart. It keeps its
+        // coarse result (the static resolution settles its overlap).
+        s.points = s.fineStartPoints;
+        s.hull = s.fineStartHull;
+        if (s.tree)
+        {
+          s.tree->Refit(s.points);
+        }
+        s.fellBack = s.fineDone = true;
+        s.result.warnings.push_back("the fine phase of muscle '" + s.input->name + "' diverged (" +
+          std::to_string(std::count(s.frozen.begin(), s.frozen.end(), 1) + std::count(s.touched.begin(), s.touched.end(), 1)) +
+          " points held by obstacles): the muscle keeps its coarse result, without the volume of its full mesh held");
+      }
+      else if (largest < parameters.convergenceTolerance)
       {
         // Converged: undo any fold, then let the volume settle again (a few times at most).
         if (s.unfoldings < maximumUnfoldings && UnfoldFlippedTriangles(s, bones, parameters.dynamicIntersections))
@@ -923,18 +1016,35 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
     const double volume = EnclosedVolume(s.points, s.input->muscle->triangles);
     r.volumeChangePercent = 100.0 * (volume - s.restVolume) / s.restVolume;
     r.flippedTriangles =
-      s.flipsCheckedClean ? 0 : CountFlippedTriangles(s.start, s.points, s.input->muscle->triangles);
+      s.flipsCheckedClean ? 0 : CountFlippedTriangles(*s.reference, s.points, s.input->muscle->triangles);
     for (size_t i = 0; i < s.frozen.size(); ++i)
     {
       r.verticesFrozen += s.frozen[i];
       r.verticesStopped += s.stopped[i];
     }
-    const TriangleTree deformed(TriangleMesh{ s.points, s.input->muscle->triangles });
-    r.currentSamplesInside = FractionInside(deformed, s.currentSamples);
+    if (parameters.measureSamplesInside)
+    {
+      r.currentSamplesInside =
+        FractionInside(TriangleTree(TriangleMesh{ s.points, s.input->muscle->triangles }), s.currentSamples);
+    }
     if (!r.converged)
     {
-      r.warnings.push_back("muscle '" + s.input->name + "' did not converge in " +
-        std::to_string(parameters.maximumIterations) + " iterations");
+      // Unconverged but sound (a small swing) is a warning; unconverged and
+      // torn apart (volume far off, or the muscle grown far beyond its size)
+      // is no result to hand on.
+      if (!s.fellBack && ((parameters.preserveVolume && std::abs(r.volumeChangePercent) > 10.0) ||
+        Diagonal(s.points) > maximumGrowth * Diagonal(s.start)))
+      {
+        throw InputError("the deformation of muscle '" + s.input->name + "' diverged: after " +
+          std::to_string(parameters.maximumIterations) + " iterations its volume is off by " +
+          std::to_string(r.volumeChangePercent) + " % and it spans " +
+          std::to_string(Diagonal(s.points) / Diagonal(s.start)) + " times its starting size");
+      }
+      if (!s.fellBack)
+      {
+        r.warnings.push_back("muscle '" + s.input->name + "' did not converge in " +
+          std::to_string(parameters.maximumIterations) + " iterations");
+      }
     }
     s.time += Clock::now() - start;
     r.seconds = std::chrono::duration<double>(s.time).count();

@@ -40,6 +40,10 @@ struct DeformationParameters
   bool preserveVolume = true;
   bool dynamicIntersections = true;
   int samplesPerSegment = 10; ///< action-line rows per segment of each matched line
+  /// Measure DeformationResult::restSamplesInside and currentSamplesInside
+  /// (a hierarchy of each muscle, twice): callers that do not report them
+  /// skip the cost.
+  bool measureSamplesInside = true;
 };
 
 /// One muscle to deform.
@@ -58,6 +62,11 @@ struct MuscleToDeform
   /// interpolation method starts from a resolved mesh whose bone prints the
   /// hull does not carry. The full mesh is then weights * hull + detail.
   const Points* detail = nullptr;
+  /// The shape that turned-over triangles are judged against and that
+  /// unfolding gives back locally (same points and triangles), when not the
+  /// muscle's own: a step of the interpolation method gives the rest pose, so
+  /// that a fold an earlier step left is undone rather than kept.
+  const Points* reference = nullptr;
   /// Volume to hold, when not the muscle's own (a step of the interpolation
   /// method holds the rest pose's volume, so that no error builds up); 0: its own.
   double targetVolume = 0;
@@ -71,14 +80,15 @@ struct DeformationResult
   int coarseIterations = 0;
   bool converged = false;
   double volumeChangePercent = 0; ///< of the full mesh
-  std::int64_t flippedTriangles = 0;
+  std::int64_t flippedTriangles = 0; ///< against the reference shape
   /// Points left where they were because they were inside a bone when the
   /// fine phase started (frozen), and points stopped at an obstacle's surface
   /// in the last step.
   std::int64_t verticesFrozen = 0;
   std::int64_t verticesStopped = 0;
   /// Action-line samples inside the muscle: rest samples in the rest-pose
-  /// muscle, current samples in the deformed muscle (fractions in [0, 1]).
+  /// muscle, current samples in the deformed muscle (fractions in [0, 1];
+  /// 0 unless DeformationParameters::measureSamplesInside).
   double restSamplesInside = 0;
   double currentSamplesInside = 0;
   double seconds = 0; ///< this muscle's share of the pass (set-up and iterations)
@@ -86,11 +96,12 @@ struct DeformationResult
 };
 
 /// An obstacle in the current pose (a bone, or any mesh the muscles may not
-/// enter). The muscles of a pass are obstacles for each other without being listed.
+/// enter). The muscles of a pass are obstacles for each other without being
+/// listed. The tree may be refitted to another pose between passes.
 struct Obstacle
 {
   std::string name;
-  std::shared_ptr<const TriangleTree> tree;
+  std::shared_ptr<TriangleTree> tree;
 };
 
 /// Bounding-volume hierarchies of the obstacles, built in parallel.

@@ -241,13 +241,17 @@ private:
     {
       created.push_back({ x, y, v });
     }
+    const std::vector<int>& nearby = this->FacesNear(created);
     for (const Face& face : created)
     {
       const std::array<Vec3, 3> corners{ this->P[face[0]], this->P[face[1]], this->P[face[2]] };
-      for (int f = 0; f < static_cast<int>(this->F.size()); ++f)
+      Vec3 low, high;
+      this->Bounds(face, low, high);
+      for (int f : nearby)
       {
         const Face& other = this->F[f];
-        if (this->FaceAlive[f] && std::find(region.begin(), region.end(), f) == region.end() &&
+        if (this->FaceAlive[f] && !this->BoxesApart(f, low, high) &&
+          std::find(region.begin(), region.end(), f) == region.end() &&
           TrianglesIntersect(corners, face, { this->P[other[0]], this->P[other[1]], this->P[other[2]] }, other))
         {
           this->P.pop_back();
@@ -489,6 +493,42 @@ private:
       for (long j = lo[1]; j <= hi[1]; ++j)
         for (long k = lo[2]; k <= hi[2]; ++k)
           visit(GridCellKey(i, j, k));
+  }
+  /// The live faces in the grid cells that the boxes of `faces` reach, each
+  /// once (in NearbyBuffer; this->Visit marks them, instead of sorting).
+  const std::vector<int>& FacesNear(const std::vector<Face>& faces)
+  {
+    std::vector<int>& nearby = this->NearbyBuffer;
+    nearby.clear();
+    ++this->Visit;
+    this->VisitedFace.resize(this->F.size(), 0);
+    const Vec3 pad = Vec3::Constant(1e-9 * this->Size);
+    for (const Face& face : faces)
+    {
+      Vec3 low, high;
+      this->Bounds(face, low, high);
+      this->ForCells(low - pad, high + pad, [&](std::uint64_t key) {
+        auto cell = this->Grid.find(key);
+        if (cell == this->Grid.end())
+        {
+          return;
+        }
+        for (int f : cell->second)
+        {
+          if (this->VisitedFace[f] != this->Visit && this->FaceAlive[f])
+          {
+            this->VisitedFace[f] = this->Visit;
+            nearby.push_back(f);
+          }
+        }
+      });
+    }
+    return nearby;
+  }
+  /// Whether face f's bounding box and the box [low, high] are apart.
+  bool BoxesApart(int f, const Vec3& low, const Vec3& high) const
+  {
+    return (this->FaceLow[f].array() > high.array()).any() || (this->FaceHigh[f].array() < low.array()).any();
   }
   void Bounds(const Face& f, Vec3& low, Vec3& high) const
   {
@@ -839,37 +879,13 @@ private:
       }
     }
     // Self-intersection: the new triangles against everything near them.
-    std::vector<int>& nearby = this->NearbyBuffer;
-    nearby.clear();
-    ++this->Visit; // marks the faces already gathered, instead of sorting
-    this->VisitedFace.resize(this->F.size(), 0);
+    const std::vector<int>& nearby = this->FacesNear(created);
     for (const std::vector<int>* replaced : { &changed, &shared })
     {
       for (int f : *replaced)
       {
         this->ReplacedMark[f] = this->Visit;
       }
-    }
-    for (const Face& face : created)
-    {
-      Vec3 low, high;
-      this->Bounds(face, low, high);
-      const Vec3 pad = Vec3::Constant(1e-9 * this->Size);
-      this->ForCells(low - pad, high + pad, [&](std::uint64_t key) {
-        auto cell = this->Grid.find(key);
-        if (cell == this->Grid.end())
-        {
-          return;
-        }
-        for (int f : cell->second)
-        {
-          if (this->VisitedFace[f] != this->Visit && this->FaceAlive[f])
-          {
-            this->VisitedFace[f] = this->Visit;
-            nearby.push_back(f);
-          }
-        }
-      });
     }
     for (size_t i = 0; i < created.size(); ++i)
     {
@@ -884,9 +900,9 @@ private:
           continue;
         }
         const Face& other = this->F[f];
-        if ((this->FaceLow[f].array() > high.array()).any() || (this->FaceHigh[f].array() < low.array()).any())
+        if (this->BoxesApart(f, low, high))
         {
-          continue; // bounding boxes apart
+          continue;
         }
         const std::array<Vec3, 3> y{ this->P[other[0]], this->P[other[1]], this->P[other[2]] };
         if (TrianglesIntersect(x, face, y, other))

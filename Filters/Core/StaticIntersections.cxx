@@ -4,7 +4,9 @@
 #include "VolumeConstrainedSolver.h"
 
 #include <algorithm>
+#include <limits>
 #include <memory>
+#include <queue>
 
 namespace md
 {
@@ -40,10 +42,15 @@ struct ObstacleSet
     {
       this->all.push_back(f.tree);
     }
-    for (const TriangleMesh& mesh : meshes)
+    this->meshTrees.resize(meshes.size());
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int m = 0; m < static_cast<int>(meshes.size()); ++m)
     {
-      this->meshTrees.push_back(std::make_unique<TriangleTree>(mesh));
-      this->all.push_back(this->meshTrees.back().get());
+      this->meshTrees[m] = std::make_unique<TriangleTree>(meshes[m]);
+    }
+    for (const auto& tree : this->meshTrees)
+    {
+      this->all.push_back(tree.get());
     }
   }
   /// Obstacle o of mesh `mesh` (null for the mesh itself).
@@ -113,64 +120,98 @@ Deepest FindDeepest(const TriangleMesh& mesh, size_t m, const ObstacleSet& set, 
 
 namespace
 {
-/// Spreads the moves of the penetrating points (obstacle >= 0) to the points
-/// up to `rings` edges away, falling to zero beyond them (the moved points
-/// fixed, every other point of the band the mean of its neighbours): the
-/// print of the obstacle gets a smooth rim instead of a step.
-void SpreadShift(const Triangles& triangles, const std::vector<int>& obstacle, int rings, Points& shift)
+/// Makes the ways out of the penetrating points a smooth field over them and
+/// their rims. On entry `shift` holds each penetrating point's way out and
+/// `rim` the width of its group's rim (> 0 marks the penetrating points);
+/// every other shift is 0. The points within that width of a penetrating
+/// point (along the edges) join them. The field is then the membrane over
+/// them: each point the mean of its neighbours, zero beyond the rim, except
+/// that no penetrating point may stay short of the obstacle's tangent plane
+/// at its way out's end (`normal`: the obstacle's outward normal there), and
+/// `pinned` points keep their shift. It is an obstacle problem, solved by
+/// projected over-relaxed Gauss-Seidel sweeps in a fixed order, from the
+/// shift given.
+void SmoothPrints(const Points& points, const Triangles& triangles, const std::vector<double>& rim,
+  const Points& normal, const std::vector<char>& pinned, Points& shift)
 {
-  const Eigen::Index n = shift.rows();
-  std::vector<std::vector<std::int64_t>> neighbours(static_cast<size_t>(n));
-  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
-  {
-    for (int k = 0; k < 3; ++k)
-    {
-      neighbours[triangles(t, k)].push_back(triangles(t, (k + 1) % 3));
-      neighbours[triangles(t, (k + 1) % 3)].push_back(triangles(t, k));
-    }
-  }
-  // The band: points within `rings` edges of a moved point, by breadth-first search.
-  std::vector<int> ring(static_cast<size_t>(n), -1);
-  std::vector<Eigen::Index> band, frontier;
+  const Eigen::Index n = points.rows();
+  const std::vector<std::vector<std::int64_t>> neighbours = PointNeighbours(triangles, n);
+  // Who is in a rim: multi-source Dijkstra on what is left of each width.
+  std::vector<double> left(static_cast<size_t>(n), 0.0);
+  std::priority_queue<std::pair<double, Eigen::Index>> queue; // most left first
+  double largest = 0;
   for (Eigen::Index i = 0; i < n; ++i)
   {
-    if (obstacle[i] >= 0)
+    if (rim[i] > 0)
     {
-      ring[i] = 0;
-      frontier.push_back(i);
+      left[i] = rim[i];
+      queue.emplace(rim[i], i);
+      largest = std::max(largest, shift.row(i).norm());
     }
   }
-  for (int r = 1; r <= rings && !frontier.empty(); ++r)
+  while (!queue.empty())
   {
-    std::vector<Eigen::Index> next;
-    for (Eigen::Index i : frontier)
+    const auto [remaining, i] = queue.top();
+    queue.pop();
+    if (remaining < left[i])
     {
-      for (std::int64_t j : neighbours[i])
+      continue;
+    }
+    for (std::int64_t j : neighbours[i])
+    {
+      const double reach = remaining - (points.row(i) - points.row(j)).norm();
+      if (reach > left[j])
       {
-        if (ring[j] < 0)
-        {
-          ring[j] = r;
-          next.push_back(j);
-          band.push_back(j);
-        }
+        left[j] = reach;
+        queue.emplace(reach, j);
       }
     }
-    frontier = std::move(next);
   }
-  std::sort(band.begin(), band.end()); // a fixed order: the result does not depend on the search
-  for (int iteration = 0; iteration < 4 * rings; ++iteration)
+  std::vector<Eigen::Index> region;
+  for (Eigen::Index i = 0; i < n; ++i)
   {
-    Points updated = shift;
-    for (Eigen::Index i : band)
+    if (left[i] > 0 && !neighbours[i].empty())
     {
-      Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+      region.push_back(i);
+    }
+  }
+  // Each penetrating point must reach the plane through its target with the
+  // obstacle's normal there: its move along that normal at least `least`.
+  std::vector<double> least(static_cast<size_t>(n), 0.0);
+  for (Eigen::Index i : region)
+  {
+    least[i] = rim[i] > 0 ? shift.row(i).dot(normal.row(i)) : 0.0;
+  }
+  constexpr double overRelaxation = 1.5;
+  constexpr int maximumSweeps = 500;
+  const double tolerance = 1e-4 * largest;
+  for (int sweep = 0; sweep < maximumSweeps; ++sweep)
+  {
+    double change = 0;
+    for (Eigen::Index i : region)
+    {
+      if (pinned[i])
+      {
+        continue;
+      }
+      Eigen::RowVector3d mean = Eigen::RowVector3d::Zero();
       for (std::int64_t j : neighbours[i])
       {
-        sum += shift.row(j);
+        mean += shift.row(j);
       }
-      updated.row(i) = sum / static_cast<double>(neighbours[i].size());
+      mean /= static_cast<double>(neighbours[i].size());
+      Eigen::RowVector3d next = shift.row(i) + overRelaxation * (mean - shift.row(i));
+      if (rim[i] > 0)
+      {
+        next += std::max(0.0, least[i] - next.dot(normal.row(i))) * normal.row(i);
+      }
+      change = std::max(change, (next - shift.row(i)).cwiseAbs().maxCoeff());
+      shift.row(i) = next;
     }
-    shift = std::move(updated);
+    if (change <= tolerance)
+    {
+      break;
+    }
   }
 }
 }
@@ -242,6 +283,12 @@ StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& 
     const Deepest d = FindDeepest(mesh, m, set, fixed.size(), existing);
     const double backOff = 1e-5 * Diagonal(mesh.points);
     Points shift = Points::Zero(n, 3);
+    // Of each penetrating point: the obstacle's outward normal where it goes
+    // out (the tangent plane there is the half-space it must reach), and its
+    // group's rim width.
+    Points normal = Points::Zero(n, 3);
+    std::vector<double> rim(static_cast<size_t>(n), 0.0);
+    std::vector<const TriangleTree*> leaving(static_cast<size_t>(n), nullptr); // the obstacle it goes out of
     StaticResolveReport report;
     for (size_t o = 0; o < set.all.size(); ++o)
     {
@@ -291,6 +338,7 @@ StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& 
         const Eigen::Vector3d way = direction.row(group[i]).transpose();
         Eigen::Vector3d target = nearest;
         Eigen::Vector3d out = nearest - p;
+        Eigen::Vector3d surfaceNormal = out.normalized(); // at the nearest point, the way there
         if (way.squaredNorm() > 0)
         {
           const auto exit = tree->FirstHit(p, p + reach * way);
@@ -298,6 +346,11 @@ StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& 
           {
             target = exit->point;
             out = way;
+            surfaceNormal = tree->Normal(exit->triangle);
+            if (surfaceNormal.dot(way) < 0)
+            {
+              surfaceNormal = -surfaceNormal; // outward: the way leaves through it
+            }
           }
         }
         const double outLength = out.norm();
@@ -306,11 +359,53 @@ StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& 
           target += (backOff / outLength) * out;
         }
         shift.row(i) = share * (target - p).transpose();
+        normal.row(i) = (surfaceNormal.allFinite() ? surfaceNormal : way).transpose();
+        leaving[i] = share == 1.0 ? tree : nullptr; // a share of the way need not leave
+      }
+      std::vector<double> deepest(static_cast<size_t>(groups), 0.0);
+      for (Eigen::Index i = 0; i < n; ++i)
+      {
+        if (group[i] >= 0)
+        {
+          deepest[group[i]] = std::max(deepest[group[i]], shift.row(i).norm());
+        }
+      }
+      for (Eigen::Index i = 0; i < n; ++i)
+      {
+        if (group[i] >= 0)
+        {
+          // Every penetrating point is marked, however small its group's move.
+          rim[i] = std::max(parameters.falloff * deepest[group[i]], std::numeric_limits<double>::min());
+        }
       }
     }
-    if (parameters.falloffRings > 0)
+    if (parameters.falloff > 0)
     {
-      SpreadShift(mesh.triangles, d.obstacle, parameters.falloffRings, shift);
+      // Smoothing can leave a point of a concave obstacle inside it: such a
+      // point (its move does not cross the obstacle's surface an odd number
+      // of times) is pinned to its own way out and the rest smoothed again.
+      const Points target = shift;
+      std::vector<char> pinned(static_cast<size_t>(n), 0);
+      for (int round = 0; round < 4; ++round)
+      {
+        SmoothPrints(mesh.points, mesh.triangles, rim, normal, pinned, shift);
+        std::int64_t failed = 0;
+#pragma omp parallel for reduction(+ : failed) schedule(dynamic, 64)
+        for (Eigen::Index i = 0; i < n; ++i)
+        {
+          const Eigen::Vector3d p = mesh.points.row(i).transpose();
+          if (leaving[i] && !pinned[i] && leaving[i]->Crossings(p, p + shift.row(i).transpose()) % 2 == 0)
+          {
+            pinned[i] = 1;
+            shift.row(i) = target.row(i);
+            ++failed;
+          }
+        }
+        if (failed == 0)
+        {
+          break;
+        }
+      }
     }
     // No move may enter a fixed obstacle (a bone) on the way: one out of
     // another muscle, or spread around a print, stops at the bone's surface.
@@ -355,45 +450,80 @@ StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& 
 std::vector<double> RestoreVolumes(std::vector<TriangleMesh>& meshes, const std::vector<double>& targetVolumes,
   const std::vector<FixedObstacle>& fixed, const std::vector<std::vector<char>>& held)
 {
+  constexpr int taperRings = 3;
   const ObstacleSet set(meshes, fixed);
   std::vector<double> left(meshes.size(), 0.0);
   for (size_t m = 0; m < meshes.size(); ++m)
   {
     TriangleMesh& mesh = meshes[m];
     const Eigen::Index n = mesh.points.rows();
-    std::vector<char> free(static_cast<size_t>(n), 1);
+    const std::vector<std::vector<std::int64_t>> neighbours = PointNeighbours(mesh.triangles, n);
+    // How far each point takes part: 1 where it is free, tapering to 0 over
+    // a few rings towards the held points (Jacobi steps with them fixed at 0).
+    Eigen::VectorXd share(n);
     for (Eigen::Index i = 0; i < n; ++i)
     {
-      free[i] = !held[m][i];
+      share(i) = held[m][i] || neighbours[i].empty() ? 0.0 : 1.0;
+    }
+    for (int k = 0; k < taperRings; ++k)
+    {
+      Eigen::VectorXd next = share;
+      for (Eigen::Index i = 0; i < n; ++i)
+      {
+        if (share(i) > 0)
+        {
+          double sum = 0;
+          for (std::int64_t j : neighbours[i])
+          {
+            sum += share(j);
+          }
+          next(i) = 0.5 * share(i) + 0.5 * sum / static_cast<double>(neighbours[i].size());
+        }
+      }
+      share = std::move(next);
+    }
+    // The way each point moves: its unit normal (of the gradient of the
+    // volume, which points outwards), times its share.
+    Points way;
+    EnclosedVolume(mesh.points, mesh.triangles, &way);
+    for (Eigen::Index i = 0; i < n; ++i)
+    {
+      const double length = way.row(i).norm();
+      way.row(i) = length > 0 ? Eigen::RowVector3d(share(i) / length * way.row(i)) : Eigen::RowVector3d::Zero();
+    }
+    std::vector<char> moving(static_cast<size_t>(n));
+    for (Eigen::Index i = 0; i < n; ++i)
+    {
+      moving[i] = share(i) > 0;
     }
     const double backOff = 1e-6 * Diagonal(mesh.points);
     for (int iteration = 0; iteration < 4; ++iteration)
     {
       Points gradient;
       const double volume = EnclosedVolume(mesh.points, mesh.triangles, &gradient);
+      double rate = 0; // of the volume with the common distance
       for (Eigen::Index i = 0; i < n; ++i)
       {
-        if (!free[i])
+        if (moving[i])
         {
-          gradient.row(i).setZero();
+          rate += gradient.row(i).dot(way.row(i));
         }
       }
-      const double norm = gradient.squaredNorm();
       const double error = targetVolumes[m] - volume;
-      if (norm == 0 || std::abs(error) <= 1e-7 * std::abs(targetVolumes[m]))
+      if (rate == 0 || std::abs(error) <= 1e-7 * std::abs(targetVolumes[m]))
       {
         break;
       }
-      const double scale = error / norm;
+      const double distance = error / rate;
 #pragma omp parallel for schedule(dynamic, 128)
       for (Eigen::Index i = 0; i < n; ++i)
       {
-        if (!free[i])
+        if (!moving[i])
         {
           continue;
         }
         const Eigen::Vector3d from = mesh.points.row(i).transpose();
-        const Eigen::Vector3d to = from + scale * gradient.row(i).transpose();
+        const Eigen::Vector3d to = from + distance * way.row(i).transpose();
         const double length = (to - from).norm();
         double first = 2;
         for (size_t o = 0; o < set.all.size(); ++o)
@@ -409,7 +539,7 @@ std::vector<double> RestoreVolumes(std::vector<TriangleMesh>& meshes, const std:
         }
         if (first <= 1)
         {
-          free[i] = 0; // at an obstacle from now on
+          moving[i] = 0; // at an obstacle from now on
           mesh.points.row(i) = (from + std::max(0.0, first - backOff / std::max(length, 1e-300)) * (to - from)).transpose();
         }
         else

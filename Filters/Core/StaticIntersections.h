@@ -48,10 +48,14 @@ struct StaticResolveParameters
   /// another deformable mesh (which takes its own share from its side): 0.6
   /// in the original, so that neither is pushed all the way.
   double deformableShare = 0.6;
-  /// The moves spread to the points this many edges around the moved ones,
-  /// falling to zero, so that the print has a smooth rim (0: the paper's
-  /// rule, only the penetrating points move).
-  int falloffRings = 3;
+  /// The print's rim, as a multiple of each group's largest move: the points
+  /// within this distance of the group (along the mesh's edges) move too, and
+  /// the moves of the group and its rim form a smooth field in which every
+  /// penetrating point still goes at least its way out; so the print is a
+  /// smooth dent, as deep as the deepest point needs, fading to nothing over
+  /// the rim, instead of the obstacle's outline cut into the mesh. 0: the
+  /// paper's rule, each penetrating point moves to its own target, no other.
+  double falloff = 3.0;
 };
 
 struct StaticResolveReport
@@ -71,22 +75,27 @@ struct StaticResolveResult
 
 /// Moves the points of every mesh that lie inside an obstacle (and are not
 /// marked in `existing`) out to its surface. Each point goes with the
-/// obstacle it is deepest in, a fixed one (a bone) before a mesh; the points with the same obstacle form
-/// edge-connected groups, and a group moves along one direction, the mean of
-/// its points' ways to their nearest surface points, each point to where that
-/// direction leaves the obstacle (to its nearest surface point when that exit
-/// is more than twice as far: a thin part of the obstacle). All meshes are
-/// resolved against the obstacles as they are on entry (the result does not
-/// depend on the meshes' order).
+/// obstacle it is deepest in, a fixed one (a bone) before a mesh; the points
+/// with the same obstacle form edge-connected groups, and a group moves along
+/// one direction, the mean of its points' ways to their nearest surface
+/// points: each point's way out is to where that direction leaves the
+/// obstacle (to its nearest surface point when that exit is more than twice
+/// as far: a thin part of the obstacle). With `falloff` the moves are then
+/// smoothed over the group and its rim (see StaticResolveParameters), each
+/// penetrating point still going at least its way out. No move enters a
+/// fixed obstacle. All meshes are resolved against the obstacles as they are
+/// on entry (the result does not depend on the meshes' order).
 StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& meshes,
   const std::vector<FixedObstacle>& fixed, const OverlapMasks* existing, const StaticResolveParameters& parameters);
 
-/// Gives the meshes back their target volumes after a static resolution (which
-/// flattens them where it pushes): the points that are free (`held` is 0:
-/// not moved by the resolution, not in the rest pose's overlap) move along the volume
-/// gradient, a few Newton steps on one scale factor, a move that would enter
-/// an obstacle or another mesh stopping at its surface. Returns the volume
-/// change left, in percent of each target.
+/// Gives the meshes back their target volumes after a static resolution
+/// (which dents them where it pushes): the surface moves out along its unit
+/// normals by one common distance (a few Newton steps on it), which tapers to
+/// nothing over three rings towards the `held` points (held[m][i] != 0; they
+/// stay). Spread over the whole surface the move is small and smooth; a move
+/// that would enter an obstacle or another mesh stops at its surface, and
+/// that point moves no further. Returns the volume change left, in percent of
+/// each target.
 std::vector<double> RestoreVolumes(std::vector<TriangleMesh>& meshes, const std::vector<double>& targetVolumes,
   const std::vector<FixedObstacle>& fixed, const std::vector<std::vector<char>>& held);
 }

@@ -103,25 +103,6 @@ std::int64_t ThirdPoint(const Triangle& t, std::int64_t a, std::int64_t b)
 
 namespace
 {
-std::vector<std::vector<std::int64_t>> PointNeighbours(const TriangleMesh& mesh)
-{
-  std::vector<std::vector<std::int64_t>> neighbours(static_cast<size_t>(mesh.points.rows()));
-  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
-  {
-    for (int k = 0; k < 3; ++k)
-    {
-      neighbours[mesh.triangles(t, k)].push_back(mesh.triangles(t, (k + 1) % 3));
-      neighbours[mesh.triangles(t, (k + 1) % 3)].push_back(mesh.triangles(t, k));
-    }
-  }
-  for (auto& list : neighbours)
-  {
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
-  }
-  return neighbours;
-}
-
 /// Moves smoothed points back towards where they were (all the way, half,
 /// a quarter), wherever that makes no triangle cross another.
 void RestoreTowardsOriginal(TriangleMesh& mesh, const Points& original, const std::vector<std::int64_t>& moved)
@@ -253,7 +234,7 @@ void UntangleSelfIntersections(TriangleMesh& mesh, RepairReport& report)
     return;
   }
   const auto initialPairs = static_cast<std::int64_t>(pairs.size());
-  const auto neighbours = PointNeighbours(mesh);
+  const auto neighbours = PointNeighbours(mesh.triangles, mesh.points.rows());
   const Points original = mesh.points;
   std::vector<char> inRegion(static_cast<size_t>(mesh.points.rows()), 0);
   std::vector<std::int64_t> region;
@@ -325,7 +306,7 @@ void UntangleSelfIntersections(TriangleMesh& mesh, RepairReport& report)
 /// Removes the connected pieces whose every point lies inside another piece.
 void RemoveEnclosedPieces(TriangleMesh& mesh, RepairReport& report)
 {
-  const auto neighbours = PointNeighbours(mesh);
+  const auto neighbours = PointNeighbours(mesh.triangles, mesh.points.rows());
   std::vector<int> piece(static_cast<size_t>(mesh.points.rows()), -1);
   int pieces = 0;
   for (std::int64_t seed = 0; seed < mesh.points.rows(); ++seed)

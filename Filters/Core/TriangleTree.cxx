@@ -4,6 +4,7 @@
 #include "TriangleIntersection.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -12,6 +13,21 @@ namespace md
 namespace
 {
 constexpr int leafSize = 4;
+constexpr int maximumDepth = 60; // splits stop there, so a traversal stack never holds more than this + 1
+
+/// The nodes still to visit in a depth-first traversal, on the call stack:
+/// queries run in hot parallel loops, where a heap allocation each would cost.
+class NodeStack
+{
+public:
+  void Push(int node) { this->Nodes[this->Size++] = node; }
+  int Pop() { return this->Nodes[--this->Size]; }
+  bool Empty() const { return this->Size == 0; }
+
+private:
+  std::array<int, maximumDepth + 2> Nodes;
+  int Size = 0;
+};
 
 /// Slab test: does the segment origin + t * direction, t in [0, limit], meet the box?
 bool SegmentMeetsBox(const Eigen::Vector3d& origin, const Eigen::Vector3d& inverse, double limit,
@@ -82,7 +98,7 @@ int TriangleTree::Build(std::vector<BuildItem>& items, int first, int count, int
   this->Nodes.emplace_back();
   this->Nodes[index].first = first;
   this->Nodes[index].count = count;
-  if (count <= leafSize || depth > 60)
+  if (count <= leafSize || depth >= maximumDepth)
   {
     return index;
   }
@@ -162,19 +178,19 @@ void TriangleTree::ForTrianglesNearSegment(
 {
   // `limit` is read at every box: a caller may shorten the segment as it goes.
   const Eigen::Vector3d inverse = direction.cwiseInverse();
-  std::vector<int> stack{ 0 };
-  while (!stack.empty())
+  NodeStack stack;
+  stack.Push(0);
+  while (!stack.Empty())
   {
-    const Node& node = this->Nodes[stack.back()];
-    stack.pop_back();
+    const Node& node = this->Nodes[stack.Pop()];
     if (!SegmentMeetsBox(from, inverse, limit, node.low, node.high))
     {
       continue;
     }
     if (node.left >= 0)
     {
-      stack.push_back(node.left);
-      stack.push_back(node.right);
+      stack.Push(node.left);
+      stack.Push(node.right);
       continue;
     }
     for (int i = node.first; i < node.first + node.count; ++i)
@@ -201,10 +217,34 @@ std::optional<TriangleTree::Hit> TriangleTree::FirstHit(const Eigen::Vector3d& f
   return best;
 }
 
+int TriangleTree::Crossings(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const
+{
+  const Eigen::Vector3d direction = to - from;
+  int crossings = 0;
+  this->ForTrianglesNearSegment(from, direction, 1.0, [&](Eigen::Index t) {
+    double t01, u, v;
+    if (IntersectLineTriangle(from, direction, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2), 0.0, t01, u, v) &&
+      t01 >= 0 && t01 <= 1)
+    {
+      ++crossings;
+    }
+  });
+  return crossings;
+}
+
 int TriangleTree::CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, bool& grazed) const
 {
-  // A segment long enough to leave the surface's box.
-  const Eigen::Vector3d d = 4.0 * (this->Size + (origin - this->Nodes[0].low).norm()) * direction;
+  // A segment just long enough to leave the surface's box (slab exits).
+  double exit = std::numeric_limits<double>::max();
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    if (direction[axis] != 0)
+    {
+      const double bound = direction[axis] > 0 ? this->Nodes[0].high[axis] : this->Nodes[0].low[axis];
+      exit = std::min(exit, (bound - origin[axis]) / direction[axis]);
+    }
+  }
+  const Eigen::Vector3d d = (std::max(exit, 0.0) + 1e-3 * this->Size) * direction;
   const double edgeTolerance = 1e-9;
   int crossings = 0;
   grazed = false;
@@ -227,23 +267,44 @@ int TriangleTree::CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vec
 
 bool TriangleTree::Inside(const Eigen::Vector3d& p) const
 {
-  // Fixed, unremarkable directions: deterministic, and unlikely to run along edges.
-  static const Eigen::Vector3d directions[] = { Eigen::Vector3d(0.5773, 0.5774, 0.5773).normalized(),
-    Eigen::Vector3d(-0.3210, 0.8765, -0.3590).normalized(), Eigen::Vector3d(0.7071, -0.2345, -0.6669).normalized(),
-    Eigen::Vector3d(-0.6543, -0.5432, 0.5265).normalized(), Eigen::Vector3d(0.1234, -0.9012, 0.4155).normalized() };
-  int votesInside = 0, votes = 0;
-  for (const Eigen::Vector3d& direction : directions)
+  if (!this->InBounds(p))
   {
+    return false; // a closed surface lies within its box
+  }
+  // Rays towards the nearest faces of the surface's box, where they leave it
+  // soonest and so meet the fewest boxes of the tree; each tilted off its
+  // axis by fixed, unremarkable amounts so that no ray runs along the edges
+  // of a mesh aligned with the axes.
+  const Eigen::Vector3d& low = this->Nodes[0].low;
+  const Eigen::Vector3d& high = this->Nodes[0].high;
+  std::array<std::pair<double, int>, 6> faces; // distance, 2 * axis + (1 towards high)
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    faces[2 * axis] = { p[axis] - low[axis], 2 * axis };
+    faces[2 * axis + 1] = { high[axis] - p[axis], 2 * axis + 1 };
+  }
+  std::sort(faces.begin(), faces.end());
+  static const Eigen::Vector3d tilts[] = { Eigen::Vector3d(0.1234, 0.0871, 0.1057),
+    Eigen::Vector3d(-0.0963, 0.1311, -0.0729), Eigen::Vector3d(0.1102, -0.0658, -0.1247),
+    Eigen::Vector3d(-0.1189, -0.1046, 0.0902), Eigen::Vector3d(0.0817, 0.1153, -0.1361),
+    Eigen::Vector3d(-0.0744, -0.1278, -0.0986) };
+  int votesInside = 0, votes = 0;
+  for (int k = 0; k < 6; ++k)
+  {
+    const int axis = faces[k].second / 2;
+    Eigen::Vector3d direction = tilts[k];
+    direction[axis] = faces[k].second % 2 ? 1.0 : -1.0;
     bool grazed = false;
-    const int crossings = this->CountCrossings(p, direction, grazed);
+    const int crossings = this->CountCrossings(p, direction.normalized(), grazed);
     if (grazed)
     {
       continue;
     }
     votesInside += crossings % 2;
-    if (++votes == 3)
+    ++votes;
+    if (votes == 3 || (votes == 2 && votesInside != 1))
     {
-      break;
+      break; // a majority of three: two that agree decide
     }
   }
   if (votes == 0)
@@ -257,11 +318,11 @@ TriangleTree::Closest TriangleTree::ClosestPoint(const Eigen::Vector3d& p) const
 {
   Closest best;
   double bestSquared = std::numeric_limits<double>::max();
-  std::vector<int> stack{ 0 };
-  while (!stack.empty())
+  NodeStack stack;
+  stack.Push(0);
+  while (!stack.Empty())
   {
-    const Node& node = this->Nodes[stack.back()];
-    stack.pop_back();
+    const Node& node = this->Nodes[stack.Pop()];
     if (BoxDistanceSquared(p, node.low, node.high) >= bestSquared)
     {
       continue;
@@ -273,8 +334,8 @@ TriangleTree::Closest TriangleTree::ClosestPoint(const Eigen::Vector3d& p) const
       const Node& right = this->Nodes[node.right];
       const bool leftNearer =
         BoxDistanceSquared(p, left.low, left.high) < BoxDistanceSquared(p, right.low, right.high);
-      stack.push_back(leftNearer ? node.right : node.left);
-      stack.push_back(leftNearer ? node.left : node.right);
+      stack.Push(leftNearer ? node.right : node.left);
+      stack.Push(leftNearer ? node.left : node.right);
       continue;
     }
     for (int i = node.first; i < node.first + node.count; ++i)

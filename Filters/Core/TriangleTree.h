@@ -26,9 +26,15 @@ public:
   /// The first triangle the segment from `from` to `to` meets, if any.
   std::optional<Hit> FirstHit(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
 
+  /// How many triangles the segment from `from` to `to` crosses: odd when
+  /// the segment leaves or enters the closed surface, even when both ends are
+  /// on the same side.
+  int Crossings(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
+
   /// Whether p is inside the closed surface: the parity of crossings along
-  /// rays, decided by the majority of three directions so that a ray grazing
-  /// an edge or a point cannot decide alone.
+  /// rays towards the nearest sides of the surface's box, decided by the
+  /// majority of three (two that agree) so that a ray grazing an edge or a
+  /// point cannot decide alone.
   bool Inside(const Eigen::Vector3d& p) const;
 
   struct Closest

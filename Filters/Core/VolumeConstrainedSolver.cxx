@@ -83,15 +83,25 @@ VolumeConstrainedSolver::VolumeConstrainedSolver(const SparseMatrix& rows, const
   : Rows(rows)
   , Faces(triangles)
 {
-  const Eigen::SparseMatrix<double> normal = Eigen::SparseMatrix<double>(rows.transpose()) * rows;
-  this->Normal = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>(normal);
+  const Eigen::MatrixXd dense(rows);
+  Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(dense.cols(), dense.cols());
+  normal.selfadjointView<Eigen::Lower>().rankUpdate(dense.transpose());
+  this->Normal.compute(normal);
   // A singular system shows as a pivot that is only rounding.
-  const Eigen::VectorXd pivots = this->Normal->vectorD();
-  if (this->Normal->info() != Eigen::Success || pivots.size() == 0 ||
-    pivots.minCoeff() <= 1e-12 * pivots.cwiseAbs().maxCoeff())
+  const Eigen::VectorXd pivots = this->Normal.vectorD();
+  const double largest = pivots.size() ? pivots.cwiseAbs().maxCoeff() : 0.0;
+  if (this->Normal.info() != Eigen::Success || pivots.size() == 0 || pivots.minCoeff() <= 1e-14 * largest)
   {
     throw InputError("the deformation's least-squares system is singular: nothing fixes the muscle's position "
                      "(are there action-line rows?)");
+  }
+  // A hull point that the rows hardly fix (a pivot far below the others)
+  // would take steps of rounding noise: a tiny damping holds it instead. The
+  // steps' fixed point, where L^T r + J^T lambda = 0, does not change.
+  if (pivots.minCoeff() <= 1e-9 * largest)
+  {
+    normal.diagonal().array() += 1e-9 * largest;
+    this->Normal.compute(normal);
   }
 }
 
@@ -116,12 +126,12 @@ Points VolumeConstrainedSolver::Step(const Points& x, const Points& targets, dou
   const Points residual = this->Rows * x - targets;
   const Points pulled = this->Rows.transpose() * residual; // L^T r
   // A applied column by column (the three coordinates share L).
-  const Eigen::MatrixXd aPulled = this->Normal->solve(Eigen::MatrixXd(pulled));
+  const Eigen::MatrixXd aPulled = this->Normal.solve(Eigen::MatrixXd(pulled));
   if (gradient.rows() == 0)
   {
     return x - alpha * aPulled;
   }
-  const Eigen::MatrixXd aGradient = this->Normal->solve(Eigen::MatrixXd(gradient));
+  const Eigen::MatrixXd aGradient = this->Normal.solve(Eigen::MatrixXd(gradient));
   const double jaj = (gradient.array() * aGradient.array()).sum();
   const double jalr = (gradient.array() * aPulled.array()).sum();
   const double lambda = (volumeError / alpha - sign * jalr) / jaj;

@@ -5,7 +5,7 @@
 
 #include "MeshTypes.h"
 
-#include <Eigen/SparseCholesky>
+#include <Eigen/Cholesky>
 #include <Eigen/SparseCore>
 
 #include <memory>
@@ -26,7 +26,9 @@ double EnclosedVolume(const Points& points, const Triangles& triangles, Points* 
 /// Solves min |L X - b|^2 subject to V(X) = V0 step by step. A = (L^T L)^-1 is
 /// factored once (L must have full column rank: the Laplacian rows alone do
 /// not, a translation costs them nothing; rows fixing positions, such as
-/// action-line rows, give it).
+/// action-line rows, give it). L^T L is factored dense: the action-line rows
+/// are mean value coordinates, which weigh every hull point, so it is dense
+/// anyway.
 class VolumeConstrainedSolver
 {
 public:
@@ -55,6 +57,6 @@ public:
 
   SparseMatrix Rows;
   Triangles Faces;
-  std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> Normal;
+  Eigen::LDLT<Eigen::MatrixXd> Normal;
 };
 }

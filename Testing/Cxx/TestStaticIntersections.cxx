@@ -3,6 +3,7 @@
 #include "MuscleDeformer.h"
 #include "StaticIntersections.h"
 #include "TestMeshes.h"
+#include "VolumeConstrainedSolver.h"
 
 #include <gtest/gtest.h>
 
@@ -29,7 +30,7 @@ TEST_F(CapInBox, ThePenetratingCapGoesOutToTheSurfaceAsOneGroup)
   EXPECT_EQ(before[0].fixedCount, before[0].count);
 
   md::StaticResolveParameters parameters;
-  parameters.falloffRings = 0; // the paper's rule: only the penetrating points move
+  parameters.falloff = 0; // the paper's rule: only the penetrating points move
   const md::StaticResolveResult r = md::ResolveStaticIntersections({ sphere }, { Fixed(box) }, nullptr, parameters);
   EXPECT_EQ(r.reports[0].penetratingPoints, before[0].count);
   EXPECT_EQ(r.reports[0].groups, 1);
@@ -54,8 +55,8 @@ TEST_F(CapInBox, ThePenetratingCapGoesOutToTheSurfaceAsOneGroup)
 TEST_F(CapInBox, TheMoveSpreadsToASmoothRimWithFewerSharpEdges)
 {
   md::StaticResolveParameters paper, smooth;
-  paper.falloffRings = 0;
-  smooth.falloffRings = 3;
+  paper.falloff = 0;
+  smooth.falloff = 3;
   const auto sharp = md::ResolveStaticIntersections({ sphere }, { Fixed(box) }, nullptr, paper);
   const auto soft = md::ResolveStaticIntersections({ sphere }, { Fixed(box) }, nullptr, smooth);
   EXPECT_NEAR(soft.reports[0].maxShift, sharp.reports[0].maxShift, 1e-9);
@@ -82,6 +83,42 @@ TEST_F(CapInBox, OverlapOfTheRestPoseIsLeftAlone)
   EXPECT_EQ(md::MeasureNewPenetration({ sphere }, { Fixed(box) }, &rest)[0].count, 0);
 }
 
+TEST_F(CapInBox, RestoreVolumesGivesTheDentedVolumeBackSmoothlyAndKeepsHeldPointsAndTheBoxOut)
+{
+  const md::StaticResolveResult r =
+    md::ResolveStaticIntersections({ sphere }, { Fixed(box) }, nullptr, md::StaticResolveParameters{});
+  std::vector<md::TriangleMesh> meshes{ { r.points[0], sphere.triangles } };
+  const double target = md::EnclosedVolume(sphere.points, sphere.triangles);
+  const double dented = md::EnclosedVolume(meshes[0].points, sphere.triangles);
+  ASSERT_LT(dented, 0.995 * target); // the print took a visible share
+  // Hold the points on the far side (x < -8), as the rest pose's overlap is held.
+  std::vector<std::vector<char>> held(1, std::vector<char>(static_cast<size_t>(sphere.points.rows()), 0));
+  for (Eigen::Index i = 0; i < sphere.points.rows(); ++i)
+  {
+    held[0][i] = sphere.points(i, 0) < -8;
+  }
+  const std::vector<double> left = md::RestoreVolumes(meshes, { target }, { Fixed(box) }, held);
+  ASSERT_EQ(left.size(), 1u);
+  EXPECT_LT(std::abs(left[0]), 1e-3);
+  EXPECT_NEAR(100 * (md::EnclosedVolume(meshes[0].points, sphere.triangles) - target) / target, left[0], 1e-9);
+  EXPECT_EQ(md::MeasureNewPenetration(meshes, { Fixed(box) }, nullptr)[0].count, 0);
+  double largest = 0;
+  for (Eigen::Index i = 0; i < sphere.points.rows(); ++i)
+  {
+    const double move = (meshes[0].points.row(i) - r.points[0].row(i)).norm();
+    if (held[0][i])
+    {
+      EXPECT_EQ(move, 0.0) << "held point " << i << " moved";
+    }
+    largest = std::max(largest, move);
+  }
+  // Spread over the surface: a small move everywhere, no bulge (a uniform
+  // offset of the radius-10 sphere would need 0.1 mm or so).
+  EXPECT_GT(largest, 0.0);
+  EXPECT_LT(largest, 0.5);
+  EXPECT_EQ(md::CountNewSharpEdges(r.points[0], meshes[0].points, sphere.triangles), 0);
+}
+
 TEST(StaticIntersections, TwoDeformableMeshesEachTakeTheirShare)
 {
   // Two spheres overlapping by 2 along x: each point of one inside the other
@@ -89,7 +126,7 @@ TEST(StaticIntersections, TwoDeformableMeshesEachTakeTheirShare)
   const md::TriangleMesh a = Sphere(Eigen::Vector3d::Zero(), 10, 3);
   const md::TriangleMesh b = Sphere(Eigen::Vector3d(18, 0, 0), 10, 3);
   md::StaticResolveParameters parameters;
-  parameters.falloffRings = 0;
+  parameters.falloff = 0;
   const auto before = md::MeasureNewPenetration({ a, b }, {}, nullptr);
   ASSERT_GT(before[0].count, 0);
   ASSERT_GT(before[1].count, 0);

@@ -65,7 +65,7 @@ TEST(TriangleTree, InsideAgreesWithTheWindingNumber)
   EXPECT_GT(rectusInside, 50);
 }
 
-TEST(TriangleTree, FirstHitAndClosestPointAgreeWithBruteForce)
+TEST(TriangleTree, FirstHitCrossingsAndClosestPointAgreeWithBruteForce)
 {
   const md::TriangleMesh femur = Femur();
   const md::TriangleTree tree(femur);
@@ -77,6 +77,7 @@ TEST(TriangleTree, FirstHitAndClosestPointAgreeWithBruteForce)
     const Eigen::Vector3d to = RandomPoint(generator, femur, 30.0);
     // Brute force: the smallest segment fraction over all triangles.
     double bestT = std::numeric_limits<double>::max();
+    int crossings = 0;
     for (Eigen::Index t = 0; t < femur.triangles.rows(); ++t)
     {
       const Eigen::Vector3d a = femur.points.row(femur.triangles(t, 0)).transpose();
@@ -88,7 +89,14 @@ TEST(TriangleTree, FirstHitAndClosestPointAgreeWithBruteForce)
       if (uvt[0] >= 0 && uvt[1] >= 0 && uvt[0] + uvt[1] <= 1 && uvt[2] >= 0 && uvt[2] <= 1)
       {
         bestT = std::min(bestT, uvt[2]);
+        ++crossings;
       }
+    }
+    EXPECT_EQ(tree.Crossings(from, to), crossings) << from.transpose() << " -> " << to.transpose();
+    if (tree.ClosestPoint(to).distance > 1e-6 && tree.ClosestPoint(from).distance > 1e-6)
+    {
+      // An odd count: the ends are on opposite sides of the surface.
+      EXPECT_EQ(crossings % 2 == 1, tree.Inside(from) != tree.Inside(to));
     }
     const auto hit = tree.FirstHit(from, to);
     ASSERT_EQ(hit.has_value(), bestT <= 1.0) << from.transpose() << " -> " << to.transpose();
