@@ -6,21 +6,72 @@
 // in total: hull time, per-step time, total, and every quality measure.
 // Prints figures; asserts nothing (see the tests).
 //
-//   BenchmarkInterpolation [data folder] [number of steps]
+//   BenchmarkInterpolation [data folder] [number of steps] [phantom flexion] [all|one-pass|refit|rebuild]
+//                          [LHDL motion] [frame]      (default hip_flexion 35: 60 degrees of flexion)
+//                          [perturbation]  (-1: none, the default; 0: inputs rounded to float; s > 0: rounded
+//                                           after a seeded random move of 1e-7 of each coordinate)
 #include "RealData.h"
 
 #include <cstdio>
+#include <functional>
+#include <random>
 #include <cstdlib>
 #include <string>
 
 namespace
 {
+/// The case with every coordinate rounded to float (as VTK pipelines with
+/// float points carry them) and, for seed > 0, first moved by a pseudo-random
+/// amount of that size (up to 1e-7 of the coordinate, a function of the
+/// value and the seed, so that equal coordinates stay equal): how much the
+/// results depend on such perturbations.
+MotionCase Perturbed(MotionCase c, int seed)
+{
+  auto perturb = [&](md::Points& points) {
+    for (Eigen::Index i = 0; i < points.size(); ++i)
+    {
+      double& x = points.data()[i];
+      if (seed > 0)
+      {
+        std::seed_seq sequence{ static_cast<int>(std::hash<double>{}(x)), seed };
+        std::mt19937 random(sequence);
+        x *= 1 + 1e-7 * std::uniform_real_distribution<double>(-1.0, 1.0)(random);
+      }
+      x = static_cast<double>(static_cast<float>(x));
+    }
+  };
+  for (md::MuscleMotion& m : c.muscles)
+  {
+    perturb(m.muscle.points);
+    for (md::MatchedLine& line : m.lines)
+    {
+      perturb(line.rest);
+      perturb(line.current);
+    }
+  }
+  for (md::BoneMotion& b : c.bones)
+  {
+    perturb(b.rest.points);
+    perturb(b.current);
+  }
+  return c;
+}
+
 void Run(const MotionCase& c, const char* label, int steps, md::HullMode mode)
 {
   md::InterpolationParameters parameters;
   parameters.numberOfSteps = steps;
   parameters.hullMode = mode;
-  const md::InterpolationResult r = md::DeformByInterpolation(c.muscles, c.bones, parameters);
+  md::InterpolationResult r;
+  try
+  {
+    r = md::DeformByInterpolation(c.muscles, c.bones, parameters);
+  }
+  catch (const md::InputError& e)
+  {
+    std::printf("\n%s, %s (N = %d): failed: %s\n", c.name.c_str(), label, steps, e.what());
+    return;
+  }
   std::printf("\n%s, %s (N = %d): total %.2f s\n", c.name.c_str(), label, r.numberOfSteps, r.totalSeconds);
   double restHulls = 0;
   for (double s : r.restHullSeconds)
@@ -55,17 +106,38 @@ void Run(const MotionCase& c, const char* label, int steps, md::HullMode mode)
       f.maxStaticShift, static_cast<long long>(f.sharpEdgeCount), static_cast<long long>(f.flippedTriangleCount),
       f.iterations, f.converged ? "yes" : "no", static_cast<long long>(frozen));
   }
+  std::printf("  largest static shift (mm) and new sharp edges at each step:\n");
+  for (size_t m = 0; m < c.muscles.size(); ++m)
+  {
+    std::printf("  %-18s", c.muscles[m].name.c_str());
+    for (int j = 1; j <= r.numberOfSteps; ++j)
+    {
+      std::printf(" %7.3f (%lld)", r.measures[j][m].stepStaticShift,
+        static_cast<long long>(r.measures[j][m].sharpEdgeCount));
+    }
+    std::printf("\n");
+  }
   for (const std::string& w : r.warnings)
   {
     std::printf("  warning: %s\n", w.c_str());
   }
 }
 
-void Compare(const MotionCase& c, int steps)
+/// `runs`: "all", or one of "one-pass", "refit", "rebuild".
+void Compare(const MotionCase& c, int steps, const std::string& runs)
 {
-  Run(c, "one-pass method", 1, md::HullMode::Refit);
-  Run(c, "interpolation, Refit", steps, md::HullMode::Refit);
-  Run(c, "interpolation, Rebuild", steps, md::HullMode::Rebuild);
+  if (runs == "all" || runs == "one-pass")
+  {
+    Run(c, "one-pass method", 1, md::HullMode::Refit);
+  }
+  if (runs == "all" || runs == "refit")
+  {
+    Run(c, "interpolation, Refit", steps, md::HullMode::Refit);
+  }
+  if (runs == "all" || runs == "rebuild")
+  {
+    Run(c, "interpolation, Rebuild", steps, md::HullMode::Rebuild);
+  }
 }
 }
 
@@ -77,13 +149,22 @@ int main(int argc, char* argv[])
               "penetration of bones and other muscles, count and deepest (mm), the same of bones only, largest static shift over the steps (mm), new sharp edges\n"
               "(> 60 deg), flipped triangles, iterations, converged in every step, points frozen in bones\n"
               "(summed over steps).\n");
-  Compare(PhantomMotion(argc > 3 ? std::atof(argv[3]) : 30), steps);
+  const std::string runs = argc > 4 ? argv[4] : "all";
+  if (runs != "all" && runs != "one-pass" && runs != "refit" && runs != "rebuild")
+  {
+    std::fprintf(stderr, "unknown run '%s': all, one-pass, refit or rebuild\n", runs.c_str());
+    return 2;
+  }
+  Compare(PhantomMotion(argc > 3 ? std::atof(argv[3]) : 30), steps, runs);
   MotionCase lhdl;
-  if (!LhdlMotion("hip_flexion", 35, lhdl, folder))
+  const std::string motion = argc > 5 ? argv[5] : "hip_flexion";
+  const int frame = argc > 6 ? std::atoi(argv[6]) : 35;
+  if (!LhdlMotion(motion, frame, lhdl, folder))
   {
     std::printf("\nLHDL data not found: skipped (pass the data folder or set MUSCLEDEFORMATION_DATA_DIR)\n");
     return 0;
   }
-  Compare(lhdl, steps);
+  const int perturbation = argc > 7 ? std::atoi(argv[7]) : -1;
+  Compare(perturbation < 0 ? lhdl : Perturbed(lhdl, perturbation), steps, runs);
   return 0;
 }
