@@ -90,10 +90,11 @@ struct NearestSegment
   }
 };
 
-/// Stacks the Laplacian rows, the dense action-line rows and one row per
-/// anchored point (its position).
-SparseMatrix StackRows(
-  const SparseMatrix& laplacian, const WeightMatrix& sampleWeights, const std::vector<Eigen::Index>& anchored)
+/// Stacks the Laplacian rows, the dense action-line rows, one row per
+/// anchored point (its position) and, with followWeight > 0, one row of that
+/// weight per hull point (its position).
+SparseMatrix StackRows(const SparseMatrix& laplacian, const WeightMatrix& sampleWeights,
+  const std::vector<Eigen::Index>& anchored, double followWeight)
 {
   const Eigen::Index n = laplacian.cols();
   std::vector<Eigen::Triplet<double>> entries;
@@ -119,7 +120,13 @@ SparseMatrix StackRows(
   {
     entries.emplace_back(laplacian.rows() + sampleWeights.rows() + static_cast<Eigen::Index>(a), anchored[a], 1.0);
   }
-  SparseMatrix rows(laplacian.rows() + sampleWeights.rows() + static_cast<Eigen::Index>(anchored.size()), n);
+  const Eigen::Index followStart = laplacian.rows() + sampleWeights.rows() + static_cast<Eigen::Index>(anchored.size());
+  const Eigen::Index followRows = followWeight > 0 ? n : 0;
+  for (Eigen::Index i = 0; i < followRows; ++i)
+  {
+    entries.emplace_back(followStart + i, i, followWeight);
+  }
+  SparseMatrix rows(followStart + followRows, n);
   rows.setFromTriplets(entries.begin(), entries.end());
   return rows;
 }
@@ -306,7 +313,9 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
 
   const SparseMatrix laplacian = CotangentLaplacian(hull);
   const Points delta = laplacian * hull.points;
-  s.targets.resize(delta.rows() + currentSamples.rows() + static_cast<Eigen::Index>(anchored.size()), 3);
+  const double followWeight = std::max(0.0, parameters.followWeight);
+  const Eigen::Index followStart = delta.rows() + currentSamples.rows() + static_cast<Eigen::Index>(anchored.size());
+  s.targets.resize(followStart + (followWeight > 0 ? hull.points.rows() : 0), 3);
   for (Eigen::Index i = 0; i < delta.rows(); ++i)
   {
     // Rotated as the nearest action-line segment turns.
@@ -321,8 +330,16 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
         .Follow(hull.points.row(anchored[a]).transpose())
         .transpose();
   }
+  if (followWeight > 0)
+  {
+    for (Eigen::Index i = 0; i < hull.points.rows(); ++i)
+    {
+      const Eigen::Vector3d p = hull.points.row(i).transpose();
+      s.targets.row(followStart + i) = followWeight * NearestSegment(p, m.lines).Follow(p).transpose();
+    }
+  }
   s.solver =
-    std::make_unique<VolumeConstrainedSolver>(StackRows(laplacian, sampleWeights, anchored), hull.triangles);
+    std::make_unique<VolumeConstrainedSolver>(StackRows(laplacian, sampleWeights, anchored, followWeight), hull.triangles);
 
   s.hull = hull.points;
   s.start = m.muscle->points;
@@ -824,6 +841,15 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
     if (s.input->detail)
     {
       s.points += *s.input->detail;
+    }
+    // The coarse result torn apart (the muscle grown far beyond its size) is
+    // no start for the fine phase, nor a result it could fall back on. (A
+    // hull point far off that hardly weighs on the muscle is no harm.)
+    if (Diagonal(s.points) > maximumGrowth * Diagonal(s.start))
+    {
+      throw InputError("the deformation of muscle '" + s.input->name + "' diverged on its hull: the muscle spans " +
+        std::to_string(Diagonal(s.points) / Diagonal(s.start)) + " times its starting size after " +
+        std::to_string(s.result.coarseIterations) + " iterations");
     }
     if (parameters.dynamicIntersections)
     {

@@ -13,50 +13,11 @@
 #include "RealData.h"
 
 #include <cstdio>
-#include <functional>
-#include <random>
 #include <cstdlib>
 #include <string>
 
 namespace
 {
-/// The case with every coordinate rounded to float (as VTK pipelines with
-/// float points carry them) and, for seed > 0, first moved by a pseudo-random
-/// amount of that size (up to 1e-7 of the coordinate, a function of the
-/// value and the seed, so that equal coordinates stay equal): how much the
-/// results depend on such perturbations.
-MotionCase Perturbed(MotionCase c, int seed)
-{
-  auto perturb = [&](md::Points& points) {
-    for (Eigen::Index i = 0; i < points.size(); ++i)
-    {
-      double& x = points.data()[i];
-      if (seed > 0)
-      {
-        std::seed_seq sequence{ static_cast<int>(std::hash<double>{}(x)), seed };
-        std::mt19937 random(sequence);
-        x *= 1 + 1e-7 * std::uniform_real_distribution<double>(-1.0, 1.0)(random);
-      }
-      x = static_cast<double>(static_cast<float>(x));
-    }
-  };
-  for (md::MuscleMotion& m : c.muscles)
-  {
-    perturb(m.muscle.points);
-    for (md::MatchedLine& line : m.lines)
-    {
-      perturb(line.rest);
-      perturb(line.current);
-    }
-  }
-  for (md::BoneMotion& b : c.bones)
-  {
-    perturb(b.rest.points);
-    perturb(b.current);
-  }
-  return c;
-}
-
 void Run(const MotionCase& c, const char* label, int steps, md::HullMode mode)
 {
   md::InterpolationParameters parameters;

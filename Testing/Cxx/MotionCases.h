@@ -7,6 +7,8 @@
 #include "InterpolatedDeformation.h"
 #include "Phantom.h"
 
+#include <functional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,43 @@ struct MotionCase
   std::vector<md::MuscleMotion> muscles;
   std::vector<md::BoneMotion> bones;
 };
+
+/// The case with every coordinate rounded to float (as VTK pipelines with
+/// float points carry them) and, for seed > 0, first moved by a pseudo-random
+/// amount of that size (up to 1e-7 of the coordinate, a function of the
+/// value and the seed, so that equal coordinates stay equal): how much the
+/// results depend on such perturbations.
+inline MotionCase Perturbed(MotionCase c, int seed)
+{
+  auto perturb = [&](md::Points& points) {
+    for (Eigen::Index i = 0; i < points.size(); ++i)
+    {
+      double& x = points.data()[i];
+      if (seed > 0)
+      {
+        std::seed_seq sequence{ static_cast<int>(std::hash<double>{}(x)), seed };
+        std::mt19937 random(sequence);
+        x *= 1 + 1e-7 * std::uniform_real_distribution<double>(-1.0, 1.0)(random);
+      }
+      x = static_cast<double>(static_cast<float>(x));
+    }
+  };
+  for (md::MuscleMotion& m : c.muscles)
+  {
+    perturb(m.muscle.points);
+    for (md::MatchedLine& line : m.lines)
+    {
+      perturb(line.rest);
+      perturb(line.current);
+    }
+  }
+  for (md::BoneMotion& b : c.bones)
+  {
+    perturb(b.rest.points);
+    perturb(b.current);
+  }
+  return c;
+}
 
 inline std::vector<md::MatchedLine> MatchLines(
   const std::vector<md::Points>& rest, const std::vector<md::Points>& current, double tolerance = 0.01)
