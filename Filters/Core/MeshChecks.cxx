@@ -261,7 +261,7 @@ std::vector<int> Components(
   return component;
 }
 
-std::vector<std::pair<Eigen::Index, Eigen::Index>> NewSharpEdges(
+std::int64_t CountNewSharpEdges(
   const Points& rest, const Points& current, const Triangles& triangles, double angleDegrees)
 {
   // The two triangles of each edge, keyed by its ordered point pair.
@@ -289,22 +289,15 @@ std::vector<std::pair<Eigen::Index, Eigen::Index>> NewSharpEdges(
     const double norms = n.norm() * m.norm();
     return norms > 0 && n.dot(m) < limit * norms;
   };
-  std::vector<std::pair<Eigen::Index, Eigen::Index>> found;
+  std::int64_t count = 0;
   for (const auto& entry : edges)
   {
     const auto [s, t] = entry.second;
     if (t >= 0 && sharp(current, s, t) && !sharp(rest, s, t))
     {
-      found.emplace_back(s, t);
+      ++count;
     }
   }
-  std::sort(found.begin(), found.end()); // a fixed order, whatever the hashing
-  return found;
-}
-
-std::int64_t CountNewSharpEdges(
-  const Points& rest, const Points& current, const Triangles& triangles, double angleDegrees)
-{
-  return static_cast<std::int64_t>(NewSharpEdges(rest, current, triangles, angleDegrees).size());
+  return count;
 }
 }

@@ -3,7 +3,6 @@
 
 #include "MeshTypes.h"
 
-#include <utility>
 #include <vector>
 
 namespace md
@@ -69,9 +68,6 @@ std::vector<std::vector<std::int64_t>> PointNeighbours(const Triangles& triangle
 /// normals of their triangles, exceeds `angleDegrees` in `current` but not in
 /// `rest` (same triangles): the pits and folds a deformation made.
 std::int64_t CountNewSharpEdges(
-  const Points& rest, const Points& current, const Triangles& triangles, double angleDegrees = 60.0);
-/// Those edges, as the pairs of triangles on either side (sorted).
-std::vector<std::pair<Eigen::Index, Eigen::Index>> NewSharpEdges(
   const Points& rest, const Points& current, const Triangles& triangles, double angleDegrees = 60.0);
 
 /// Number of pairs of triangles that intersect other than at what they share.

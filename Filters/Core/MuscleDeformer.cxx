@@ -161,7 +161,7 @@ double FractionInside(const TriangleTree& tree, const Points& points)
 struct MuscleState
 {
   const MuscleToDeform* input = nullptr;
-  double size = 0;
+  double size = 0; // span (box diagonal) of the muscle where the pass starts
   WeightMatrix ownWeights;               // when not given
   const WeightMatrix* weights = nullptr; // full mesh = weights * hull
   std::unique_ptr<VolumeConstrainedSolver> solver;
@@ -177,7 +177,10 @@ struct MuscleState
   std::vector<char> touched; // held at an obstacle in any move: left out of the volume gradient, which
                              // would otherwise swing as points come off the obstacle and back
   std::unique_ptr<TriangleTree> tree; // of `points`, for the other muscles
-  std::vector<std::vector<std::int64_t>> neighbours; // of the full mesh's points, when first needed
+  // Of the full mesh's points, when the unfolding first needs them: their
+  // neighbours and the triangles they are corners of.
+  std::vector<std::vector<std::int64_t>> neighbours;
+  std::vector<std::vector<Eigen::Index>> trianglesOf;
   double orientation = 1; // +1 when the triangles face outwards
   bool converged = false;
   bool fineDone = false;
@@ -397,6 +400,13 @@ void RunCoarsePhase(MuscleState& s, const DeformationParameters& parameters)
   }
 }
 
+/// How many times its starting span the muscle spans now: beyond
+/// maximumGrowth it is being torn apart.
+double Growth(const MuscleState& s)
+{
+  return Diagonal(s.points) / s.size;
+}
+
 /// Moves every point of `s` from `points` to `candidate`, except where an
 /// obstacle holds it.
 void MoveWithObstacles(MuscleState& s, const Points& candidate, const std::vector<Obstacle>& bones,
@@ -469,16 +479,17 @@ bool UnfoldFlippedTriangles(MuscleState& s, const std::vector<Obstacle>& bones, 
   if (s.neighbours.empty())
   {
     s.neighbours = PointNeighbours(triangles, n);
-  }
-  const std::vector<std::vector<std::int64_t>>& ring = s.neighbours;
-  std::vector<std::vector<Eigen::Index>> trianglesOf(static_cast<size_t>(n));
-  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
-  {
-    for (int k = 0; k < 3; ++k)
+    s.trianglesOf.assign(static_cast<size_t>(n), {});
+    for (Eigen::Index t = 0; t < triangles.rows(); ++t)
     {
-      trianglesOf[triangles(t, k)].push_back(t);
+      for (int k = 0; k < 3; ++k)
+      {
+        s.trianglesOf[triangles(t, k)].push_back(t);
+      }
     }
   }
+  const std::vector<std::vector<std::int64_t>>& ring = s.neighbours;
+  const std::vector<std::vector<Eigen::Index>>& trianglesOf = s.trianglesOf;
   std::vector<char> region(static_cast<size_t>(n), 0);
   std::vector<Eigen::Index> members;
   std::vector<Eigen::Matrix3d> rotation(static_cast<size_t>(n));
@@ -845,10 +856,10 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
     // The coarse result torn apart (the muscle grown far beyond its size) is
     // no start for the fine phase, nor a result it could fall back on. (A
     // hull point far off that hardly weighs on the muscle is no harm.)
-    if (Diagonal(s.points) > maximumGrowth * Diagonal(s.start))
+    if (Growth(s) > maximumGrowth)
     {
       throw InputError("the deformation of muscle '" + s.input->name + "' diverged on its hull: the muscle spans " +
-        std::to_string(Diagonal(s.points) / Diagonal(s.start)) + " times its starting size after " +
+        std::to_string(Growth(s)) + " times its starting size after " +
         std::to_string(s.result.coarseIterations) + " iterations");
     }
     if (parameters.dynamicIntersections)
@@ -982,7 +993,7 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
       }
       ++s.result.iterations;
       const int total = s.result.coarseIterations + s.result.iterations;
-      if (Diagonal(s.points) > maximumGrowth * Diagonal(s.start))
+      if (Growth(s) > maximumGrowth)
       {
         // With many points held by obstacles the hull, which knows nothing of
         // them, can run on through a bone while the volume held on the full
@@ -1059,12 +1070,12 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
       // torn apart (volume far off, or the muscle grown far beyond its size)
       // is no result to hand on.
       if (!s.fellBack && ((parameters.preserveVolume && std::abs(r.volumeChangePercent) > 10.0) ||
-        Diagonal(s.points) > maximumGrowth * Diagonal(s.start)))
+        Growth(s) > maximumGrowth))
       {
         throw InputError("the deformation of muscle '" + s.input->name + "' diverged: after " +
           std::to_string(parameters.maximumIterations) + " iterations its volume is off by " +
           std::to_string(r.volumeChangePercent) + " % and it spans " +
-          std::to_string(Diagonal(s.points) / Diagonal(s.start)) + " times its starting size");
+          std::to_string(Growth(s)) + " times its starting size");
       }
       if (!s.fellBack)
       {

@@ -43,9 +43,10 @@ struct DeformationParameters
   /// Weight of one row per hull point that pulls it to where the motion of
   /// its nearest action-line segment takes it (the Laplacian rows weigh 1 a
   /// point). Without it a hull point that the Laplacian and the action-line
-  /// rows hardly fix (two points of a thin sliver moving apart cost nearly
-  /// nothing) takes the least-squares step of a near-null mode: on the LHDL
-  /// hip, moves of metres that tore muscles apart. 0: the paper's system.
+  /// rows hardly fix (a near-null mode of their normal matrix, on the LHDL
+  /// hip one of eigenvalue 3e-8 of the largest, half of it on one point)
+  /// takes the least-squares step of that mode: moves of metres that tore
+  /// muscles apart. 0: the paper's system.
   double followWeight = 0.01;
   /// Measure DeformationResult::restSamplesInside and currentSamplesInside
   /// (a hierarchy of each muscle, twice): callers that do not report them

@@ -131,11 +131,10 @@ namespace
 /// `pinned` points keep their shift. It is an obstacle problem, solved by
 /// projected over-relaxed Gauss-Seidel sweeps in a fixed order, from the
 /// shift given.
-void SmoothPrints(const Points& points, const Triangles& triangles, const std::vector<double>& rim,
-  const Points& normal, const std::vector<char>& pinned, Points& shift)
+void SmoothPrints(const Points& points, const std::vector<std::vector<std::int64_t>>& neighbours,
+  const std::vector<double>& rim, const Points& normal, const std::vector<char>& pinned, Points& shift)
 {
   const Eigen::Index n = points.rows();
-  const std::vector<std::vector<std::int64_t>> neighbours = PointNeighbours(triangles, n);
   // Who is in a rim: multi-source Dijkstra on what is left of each width.
   std::vector<double> left(static_cast<size_t>(n), 0.0);
   std::priority_queue<std::pair<double, Eigen::Index>> queue; // most left first
@@ -385,10 +384,11 @@ StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& 
       // point (its move does not cross the obstacle's surface an odd number
       // of times) is pinned to its own way out and the rest smoothed again.
       const Points target = shift;
+      const std::vector<std::vector<std::int64_t>> neighbours = PointNeighbours(mesh.triangles, n);
       std::vector<char> pinned(static_cast<size_t>(n), 0);
       for (int round = 0; round < 4; ++round)
       {
-        SmoothPrints(mesh.points, mesh.triangles, rim, normal, pinned, shift);
+        SmoothPrints(mesh.points, neighbours, rim, normal, pinned, shift);
         std::int64_t failed = 0;
 #pragma omp parallel for reduction(+ : failed) schedule(dynamic, 64)
         for (Eigen::Index i = 0; i < n; ++i)

@@ -219,17 +219,8 @@ std::optional<TriangleTree::Hit> TriangleTree::FirstHit(const Eigen::Vector3d& f
 
 int TriangleTree::Crossings(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const
 {
-  const Eigen::Vector3d direction = to - from;
-  int crossings = 0;
-  this->ForTrianglesNearSegment(from, direction, 1.0, [&](Eigen::Index t) {
-    double t01, u, v;
-    if (IntersectLineTriangle(from, direction, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2), 0.0, t01, u, v) &&
-      t01 >= 0 && t01 <= 1)
-    {
-      ++crossings;
-    }
-  });
-  return crossings;
+  bool grazed = false;
+  return this->SegmentCrossings(from, to - from, 0.0, grazed);
 }
 
 int TriangleTree::CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, bool& grazed) const
@@ -245,13 +236,18 @@ int TriangleTree::CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vec
     }
   }
   const Eigen::Vector3d d = (std::max(exit, 0.0) + 1e-3 * this->Size) * direction;
-  const double edgeTolerance = 1e-9;
+  return this->SegmentCrossings(origin, d, 1e-9, grazed);
+}
+
+int TriangleTree::SegmentCrossings(
+  const Eigen::Vector3d& from, const Eigen::Vector3d& d, double edgeTolerance, bool& grazed) const
+{
   int crossings = 0;
   grazed = false;
-  this->ForTrianglesNearSegment(origin, d, 1.0, [&](Eigen::Index t) {
+  this->ForTrianglesNearSegment(from, d, 1.0, [&](Eigen::Index t) {
     double t01, u, v;
     if (!IntersectLineTriangle(
-          origin, d, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2), edgeTolerance, t01, u, v) ||
+          from, d, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2), edgeTolerance, t01, u, v) ||
       t01 < 0 || t01 > 1)
     {
       return;

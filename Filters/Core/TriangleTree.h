@@ -88,6 +88,10 @@ private:
     return this->Surface.points.row(this->Surface.triangles(triangle, k)).transpose();
   }
   int CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, bool& grazed) const;
+  /// Triangles the segment from + t d, t in [0, 1], crosses, counting those it
+  /// meets within `edgeTolerance` (barycentric) of their edges, and whether
+  /// any crossing was that close to an edge or a point (`grazed`).
+  int SegmentCrossings(const Eigen::Vector3d& from, const Eigen::Vector3d& d, double edgeTolerance, bool& grazed) const;
   /// Calls visit(triangle) for every triangle whose leaf box the segment
   /// from + t direction, t in [0, limit], meets.
   template <typename Visit>
