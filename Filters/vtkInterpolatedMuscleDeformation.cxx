@@ -250,6 +250,7 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     parameters.deformation.maximumIterations = this->MaximumNumberOfIterations;
     parameters.deformation.convergenceTolerance = this->ConvergenceTolerance;
     parameters.deformation.preserveVolume = this->PreserveVolume;
+    parameters.deformation.contactWeight = this->BoneContactWeight;
     parameters.hull.targetNumberOfPoints = this->HullTargetNumberOfPoints;
     try
     {
@@ -350,6 +351,7 @@ void vtkInterpolatedMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ConvergenceTolerance: " << this->ConvergenceTolerance << "\n";
   os << indent << "PreserveVolume: " << this->PreserveVolume << "\n";
   os << indent << "HullTargetNumberOfPoints: " << this->HullTargetNumberOfPoints << "\n";
+  os << indent << "BoneContactWeight: " << this->BoneContactWeight << "\n";
   os << indent << "RefitRegularisation: " << this->RefitRegularisation << "\n";
   os << indent << "ResolvedNumberOfSteps: " << this->ResolvedNumberOfSteps << "\n";
 }

@@ -91,6 +91,12 @@ public:
   vtkSetMacro(PreserveVolume, bool);
   vtkGetMacro(PreserveVolume, bool);
   vtkBooleanMacro(PreserveVolume, bool);
+  /// Weight of the rows that push a muscle's points out of a bone that moved
+  /// into them, in each step's deformation (against 1 for the action-line
+  /// rows). Default 0.5; 0 = the paper's step, where a bone only stops
+  /// points that move into it and the static resolution does the rest.
+  vtkSetClampMacro(BoneContactWeight, double, 0.0, 100.0);
+  vtkGetMacro(BoneContactWeight, double);
   /// Points of each muscle's hull. Default 250.
   vtkSetClampMacro(HullTargetNumberOfPoints, int, 8, 1000000);
   vtkGetMacro(HullTargetNumberOfPoints, int);
@@ -118,6 +124,7 @@ protected:
   int MaximumNumberOfIterations = 200;
   double ConvergenceTolerance = 0.01;
   bool PreserveVolume = true;
+  double BoneContactWeight = 0.5;
   int HullTargetNumberOfPoints = 250;
   double RefitRegularisation = 1e-3;
   int ResolvedNumberOfSteps = 4;

@@ -319,6 +319,12 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
 
   DeformationParameters stepParameters = parameters.deformation;
   stepParameters.measureSamplesInside = false; // not part of the method's measures
+  // Contact rows leave the rest pose's overlap with each bone alone.
+  std::vector<std::vector<std::vector<char>>> boneOverlap(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    boneOverlap[m].assign(restOverlap[m].begin(), restOverlap[m].begin() + static_cast<std::ptrdiff_t>(bones.size()));
+  }
   double stepStart = 0.2;
   const double stepShare = 0.8 / steps;
   std::vector<MuscleStepMeasures> previous(count);
@@ -376,6 +382,7 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
       d.detail = &details[m];
       d.targetVolume = restVolumes[m];
       d.reference = &muscles[m].muscle.points; // folds an earlier step left are undone too
+      d.boneOverlap = &boneOverlap[m];
       for (const PoseInterpolator& line : lineMotions[m])
       {
         d.lines.push_back({ line.AtStep(j - 1, steps), line.AtStep(j, steps) });

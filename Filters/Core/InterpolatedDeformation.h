@@ -3,6 +3,10 @@
 // at every step, each step deformed from the previous result (all muscles
 // together, obstacles for each other) and then statically resolved.
 //
+// Beyond the paper (StepDeformationDefaults): in each step's deformation the
+// bones push the muscles (contact rows), instead of only stopping the points
+// that move into them; the static resolution then has little left to do.
+//
 // Beyond the paper (HullMode::Refit): the rest-pose hull and its mean value
 // coordinates are kept for the whole motion. After each step's static
 // resolution the hull is refitted to the resolved mesh by least squares with a
@@ -40,7 +44,7 @@ public:
   /// `regularisation` is relative to trace(W^T W): it weighs the Laplacian
   /// term (over trace(L^T L)) and an identity term (over the number of hull
   /// points) that holds the hull points the mesh hardly depends on.
-  HullRefitter(const WeightMatrix& weights, const TriangleMesh& restHull, double regularisation = 1e-2);
+  HullRefitter(const WeightMatrix& weights, const TriangleMesh& restHull, double regularisation = 1e-3);
   Points Fit(const Points& mesh, const Points& guess) const;
 
 private:
@@ -67,18 +71,29 @@ struct BoneMotion
   Points current;
 };
 
+/// The deformation step of the interpolation method: the paper's, except
+/// that bones push the muscle (DeformationParameters::contactWeight 0.5;
+/// 0 gives the paper's step). Measured on the LHDL hip at 60 degrees of
+/// flexion, N = 4: the largest static shift falls from 16.7 to 5.4 mm.
+inline DeformationParameters StepDeformationDefaults()
+{
+  DeformationParameters parameters;
+  parameters.contactWeight = 0.5;
+  return parameters;
+}
+
 struct InterpolationParameters
 {
   int numberOfSteps = 4;                ///< N; 0: automatic
   double maximumStepDisplacement = 20;  ///< largest bone-point move per step when N is automatic
   InterpolationMode interpolationMode = InterpolationMode::Rigid; ///< bones and action lines
   HullMode hullMode = HullMode::Refit;
-  double refitRegularisation = 1e-2; ///< HullRefitter's, relative
+  double refitRegularisation = 1e-3; ///< HullRefitter's, relative (the filter's default too)
   /// Halfway smoothing steps of the per-point detail after each step (Refit):
   /// the rims of earlier bone prints fade (0: the detail is kept as it is).
   int detailRelaxation = 2;
   StaticResolveParameters staticResolve;
-  DeformationParameters deformation;
+  DeformationParameters deformation = StepDeformationDefaults();
   HullParameters hull;
 };
 

@@ -171,16 +171,22 @@ std::int64_t CountOutside(const TriangleMesh& surface, const Points& points, dou
   return outside;
 }
 
-Points UsedPoints(const TriangleMesh& mesh)
+std::vector<char> UsedMask(const TriangleMesh& mesh)
 {
   std::vector<char> used(static_cast<size_t>(mesh.points.rows()), 0);
   for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
   {
     for (int k = 0; k < 3; ++k)
     {
-      used[mesh.triangles(t, k)] = 1;
+      used[static_cast<size_t>(mesh.triangles(t, k))] = 1;
     }
   }
+  return used;
+}
+
+Points UsedPoints(const TriangleMesh& mesh)
+{
+  const std::vector<char> used = UsedMask(mesh);
   Points out(std::count(used.begin(), used.end(), 1), 3);
   for (Eigen::Index i = 0, next = 0; i < mesh.points.rows(); ++i)
   {

@@ -51,7 +51,10 @@ double PointTriangleDistance(
 /// and farther than `tolerance` from every triangle. Every point is tested.
 std::int64_t CountOutside(const TriangleMesh& surface, const Points& points, double tolerance);
 
-/// The points the triangles use, in order (mesh files may carry others).
+/// Per point, whether a triangle uses it (mesh files may carry other points).
+std::vector<char> UsedMask(const TriangleMesh& mesh);
+
+/// The points the triangles use, in order.
 Points UsedPoints(const TriangleMesh& mesh);
 
 /// Connected component of every point, numbered from 0 (`count` of them),

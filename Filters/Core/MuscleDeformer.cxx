@@ -188,6 +188,7 @@ struct MuscleState
   Points fineStartPoints, fineStartHull;
   int unfoldings = 0;
   bool flipsCheckedClean = false;
+  bool unfoldingBlocked = false; // the last unfolding left folds (pinned at a bone): no more
   double fineStep = 1;                                   // step length of the fine phase
   double lastChange = std::numeric_limits<double>::max(); // largest hull change of the last fine step
   Clock::duration time{};
@@ -400,6 +401,107 @@ void RunCoarsePhase(MuscleState& s, const DeformationParameters& parameters)
   }
 }
 
+/// Contact rows (DeformationParameters::contactWeight): each point of the full
+/// mesh (W X + detail) inside a bone it may not overlap gets a row pulling it
+/// to that bone's nearest surface point, and the coarse phase runs again from
+/// where it stopped; rounds until no new point comes in. A point keeps its row
+/// and target once it has one, so that the rounds do not swing it in and out.
+void PushOffBones(MuscleState& s, const std::vector<Obstacle>& bones, const DeformationParameters& parameters)
+{
+  const MuscleToDeform& m = *s.input;
+  const Eigen::Index n = s.start.rows();
+  const std::vector<std::vector<char>> noOverlap(bones.size(), std::vector<char>(static_cast<size_t>(n), 0));
+  const std::vector<std::vector<char>>* allowed = m.boneOverlap ? m.boneOverlap : &noOverlap;
+  if (allowed->size() != bones.size())
+  {
+    throw InputError("the bone overlap given for muscle '" + m.name + "' has " + std::to_string(allowed->size()) +
+      " lists, for " + std::to_string(bones.size()) + " bones");
+  }
+  for (const std::vector<char>& overlap : *allowed)
+  {
+    if (overlap.size() != static_cast<size_t>(n))
+    {
+      throw InputError("the bone overlap given for muscle '" + m.name + "' does not fit its points");
+    }
+  }
+  const std::vector<char> used = UsedMask(*m.muscle);
+
+  std::unique_ptr<VolumeConstrainedSolver> base; // the system without contact rows, once there are some
+  const Points baseTargets = s.targets;
+  const double margin = 1e-3 * s.size; // just outside, so that the fine phase does not find it inside
+  std::vector<Eigen::Index> contacts;
+  std::vector<Eigen::Vector3d> targets;
+  std::vector<char> inContact(static_cast<size_t>(n), 0);
+  for (int round = 0; round < parameters.contactRounds; ++round)
+  {
+    Points points = *s.weights * s.hull;
+    if (m.detail)
+    {
+      points += *m.detail;
+    }
+    std::vector<Eigen::Vector3d> found(static_cast<size_t>(n));
+    std::vector<char> isNew(static_cast<size_t>(n), 0);
+#pragma omp parallel for schedule(dynamic, 256)
+    for (Eigen::Index i = 0; i < n; ++i)
+    {
+      if (inContact[i] || !used[i])
+      {
+        continue;
+      }
+      const Eigen::Vector3d p = points.row(i).transpose();
+      for (size_t b = 0; b < bones.size(); ++b)
+      {
+        if ((*allowed)[b][i] || !bones[b].tree->InBounds(p) || !bones[b].tree->Inside(p))
+        {
+          continue;
+        }
+        const TriangleTree::Closest closest = bones[b].tree->ClosestPoint(p);
+        if (closest.distance > 0)
+        {
+          found[i] = closest.point + (margin / closest.distance) * (closest.point - p);
+          isNew[i] = 1;
+        }
+        break;
+      }
+    }
+    const size_t before = contacts.size();
+    for (Eigen::Index i = 0; i < n; ++i)
+    {
+      if (isNew[i])
+      {
+        inContact[i] = 1;
+        contacts.push_back(i);
+        targets.push_back(found[i]);
+      }
+    }
+    if (contacts.size() == before)
+    {
+      break;
+    }
+    const Eigen::Index k = static_cast<Eigen::Index>(contacts.size());
+    Eigen::MatrixXd rows(k, s.hull.rows());
+    Points contactTargets(k, 3);
+    for (Eigen::Index c = 0; c < k; ++c)
+    {
+      const Eigen::Index i = contacts[c];
+      rows.row(c) = parameters.contactWeight * s.weights->row(i);
+      // The row acts on W X, the target is for W X + detail.
+      const Eigen::RowVector3d detail = m.detail ? Eigen::RowVector3d(m.detail->row(i)) : Eigen::RowVector3d::Zero();
+      contactTargets.row(c) = parameters.contactWeight * (targets[c].transpose() - detail);
+    }
+    if (!base)
+    {
+      base = std::move(s.solver);
+    }
+    s.solver = std::make_unique<VolumeConstrainedSolver>(*base, rows);
+    s.targets.resize(baseTargets.rows() + k, 3);
+    s.targets.topRows(baseTargets.rows()) = baseTargets;
+    s.targets.bottomRows(k) = contactTargets;
+    RunCoarsePhase(s, parameters);
+  }
+  s.result.verticesInContact = static_cast<std::int64_t>(contacts.size());
+}
+
 /// How many times its starting span the muscle spans now: beyond
 /// maximumGrowth it is being torn apart.
 double Growth(const MuscleState& s)
@@ -460,13 +562,77 @@ void MoveWithObstacles(MuscleState& s, const Points& candidate, const std::vecto
   }
 }
 
+/// Points of `members` (not frozen) inside a bone go to its nearest surface
+/// point, just outside.
+void SlideOnBones(MuscleState& s, const std::vector<Obstacle>& bones, const std::vector<Eigen::Index>& members)
+{
+  const double backOff = 1e-6 * s.size;
+#pragma omp parallel for schedule(dynamic, 16)
+  for (Eigen::Index a = 0; a < static_cast<Eigen::Index>(members.size()); ++a)
+  {
+    const Eigen::Index i = members[a];
+    if (s.frozen[i])
+    {
+      continue;
+    }
+    const Eigen::Vector3d p = s.points.row(i).transpose();
+    for (const Obstacle& bone : bones)
+    {
+      if (bone.tree->InBounds(p) && bone.tree->Inside(p))
+      {
+        const TriangleTree::Closest closest = bone.tree->ClosestPoint(p);
+        if (closest.distance > 0)
+        {
+          s.points.row(i) = (closest.point + (backOff / closest.distance) * (closest.point - p)).transpose();
+        }
+        break;
+      }
+    }
+  }
+}
+
+/// Points of `members` inside a bone, deeper than they were at `before` (or
+/// not inside it then), go back to `before` and are pinned. Returns how many.
+std::int64_t PinDeeperInBones(MuscleState& s, const std::vector<Obstacle>& bones,
+  const std::vector<Eigen::Index>& members, const Points& before, std::vector<char>& pinned)
+{
+  std::int64_t count = 0;
+#pragma omp parallel for reduction(+ : count) schedule(dynamic, 16)
+  for (Eigen::Index a = 0; a < static_cast<Eigen::Index>(members.size()); ++a)
+  {
+    const Eigen::Index i = members[a];
+    const Eigen::Vector3d p = s.points.row(i).transpose(), was = before.row(i).transpose();
+    for (const Obstacle& bone : bones)
+    {
+      if (!bone.tree->InBounds(p) || !bone.tree->Inside(p))
+      {
+        continue;
+      }
+      const bool wasInside = bone.tree->InBounds(was) && bone.tree->Inside(was);
+      if (!wasInside || bone.tree->ClosestPoint(p).distance > bone.tree->ClosestPoint(was).distance)
+      {
+        s.points.row(i) = before.row(i);
+        pinned[i] = 1;
+        ++count;
+      }
+      break;
+    }
+  }
+  return count;
+}
+
 /// Undoes folds of the full mesh (triangles the mapping turned over, where
 /// the hull deformed too unevenly for its mean value coordinates): the points
 /// around the flipped triangles take back the shape their neighbourhood has
 /// in the reference shape (as-rigid-as-possible: local rotations, one small
 /// sparse solve with the region's border fixed), the region growing until
-/// nothing is flipped. Returns whether any point moved.
-bool UnfoldFlippedTriangles(MuscleState& s, const std::vector<Obstacle>& bones, bool dynamicIntersections)
+/// nothing is flipped. With `onBones` (bones push the muscle) the reshaping
+/// keeps to the bones: a point it carries into a bone slides on the bone's
+/// surface, and a point already inside one that it would carry deeper stays
+/// where it was, held as part of the region's border. Returns whether any
+/// point moved.
+bool UnfoldFlippedTriangles(
+  MuscleState& s, const std::vector<Obstacle>& bones, bool dynamicIntersections, bool onBones)
 {
   const Triangles& triangles = s.input->muscle->triangles;
   const Points& reference = *s.reference;
@@ -493,6 +659,8 @@ bool UnfoldFlippedTriangles(MuscleState& s, const std::vector<Obstacle>& bones, 
   std::vector<char> region(static_cast<size_t>(n), 0);
   std::vector<Eigen::Index> members;
   std::vector<Eigen::Matrix3d> rotation(static_cast<size_t>(n));
+  std::vector<char> pinned(static_cast<size_t>(n), 0); // held where they were (onBones)
+  const Points before = s.points;
   for (int attempt = 0; attempt < 8 && !flipped.empty(); ++attempt)
   {
     // The region: the region of the attempts before and the corners of the
@@ -533,7 +701,7 @@ bool UnfoldFlippedTriangles(MuscleState& s, const std::vector<Obstacle>& bones, 
     std::vector<Eigen::Index> slot(static_cast<size_t>(n), -1);
     for (Eigen::Index i = 0; i < n; ++i)
     {
-      if (region[i] && !ring[i].empty())
+      if (region[i] && !ring[i].empty() && !pinned[i])
       {
         slot[i] = static_cast<Eigen::Index>(members.size());
         members.push_back(i);
@@ -592,6 +760,14 @@ bool UnfoldFlippedTriangles(MuscleState& s, const std::vector<Obstacle>& bones, 
       {
         shape.row(members[a]) = solved.row(a);
       }
+      if (onBones)
+      {
+        SlideOnBones(s, bones, members);
+      }
+    }
+    if (onBones && attempt + 1 < 8 && PinDeeperInBones(s, bones, members, before, pinned) > 0)
+    {
+      continue; // the same folds, the region reshaped again around the held points
     }
     // Only triangles with a corner in the region or next to it can have changed.
     std::vector<char> candidate(static_cast<size_t>(triangles.rows()), 0);
@@ -619,9 +795,11 @@ bool UnfoldFlippedTriangles(MuscleState& s, const std::vector<Obstacle>& bones, 
     }
     flipped = FlippedTriangles(reference, s.points, triangles, &candidates);
   }
-  // Unfolding is not held by obstacles (a fold is the worse defect): a point
-  // it moved into a bone is frozen there like any point found inside a bone,
-  // for the static resolution to settle.
+  // Held at the bones, a fold may stay: unfolding again would not undo it.
+  s.unfoldingBlocked = onBones && !flipped.empty();
+  // Without `onBones` unfolding is not held by obstacles (a fold is the worse
+  // defect): a point it moved into a bone is frozen there like any point
+  // found inside a bone, for the static resolution to settle.
   if (dynamicIntersections)
   {
 #pragma omp parallel for schedule(dynamic, 16)
@@ -836,6 +1014,10 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
     SetUp(s, parameters);
     report((m + 0.3) * share * 0.5);
     RunCoarsePhase(s, parameters);
+    if (parameters.contactWeight > 0 && parameters.dynamicIntersections && !bones.empty()) // pushed by bones
+    {
+      PushOffBones(s, bones, parameters);
+    }
     s.time += Clock::now() - start;
     report((m + 1) * share * 0.5);
   }
@@ -943,6 +1125,7 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
     s.fineStartHull = s.hull;
   }
   const int fineLimit = parameters.maximumIterations;
+  const bool pushedByBones = parameters.contactWeight > 0 && parameters.dynamicIntersections;
   for (int k = 0; k < fineLimit; ++k)
   {
     bool anyActive = false;
@@ -1013,7 +1196,8 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
       else if (largest < parameters.convergenceTolerance)
       {
         // Converged: undo any fold, then let the volume settle again (a few times at most).
-        if (s.unfoldings < maximumUnfoldings && UnfoldFlippedTriangles(s, bones, parameters.dynamicIntersections))
+        if (s.unfoldings < maximumUnfoldings && !s.unfoldingBlocked &&
+          UnfoldFlippedTriangles(s, bones, parameters.dynamicIntersections, pushedByBones))
         {
           ++s.unfoldings;
           s.lastChange = std::numeric_limits<double>::max();

@@ -48,6 +48,20 @@ struct DeformationParameters
   /// takes the least-squares step of that mode: moves of metres that tore
   /// muscles apart. 0: the paper's system.
   double followWeight = 0.01;
+  /// Bones push the muscle (beyond the paper, whose bones only stop points
+  /// that move into them): after the coarse phase, each point of the full
+  /// mesh that the bones' motion put inside a bone gets a row (of this weight
+  /// against the action-line rows' 1) pulling it to the bone's nearest
+  /// surface point, and the hull is solved again with those rows, for up to
+  /// `contactRounds` rounds as new points come in. The muscle then slides over
+  /// the bone as a whole, its volume held, instead of keeping a deep print
+  /// for the static resolution to cut out; and the unfolding of turned-over
+  /// triangles keeps to the bones (a point it would carry into a bone slides
+  /// on its surface, one already inside is not carried deeper). Overlap a
+  /// muscle may keep is MuscleToDeform::boneOverlap. 0: none of this, the
+  /// paper's method.
+  double contactWeight = 0;
+  int contactRounds = 3;
   /// Measure DeformationResult::restSamplesInside and currentSamplesInside
   /// (a hierarchy of each muscle, twice): callers that do not report them
   /// skip the cost.
@@ -78,6 +92,10 @@ struct MuscleToDeform
   /// Volume to hold, when not the muscle's own (a step of the interpolation
   /// method holds the rest pose's volume, so that no error builds up); 0: its own.
   double targetVolume = 0;
+  /// With DeformationParameters::contactWeight: [bone][point] != 0 where the
+  /// point may stay inside that bone (the overlap a rest pose already has),
+  /// one list per bone of the pass. Null: none may.
+  const std::vector<std::vector<char>>* boneOverlap = nullptr;
 };
 
 struct DeformationResult
@@ -94,6 +112,8 @@ struct DeformationResult
   /// in the last step.
   std::int64_t verticesFrozen = 0;
   std::int64_t verticesStopped = 0;
+  /// Points held to a bone's surface by contact rows (DeformationParameters::contactWeight).
+  std::int64_t verticesInContact = 0;
   /// Action-line samples inside the muscle: rest samples in the rest-pose
   /// muscle, current samples in the deformed muscle (fractions in [0, 1];
   /// 0 unless DeformationParameters::measureSamplesInside).
@@ -118,7 +138,9 @@ std::vector<Obstacle> BuildObstacles(const std::vector<std::string>& names, cons
 /// Deforms every muscle from the rest pose to the current pose in one pass,
 /// all together.
 ///
-/// Coarse phase: the hull alone, its own volume held, no obstacles. Fine
+/// Coarse phase: the hull alone, its own volume held, no obstacles; with
+/// `contactWeight` then again with rows pulling the points the bones moved
+/// into out to the bones' surfaces (see DeformationParameters). Fine
 /// phase, from the coarse result W X: the volume of the full mesh held and,
 /// with `dynamicIntersections`, every move that would enter an obstacle or
 /// another muscle stops at its surface, and a point inside a bone when the

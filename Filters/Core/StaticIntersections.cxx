@@ -17,19 +17,6 @@ double Diagonal(const Points& points)
   return points.rows() ? (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm() : 0.0;
 }
 
-std::vector<char> UsedMask(const TriangleMesh& mesh)
-{
-  std::vector<char> used(static_cast<size_t>(mesh.points.rows()), 0);
-  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
-  {
-    for (int k = 0; k < 3; ++k)
-    {
-      used[static_cast<size_t>(mesh.triangles(t, k))] = 1;
-    }
-  }
-  return used;
-}
-
 /// The obstacles of mesh m: the fixed ones, then the other meshes (null for itself).
 struct ObstacleSet
 {

@@ -84,9 +84,29 @@ VolumeConstrainedSolver::VolumeConstrainedSolver(const SparseMatrix& rows, const
   , Faces(triangles)
 {
   const Eigen::MatrixXd dense(rows);
-  Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(dense.cols(), dense.cols());
-  normal.selfadjointView<Eigen::Lower>().rankUpdate(dense.transpose());
-  this->Normal.compute(normal);
+  this->NormalMatrix = Eigen::MatrixXd::Zero(dense.cols(), dense.cols());
+  this->NormalMatrix.selfadjointView<Eigen::Lower>().rankUpdate(dense.transpose());
+  this->NormalMatrix = this->NormalMatrix.selfadjointView<Eigen::Lower>();
+  this->Factor();
+}
+
+VolumeConstrainedSolver::VolumeConstrainedSolver(const VolumeConstrainedSolver& base, const Eigen::MatrixXd& extraRows)
+  : Faces(base.Faces)
+  , NormalMatrix(base.NormalMatrix)
+{
+  SparseMatrix extra = extraRows.sparseView();
+  this->Rows.resize(base.Rows.rows() + extra.rows(), base.Rows.cols());
+  this->Rows.reserve(base.Rows.nonZeros() + extra.nonZeros());
+  this->Rows.topRows(base.Rows.rows()) = base.Rows;
+  this->Rows.bottomRows(extra.rows()) = extra;
+  this->NormalMatrix.selfadjointView<Eigen::Lower>().rankUpdate(extraRows.transpose());
+  this->NormalMatrix = this->NormalMatrix.selfadjointView<Eigen::Lower>();
+  this->Factor();
+}
+
+void VolumeConstrainedSolver::Factor()
+{
+  this->Normal.compute(this->NormalMatrix);
   // A singular system shows as a pivot that is only rounding.
   const Eigen::VectorXd pivots = this->Normal.vectorD();
   const double largest = pivots.size() ? pivots.cwiseAbs().maxCoeff() : 0.0;
@@ -100,8 +120,9 @@ VolumeConstrainedSolver::VolumeConstrainedSolver(const SparseMatrix& rows, const
   // steps' fixed point, where L^T r + J^T lambda = 0, does not change.
   if (pivots.minCoeff() <= 1e-9 * largest)
   {
-    normal.diagonal().array() += 1e-9 * largest;
-    this->Normal.compute(normal);
+    Eigen::MatrixXd damped = this->NormalMatrix;
+    damped.diagonal().array() += 1e-9 * largest;
+    this->Normal.compute(damped);
   }
 }
 

@@ -33,6 +33,9 @@ class VolumeConstrainedSolver
 {
 public:
   VolumeConstrainedSolver(const SparseMatrix& rows, const Triangles& triangles);
+  /// The system of `base` with `extraRows` (dense, one column per hull point)
+  /// appended: its normal matrix is updated, not rebuilt from all the rows.
+  VolumeConstrainedSolver(const VolumeConstrainedSolver& base, const Eigen::MatrixXd& extraRows);
 
   /// One step of length alpha in (0, 1] from X, with r = L X - b, J = dV/dX,
   /// c = V(X) - V0:
@@ -57,6 +60,10 @@ public:
 
   SparseMatrix Rows;
   Triangles Faces;
+  Eigen::MatrixXd NormalMatrix; ///< L^T L, undamped
   Eigen::LDLT<Eigen::MatrixXd> Normal;
+
+private:
+  void Factor(); ///< Normal from NormalMatrix; throws InputError when singular
 };
 }

@@ -150,6 +150,69 @@ TEST(MuscleDeformer, DynamicIntersectionsStopPointsAtTheObstacle)
   EXPECT_LT(std::abs(held[0].volumeChangePercent), 0.05);
 }
 
+namespace
+{
+/// The deepest of `points` inside `tree` (distance to its surface), 0 when none is.
+double DeepestInside(const md::TriangleTree& tree, const Points& points)
+{
+  double deepest = 0;
+  for (Eigen::Index i = 0; i < points.rows(); ++i)
+  {
+    const Eigen::Vector3d p = points.row(i).transpose();
+    if (tree.InBounds(p) && tree.Inside(p))
+    {
+      deepest = std::max(deepest, tree.ClosestPoint(p).distance);
+    }
+  }
+  return deepest;
+}
+}
+
+TEST(MuscleDeformer, ContactRowsPushTheMuscleOffTheBoneThatMovedIntoIt)
+{
+  // The femur swings into the rectus femoris at 30 degrees: the paper's step
+  // leaves the points it swept over inside (frozen) for the static
+  // resolution; with contact rows the muscle moves off the bone as a whole.
+  PhantomCase c(20);
+  const md::TriangleTree& femur = *c.bones[1].tree;
+  md::DeformationParameters paper;
+  md::DeformationParameters contact;
+  contact.contactWeight = 0.5;
+  const auto without = md::DeformMuscles({ c.muscles[2] }, c.bones, paper);
+  const auto with = md::DeformMuscles({ c.muscles[2] }, c.bones, contact);
+  EXPECT_EQ(without[0].verticesInContact, 0);
+  EXPECT_GT(with[0].verticesInContact, 0);
+  const double deepWithout = DeepestInside(femur, without[0].points);
+  const double deepWith = DeepestInside(femur, with[0].points);
+  EXPECT_GT(deepWithout, 0);
+  EXPECT_LT(deepWith, 0.5 * deepWithout);
+  EXPECT_LT(with[0].verticesFrozen, without[0].verticesFrozen);
+  EXPECT_TRUE(with[0].converged);
+  EXPECT_LT(std::abs(with[0].volumeChangePercent), 0.05);
+
+  // Overlap a muscle may keep is left alone: with every point allowed inside
+  // the femur, nothing is pushed.
+  std::vector<std::vector<char>> allowed(c.bones.size(), std::vector<char>(c.muscles[2].muscle->points.rows(), 0));
+  allowed[1].assign(allowed[1].size(), 1);
+  md::MuscleToDeform keeping = c.muscles[2];
+  keeping.boneOverlap = &allowed;
+  const auto kept = md::DeformMuscles({ keeping }, c.bones, contact);
+  EXPECT_EQ(kept[0].verticesInContact, 0);
+
+  // A list per bone, one entry per point, or a clear refusal.
+  std::vector<std::vector<char>> wrong(1, std::vector<char>(3, 0));
+  keeping.boneOverlap = &wrong;
+  try
+  {
+    md::DeformMuscles({ keeping }, c.bones, contact);
+    ADD_FAILURE() << "a bone overlap of the wrong size was accepted";
+  }
+  catch (const md::InputError& e)
+  {
+    EXPECT_NE(std::string(e.what()).find(keeping.name), std::string::npos) << e.what();
+  }
+}
+
 TEST(MuscleDeformer, MusclesAreObstaclesForEachOther)
 {
   // Two copies of a muscle side by side, the one behind pushed into the one

@@ -10,11 +10,15 @@
 
 namespace
 {
-md::InterpolationResult RunMethod(const MotionCase& c, int steps, md::HullMode mode)
+/// The method with its own deformation step (bones push the muscle), or
+/// with `contactWeight` 0 the paper's step.
+md::InterpolationResult RunMethod(const MotionCase& c, int steps, md::HullMode mode,
+  double contactWeight = md::StepDeformationDefaults().contactWeight)
 {
   md::InterpolationParameters parameters;
   parameters.numberOfSteps = steps;
   parameters.hullMode = mode;
+  parameters.deformation.contactWeight = contactWeight;
   return md::DeformByInterpolation(c.muscles, c.bones, parameters);
 }
 
@@ -48,11 +52,14 @@ TEST(RealInterpolation, HipFlexion60InFourStepsBeatsTheOnePassMethodAndRefitIsCo
   }
   ASSERT_EQ(c.muscles.size(), 4u);
   ASSERT_EQ(c.bones.size(), 3u);
+  // The one-pass method as the paper has it (its deformation step: bones only
+  // stop points) and with the method's own step (bones push the muscle).
+  const md::InterpolationResult paper = RunMethod(c, 1, md::HullMode::Refit, 0.0);
   const md::InterpolationResult one = RunMethod(c, 1, md::HullMode::Refit);
   const md::InterpolationResult refit = RunMethod(c, 4, md::HullMode::Refit);
   const md::InterpolationResult rebuild = RunMethod(c, 4, md::HullMode::Rebuild);
   ASSERT_EQ(refit.points.size(), 5u);
-  for (const md::InterpolationResult* r : { &one, &refit, &rebuild })
+  for (const md::InterpolationResult* r : { &paper, &one, &refit, &rebuild })
   {
     for (size_t m = 0; m < c.muscles.size(); ++m)
     {
@@ -60,25 +67,30 @@ TEST(RealInterpolation, HipFlexion60InFourStepsBeatsTheOnePassMethodAndRefitIsCo
       SCOPED_TRACE(c.muscles[m].name + ", " + std::to_string(r->numberOfSteps) + " steps");
       EXPECT_LE(std::abs(f.volumeChangePercent), 0.1);
       EXPECT_LE(f.maxNewBonePenetrationDepth, 0.5); // no new penetration of a bone deeper than 0.5 mm
+      EXPECT_TRUE(f.converged);
       EXPECT_TRUE(r->points.back()[m].allFinite());
     }
   }
   const auto shift = &md::MuscleStepMeasures::maxStaticShift;
   const auto sharp = &md::MuscleStepMeasures::sharpEdgeCount;
   const auto flips = &md::MuscleStepMeasures::flippedTriangleCount;
-  // Measured here: largest static shift 16.6 mm against 18.2 mm in one pass
-  // (0.91; the issue's target, 0.6, is not met: the femur sweeps under the
-  // gluteus maximus by about as much in each step), 343 new sharp edges
-  // against 432, 11 flipped triangles against 62. The largest shift is one
-  // point's and moves by millimetres when the inputs move by 1e-7: over such
-  // perturbations it is 0.60-0.91 of the one-pass figure, the flips always
-  // fewer, the sharp edges fewer in 5 of 7 (BENCHMARKS.md).
-  EXPECT_LT(Largest(refit, shift), Largest(one, shift));
-  EXPECT_LT(Total(refit, sharp), Total(one, sharp));
-  EXPECT_LT(Total(refit, flips), Total(one, flips));
-  // Refit against the paper's Rebuild: comparable quality (here 16.6 against
-  // 13.9 mm, 343 against 330 sharp edges; over the perturbations Refit's
-  // largest shift is 0.85-1.20 of Rebuild's and its sharp edges 0.89-1.26).
+  // Measured here: largest static shift 5.4 mm against 18.2 mm in one pass
+  // with the paper's step and 17.1 mm with the method's own (0.29 and 0.31;
+  // the issue asks for at most 0.6, the paper reports about half); 272 new
+  // sharp edges against 432 and 482, 16 flipped triangles against 62 and 110.
+  // The largest shift is one point's and moves by millimetres when the inputs
+  // move by 1e-7: over six such perturbations it is 0.32-0.64 of the
+  // one-pass figure, the sharp edges and flips always fewer (BENCHMARKS.md).
+  for (const md::InterpolationResult* onePass : { &paper, &one })
+  {
+    SCOPED_TRACE(onePass == &paper ? "against the paper's one-pass method" : "against one pass of the method's step");
+    EXPECT_LE(Largest(refit, shift), 0.6 * Largest(*onePass, shift));
+    EXPECT_LT(Total(refit, sharp), Total(*onePass, sharp));
+    EXPECT_LT(Total(refit, flips), Total(*onePass, flips));
+  }
+  // Refit against the paper's Rebuild: comparable quality (here 5.4 against
+  // 8.1 mm, 272 against 259 sharp edges, 16 against 27 flips; over the
+  // perturbations, BENCHMARKS.md).
   EXPECT_LE(Largest(refit, shift), 1.25 * Largest(rebuild, shift));
   EXPECT_LE(Total(refit, sharp), 1.3 * Total(rebuild, sharp));
 }
@@ -91,7 +103,10 @@ TEST(RealInterpolation, InputsMovedBy1e7StillGiveSoundMuscles)
   // near-null modes tore a muscle apart in runs like these (the gluteus
   // medius, the iliacus or the psoas spanning 1.6 to 6.5 times its size;
   // with followWeight 0, seed 4 is refused as diverged); now each run
-  // completes, every muscle keeps its volume and its size.
+  // completes, every muscle keeps its volume and its size. And the method
+  // keeps its lead over the paper's one-pass method: over seeds 0-5 its
+  // largest static shift is 0.27-0.51 of the one-pass figure (0.27-0.32
+  // for the seeds here) and it has fewer flipped triangles (BENCHMARKS.md).
   MotionCase c;
   if (!LhdlMotion("hip_flexion", 35, c))
   {
@@ -112,5 +127,10 @@ TEST(RealInterpolation, InputsMovedBy1e7StillGiveSoundMuscles)
       EXPECT_LE(f.maxNewBonePenetrationDepth, 0.5);
       EXPECT_LT(span(r.points.back()[m]), 1.2 * span(perturbed.muscles[m].muscle.points));
     }
+    const md::InterpolationResult paper = RunMethod(perturbed, 1, md::HullMode::Refit, 0.0);
+    EXPECT_LE(Largest(r, &md::MuscleStepMeasures::maxStaticShift),
+      0.6 * Largest(paper, &md::MuscleStepMeasures::maxStaticShift));
+    EXPECT_LT(Total(r, &md::MuscleStepMeasures::flippedTriangleCount),
+      Total(paper, &md::MuscleStepMeasures::flippedTriangleCount));
   }
 }

@@ -152,3 +152,57 @@ TEST(VolumeConstrainedSolver, RefusesASystemThatDoesNotFixThePosition)
   const TriangleMesh hull = CoarseMuscleHull();
   EXPECT_THROW(md::VolumeConstrainedSolver(md::CotangentLaplacian(hull), hull.triangles), md::InputError);
 }
+
+TEST(VolumeConstrainedSolver, RowsAppendedGiveTheSameStepsAsTheStackedSystem)
+{
+  // The contact rows of the deformation are appended to a solver already
+  // factored: the result must be the solver of all the rows stacked.
+  const TriangleMesh hull = CoarseMuscleHull();
+  const Problem problem = StretchProblem(hull, 1.2);
+  const Eigen::Index n = hull.points.rows(), rows = problem.rows.rows();
+  Eigen::MatrixXd extra = Eigen::MatrixXd::Zero(3, n);
+  extra(0, 3) = 0.5;
+  extra(1, 7) = 0.3;
+  extra(1, 8) = 0.2;
+  extra(2, n - 1) = 1.0;
+  Points extraTargets(3, 3);
+  extraTargets << 1.0, 2.0, 3.0, -4.0, 0.5, 2.0, 0.0, 0.0, 9.0;
+
+  SparseMatrix stacked(rows + 3, n);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index r = 0; r < rows; ++r)
+  {
+    for (SparseMatrix::InnerIterator it(problem.rows, r); it; ++it)
+    {
+      entries.emplace_back(r, it.col(), it.value());
+    }
+  }
+  for (Eigen::Index r = 0; r < 3; ++r)
+  {
+    for (Eigen::Index c = 0; c < n; ++c)
+    {
+      if (extra(r, c) != 0)
+      {
+        entries.emplace_back(rows + r, c, extra(r, c));
+      }
+    }
+  }
+  stacked.setFromTriplets(entries.begin(), entries.end());
+  Points targets(rows + 3, 3);
+  targets << problem.targets, extraTargets;
+
+  const md::VolumeConstrainedSolver base(problem.rows, hull.triangles);
+  const md::VolumeConstrainedSolver appended(base, extra);
+  const md::VolumeConstrainedSolver direct(stacked, hull.triangles);
+  ASSERT_EQ(appended.Rows.rows(), rows + 3);
+  const double restVolume = md::EnclosedVolume(hull.points, hull.triangles);
+  Points a = hull.points, d = hull.points;
+  for (int iteration = 0; iteration < 5; ++iteration)
+  {
+    a = appended.Step(a, targets, restVolume, 1.0);
+    d = direct.Step(d, targets, restVolume, 1.0);
+  }
+  const double scale = (hull.points.colwise().maxCoeff() - hull.points.colwise().minCoeff()).norm();
+  EXPECT_LT((a - d).cwiseAbs().maxCoeff(), 1e-9 * scale);
+  EXPECT_GT((a - hull.points).cwiseAbs().maxCoeff(), 1e-3 * scale); // the rows did move it
+}

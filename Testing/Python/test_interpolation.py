@@ -48,6 +48,7 @@ class Interpolation(unittest.TestCase):
         self.assertEqual(method.BoneInterpolationMode, "Rigid")
         self.assertEqual(method.HullMode, "Refit")
         self.assertEqual(method.PreserveVolume, 1)
+        self.assertAlmostEqual(method.BoneContactWeight, 0.5)
         resolve = simple.IntersectionResolve()
         self.assertAlmostEqual(resolve.DeformableShare, 0.6)
         simple.Delete(resolve)
@@ -84,6 +85,20 @@ class Interpolation(unittest.TestCase):
         # Every step was computed once: the run behind step 2 is the one behind step 0.
         self.assertEqual(field(block(last, "RectusFemoris"), "ElapsedSeconds"), elapsed)
         simple.Delete(method)
+
+    def test_bones_push_the_muscle_unless_the_contact_weight_is_zero(self):
+        # The femur sweeps into the rectus femoris: pushed along by it, the muscle needs a far
+        # shorter static resolution than with the paper's step (here 6.5 against 11.5 mm).
+        shifts = {}
+        for weight in (0.5, 0.0):
+            method = self.method(NumberOfSteps=4, BoneContactWeight=weight)
+            method.UpdatePipeline(4)
+            muscle = block(servermanager.Fetch(method), "RectusFemoris")
+            shifts[weight] = field(muscle, "MaxStaticShift")
+            self.assertLessEqual(abs(field(muscle, "VolumeChangePercent")), 0.1)
+            self.assertLessEqual(field(muscle, "MaxNewBonePenetrationDepth"), 0.5)
+            simple.Delete(method)
+        self.assertLess(shifts[0.5], 0.75 * shifts[0.0])
 
     def test_a_motion_of_zero_length_returns_the_input(self):
         port = lambda k: simple.OutputPort(self.phantom, k)  # noqa: E731

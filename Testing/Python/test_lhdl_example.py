@@ -46,12 +46,15 @@ class LhdlExample(unittest.TestCase):
             self.assertLessEqual(abs(measures["VolumeChangePercent"]), 0.1, name)
             self.assertLessEqual(measures["MaxNewBonePenetrationDepth"], 0.5, name)
         # Through the pipeline the points are floats, and the largest static shift (one point's)
-        # is sensitive to such rounding (BENCHMARKS.md: 0.64 to 0.93 of the one-pass figure over
-        # perturbations of 1e-7); what holds throughout is asserted, on the whole case.
-        self.assertLess(max(m["MaxStaticShift"] for m in final.values()),
-                        max(m["MaxStaticShift"] for m in one_pass.values()))
+        # is sensitive to such rounding: here 6.4 against 18.2 mm in the paper's one pass, over
+        # perturbations of 1e-7 0.27 to 0.51 of the one-pass figure (BENCHMARKS.md). Sharp edges
+        # 325 against 432, flipped triangles 19 against 62.
+        self.assertLessEqual(max(m["MaxStaticShift"] for m in final.values()),
+                             0.6 * max(m["MaxStaticShift"] for m in one_pass.values()))
         self.assertLess(sum(m["SharpEdgeCount"] for m in final.values()),
                         sum(m["SharpEdgeCount"] for m in one_pass.values()))
+        self.assertLess(sum(m["FlippedTriangleCount"] for m in final.values()),
+                        sum(m["FlippedTriangleCount"] for m in one_pass.values()))
         self.assertTrue(os.path.isfile(os.path.join(output, "muscles_method_step_4_iliacus_r.vtp")))
         # psoas and iliacus lose their conditional via point beyond 40 and 54 degrees of flexion.
         rest, current = figures["action_line_points_rest"], figures["action_line_points_current"]
