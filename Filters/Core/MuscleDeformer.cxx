@@ -1209,7 +1209,8 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
         else
         {
           s.converged = s.fineDone = true;
-          s.flipsCheckedClean = s.unfoldings < maximumUnfoldings; // the check just found none, nothing moved since
+          // The check just found none and nothing moved since (unless folds were left held at a bone).
+          s.flipsCheckedClean = s.unfoldings < maximumUnfoldings && !s.unfoldingBlocked;
         }
       }
       else if (total >= parameters.maximumIterations)

@@ -189,6 +189,8 @@ TEST(MuscleDeformer, ContactRowsPushTheMuscleOffTheBoneThatMovedIntoIt)
   EXPECT_LT(with[0].verticesFrozen, without[0].verticesFrozen);
   EXPECT_TRUE(with[0].converged);
   EXPECT_LT(std::abs(with[0].volumeChangePercent), 0.05);
+  EXPECT_EQ(with[0].flippedTriangles,
+    md::CountFlippedTriangles(c.muscles[2].muscle->points, with[0].points, c.muscles[2].muscle->triangles));
 
   // Overlap a muscle may keep is left alone: with every point allowed inside
   // the femur, nothing is pushed.
