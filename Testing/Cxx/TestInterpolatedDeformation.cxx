@@ -106,6 +106,7 @@ TEST(InterpolatedDeformation, TheMuscleTheFemurSwallowsIsNotFixedOnTheBoneWhenIn
   const MotionCase c = PhantomMotion(30);
   md::InterpolationParameters onePass, interpolated;
   onePass.numberOfSteps = 1;
+  onePass.deformation.contactWeight = 0; // the paper's one-pass method
   interpolated.numberOfSteps = 8;
   const md::InterpolationResult one = md::DeformByInterpolation(c.muscles, c.bones, onePass);
   const md::InterpolationResult steps = md::DeformByInterpolation(c.muscles, c.bones, interpolated);
@@ -116,6 +117,9 @@ TEST(InterpolatedDeformation, TheMuscleTheFemurSwallowsIsNotFixedOnTheBoneWhenIn
   const md::MuscleStepMeasures& b = steps.measures.back()[rectus];
   EXPECT_GT(a.pointsFrozenInObstacles, 100); // the one pass leaves them in the bone...
   EXPECT_GT(a.maxStaticShift, 15.0);         // ...and the static resolution throws them far
+  // Measured: 7.3 against 20.5 mm, no flipped triangle against 14, 41 new
+  // sharp edges against 42 (close: the pushed muscle bends around the femur's
+  // neck too).
   EXPECT_LE(b.maxStaticShift, 0.6 * a.maxStaticShift);
   EXPECT_LT(b.flippedTriangleCount, a.flippedTriangleCount);
   EXPECT_LT(b.sharpEdgeCount, a.sharpEdgeCount);
