@@ -28,6 +28,13 @@ double Diagonal(const Points& points)
   return (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
 }
 
+/// Just outside a surface: `offset` beyond its point `closest` nearest to p,
+/// p being inside (closest.distance > 0), on the way out.
+Eigen::Vector3d JustOutside(const TriangleTree::Closest& closest, const Eigen::Vector3d& p, double offset)
+{
+  return closest.point + (offset / closest.distance) * (closest.point - p);
+}
+
 /// The action-line segment nearest to p (over all lines), as line and index
 /// of its first point, with the parameter of p's foot on it in [0, 1].
 /// Segments of zero length in either pose carry no direction and are skipped.
@@ -458,7 +465,7 @@ void PushOffBones(MuscleState& s, const std::vector<Obstacle>& bones, const Defo
         const TriangleTree::Closest closest = bones[b].tree->ClosestPoint(p);
         if (closest.distance > 0)
         {
-          found[i] = closest.point + (margin / closest.distance) * (closest.point - p);
+          found[i] = JustOutside(closest, p, margin);
           isNew[i] = 1;
         }
         break;
@@ -583,7 +590,7 @@ void SlideOnBones(MuscleState& s, const std::vector<Obstacle>& bones, const std:
         const TriangleTree::Closest closest = bone.tree->ClosestPoint(p);
         if (closest.distance > 0)
         {
-          s.points.row(i) = (closest.point + (backOff / closest.distance) * (closest.point - p)).transpose();
+          s.points.row(i) = JustOutside(closest, p, backOff).transpose();
         }
         break;
       }
@@ -1107,7 +1114,7 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
           const TriangleTree::Closest closest = other.tree->ClosestPoint(p);
           if (closest.distance > 0)
           {
-            s.points.row(i) = (closest.point + (1e-6 * s.size / closest.distance) * (closest.point - p)).transpose();
+            s.points.row(i) = JustOutside(closest, p, 1e-6 * s.size).transpose();
             s.touched[i] = 1;
           }
         }

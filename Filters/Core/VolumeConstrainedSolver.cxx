@@ -83,11 +83,8 @@ VolumeConstrainedSolver::VolumeConstrainedSolver(const SparseMatrix& rows, const
   : Rows(rows)
   , Faces(triangles)
 {
-  const Eigen::MatrixXd dense(rows);
-  this->NormalMatrix = Eigen::MatrixXd::Zero(dense.cols(), dense.cols());
-  this->NormalMatrix.selfadjointView<Eigen::Lower>().rankUpdate(dense.transpose());
-  this->NormalMatrix = this->NormalMatrix.selfadjointView<Eigen::Lower>();
-  this->Factor();
+  this->NormalMatrix = Eigen::MatrixXd::Zero(rows.cols(), rows.cols());
+  this->AddToNormal(Eigen::MatrixXd(rows));
 }
 
 VolumeConstrainedSolver::VolumeConstrainedSolver(const VolumeConstrainedSolver& base, const Eigen::MatrixXd& extraRows)
@@ -99,7 +96,12 @@ VolumeConstrainedSolver::VolumeConstrainedSolver(const VolumeConstrainedSolver& 
   this->Rows.reserve(base.Rows.nonZeros() + extra.nonZeros());
   this->Rows.topRows(base.Rows.rows()) = base.Rows;
   this->Rows.bottomRows(extra.rows()) = extra;
-  this->NormalMatrix.selfadjointView<Eigen::Lower>().rankUpdate(extraRows.transpose());
+  this->AddToNormal(extraRows);
+}
+
+void VolumeConstrainedSolver::AddToNormal(const Eigen::MatrixXd& rows)
+{
+  this->NormalMatrix.selfadjointView<Eigen::Lower>().rankUpdate(rows.transpose());
   this->NormalMatrix = this->NormalMatrix.selfadjointView<Eigen::Lower>();
   this->Factor();
 }

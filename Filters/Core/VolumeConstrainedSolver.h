@@ -8,8 +8,6 @@
 #include <Eigen/Cholesky>
 #include <Eigen/SparseCore>
 
-#include <memory>
-
 namespace md
 {
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
@@ -64,6 +62,7 @@ public:
   Eigen::LDLT<Eigen::MatrixXd> Normal;
 
 private:
+  void AddToNormal(const Eigen::MatrixXd& rows); ///< NormalMatrix += rows^T rows, then Factor
   void Factor(); ///< Normal from NormalMatrix; throws InputError when singular
 };
 }
