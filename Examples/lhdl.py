@@ -1,57 +1,24 @@
 """Reading the LHDL right-hip data set (../shared/data/lhdl_hip_r) into the pipeline (pvpython).
 
-Bones, muscles, action lines (action_lines_rp_mm.csv) and femur motions (femur_transforms.csv),
-in one frame, in millimetres. A current pose is a frame of a motion: the pelvis bones stay, the
-femur and every path point fixed to the femur move by the frame's rigid transform, and a
-conditional path point exists only while the hip flexion is inside its range.
+The model and its motions come from the data set's own OpenSim files (LHDL_hip_r.osim,
+kinematics/*.mot) through OpenSimModelReader; the scanned bones and muscles are the .vtk surfaces
+beside it, in mm, in the scan pose (the rest pose), in the pelvis's frame. The femur moves with
+the model's femur_r body (MoveWithBodies), the pelvis bones with the pelvis; the muscle paths
+become the muscles' action lines by ActionLineGrouping.
 """
-import csv
 import os
+import types
 
-import numpy
-from paraview import simple
-from vtkmodules.util import numpy_support
-from vtkmodules.vtkCommonCore import vtkPoints, vtkStringArray
-from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkCompositeDataSet, vtkMultiBlockDataSet, vtkPolyData
+from paraview import servermanager, simple
+from vtkmodules.vtkCommonDataModel import vtkCompositeDataSet, vtkMultiBlockDataSet, vtkPolyData
 from vtkmodules.vtkIOLegacy import vtkPolyDataReader
 
 BONES = ("iliac_r", "sacrum", "femur_r")
 MUSCLES = ("gluteus_maximus_r", "gluteus_medius_r", "iliacus_r", "psoas_r")
-# The action lines (OpenSim paths) of each muscle.
-ACTION_LINES = {
-    "gluteus_maximus_r": ("glut_max1_r", "glut_max2_r", "glut_max3_r"),
-    "gluteus_medius_r": ("glut_med1_r", "glut_med2_r", "glut_med3_r"),
-    "iliacus_r": ("iliacus_r",),
-    "psoas_r": ("psoas_r",),
-}
-MOVING_BODY = "femur_r"
-
-
-class Frame:
-    """One frame of a motion: x_CP = rotation @ x_RP + translation for the femur."""
-
-    def __init__(self, row):
-        self.motion = row["motion"]
-        self.index = int(row["frame"])
-        self.hip_flexion = float(row["hip_flexion_deg"])
-        self.hip_adduction = float(row["hip_adduction_deg"])
-        self.rotation = numpy.array([float(row["r%d%d" % (i, j)]) for i in range(3) for j in range(3)]).reshape(3, 3)
-        self.translation = numpy.array([float(row["tx_mm"]), float(row["ty_mm"]), float(row["tz_mm"])])
-
-    def apply(self, points):
-        return points @ self.rotation.T + self.translation
-
-
-def read_frame(folder, motion, frame):
-    with open(os.path.join(folder, "femur_transforms.csv")) as f:
-        for row in csv.DictReader(f):
-            if row["motion"] == motion and int(row["frame"]) == frame:
-                return Frame(row)
-    raise ValueError("no frame %d of motion %r in femur_transforms.csv" % (frame, motion))
-
-
-def rest_pose_frame(folder):
-    return read_frame(folder, "scan_pose_RP", 0)
+# The scan pose (femur_transforms.csv, row scan_pose_RP): the rest pose, in degrees.
+REST_POSE = "hip_flexion_r=1.5760 hip_adduction_r=-4.7269 hip_rotation_r=-5.2899"
+# The bones whose names do not say which body of the model they move with.
+BODY_OF_SURFACE = "iliac_r=pelvis; sacrum=pelvis"
 
 
 def read_surface(folder, name):
@@ -71,48 +38,6 @@ def named_blocks(blocks):
     return tree
 
 
-def moved(surface, frame):
-    out = vtkPolyData()
-    out.DeepCopy(surface)
-    xyz = numpy_support.vtk_to_numpy(surface.GetPoints().GetData()).astype(numpy.float64)
-    points = vtkPoints()
-    points.SetData(numpy_support.numpy_to_vtk(frame.apply(xyz), deep=True))
-    out.SetPoints(points)
-    return out
-
-
-def read_action_lines(folder, frame):
-    """{path name: [(x, y, z), ...]} of the action lines in the pose of `frame`."""
-    paths = {}
-    with open(os.path.join(folder, "action_lines_rp_mm.csv")) as f:
-        for row in csv.DictReader(f):
-            if row["point_type"] == "ConditionalPathPoint":
-                low, high = float(row["active_min_deg"]), float(row["active_max_deg"])
-                if not low <= frame.hip_flexion <= high:
-                    continue
-            point = numpy.array([float(row["x_mm"]), float(row["y_mm"]), float(row["z_mm"])])
-            if row["attached_body"] == MOVING_BODY:
-                point = frame.apply(point[None, :])[0]
-            paths.setdefault(row["muscle"], []).append((int(row["order"]), point))
-    return {name: [p for _, p in sorted(points, key=lambda item: item[0])] for name, points in paths.items()}
-
-
-def polylines(lines):
-    """A polydata of polylines with the cell array ActionLineName."""
-    points, cells, names = vtkPoints(), vtkCellArray(), vtkStringArray()
-    names.SetName("ActionLineName")
-    for name, line in lines:
-        cells.InsertNextCell(len(line))
-        for p in line:
-            cells.InsertCellPoint(points.InsertNextPoint(*p))
-        names.InsertNextValue(name)
-    out = vtkPolyData()
-    out.SetPoints(points)
-    out.SetLines(cells)
-    out.GetCellData().AddArray(names)
-    return out
-
-
 def producer(data, name):
     """A pipeline source holding `data` (builtin session)."""
     source = simple.TrivialProducer(registrationName=name)
@@ -121,25 +46,44 @@ def producer(data, name):
     return source
 
 
+def model_reader(folder, motion="hip_flexion", frame=35, play=False):
+    """OpenSimModelReader of the data set's model in mm, in the pelvis's frame, with the scan pose
+    as the rest pose, and `motion` (its frame `frame` the current pose when `play` is off)."""
+    reader = simple.OpenSimModelReader(
+        registrationName="LHDL_hip_r.osim", FileName=os.path.join(folder, "LHDL_hip_r.osim"),
+        IgnoreUnknownColumns=1, Scale=1000.0, ReferenceBody="pelvis", RestPoseCoordinates=REST_POSE,
+        PlayMotion=1, MotionFileName=os.path.join(folder, "kinematics", motion + ".mot"))
+    times = list(reader.TimestepValues)
+    if not 0 <= frame < len(times):
+        raise ValueError("motion %r has %d frames, not %d" % (motion, len(times), frame + 1))
+    reader.CurrentPoseTime = times[frame]
+    reader.PlayMotion = 1 if play else 0
+    reader.UpdatePipeline()
+    return reader
+
+
 def load(folder, motion="hip_flexion", frame=35):
     """Pipeline sources of the data set in the rest pose and in one frame of a motion:
-    {'muscles', 'bones_rest', 'bones_current', 'lines_rest', 'lines_current'}, plus 'frame'."""
-    current = read_frame(folder, motion, frame)
-    rest = rest_pose_frame(folder)
-    bones = [(name, read_surface(folder, name)) for name in BONES]
-    bones_current = [(name, moved(surface, current) if name == MOVING_BODY else surface) for name, surface in bones]
-    muscles = [(name, read_surface(folder, name)) for name in MUSCLES]
-    rest_paths, current_paths = read_action_lines(folder, rest), read_action_lines(folder, current)
-
-    def lines_of(paths):
-        return named_blocks([(muscle, polylines([(p, paths[p]) for p in ACTION_LINES[muscle]]))
-                             for muscle in MUSCLES])
-
+    {'muscles', 'bones_rest', 'bones_current', 'lines_rest', 'lines_current'}, plus 'frame'
+    (motion, index, time, hip_flexion, hip_adduction in degrees) and 'model' (the reader)."""
+    reader = model_reader(folder, motion, frame)
+    bones = producer(named_blocks([(name, read_surface(folder, name)) for name in BONES]), "LHDL bones (rest pose)")
+    muscles = producer(named_blocks([(name, read_surface(folder, name)) for name in MUSCLES]), "LHDL muscles")
+    bones_current = simple.MoveWithBodies(registrationName="LHDL bones (current pose)", Input=bones,
+                                          BodyTransforms=simple.OutputPort(reader, 4),
+                                          BodyOfSurface=BODY_OF_SURFACE)
+    lines = simple.ActionLineGrouping(registrationName="LHDL action lines", Input=muscles,
+                                      Paths=simple.OutputPort(reader, 3), PathsCurrent=simple.OutputPort(reader, 1))
+    pose = servermanager.Fetch(reader, idx=4).GetFieldData()
+    value = lambda name: pose.GetArray(name).GetValue(0)  # noqa: E731
     return {
-        "frame": current,
-        "muscles": producer(named_blocks(muscles), "LHDL muscles"),
-        "bones_rest": producer(named_blocks(bones), "LHDL bones (rest pose)"),
-        "bones_current": producer(named_blocks(bones_current), "LHDL bones (current pose)"),
-        "lines_rest": producer(lines_of(rest_paths), "LHDL action lines (rest pose)"),
-        "lines_current": producer(lines_of(current_paths), "LHDL action lines (current pose)"),
+        "frame": types.SimpleNamespace(motion=motion, index=frame, time=value("Time"),
+                                       hip_flexion=round(value("hip_flexion_r"), 6),
+                                       hip_adduction=round(value("hip_adduction_r"), 6)),
+        "model": reader,
+        "muscles": muscles,
+        "bones_rest": bones,
+        "bones_current": bones_current,
+        "lines_rest": simple.OutputPort(lines, 0),
+        "lines_current": simple.OutputPort(lines, 1),
     }

@@ -4,9 +4,10 @@ Run with pvpython (under xvfb-run on a machine without a display):
 
     pvpython Examples/lhdl_hip_interpolation.py --output results/lhdl [--motion hip_flexion --frame 35]
 
-Reads ../shared/data/lhdl_hip_r (or --data / $MUSCLEDEFORMATION_DATA_DIR); the pelvis bones stay,
-the femur and the action-line points fixed to it move by the frame's transform
-(femur_transforms.csv; frame 35 of hip_flexion is 60 degrees). The four muscles are deformed
+Reads ../shared/data/lhdl_hip_r (or --data / $MUSCLEDEFORMATION_DATA_DIR) through its own OpenSim
+files: OpenSimModelReader places the femur and the muscle paths at the frame of the motion
+(kinematics/<motion>.mot; frame 35 of hip_flexion is 60 degrees), MoveWithBodies moves the
+scanned femur with it, ActionLineGrouping makes the paths the muscles' action lines. The four muscles are deformed
 together by InterpolatedMuscleDeformation (N steps, obstacles the iliac bone, the sacrum and the
 femur) and by the one-pass method (one step, the same static resolution). Writes lhdl_rest.png,
 lhdl_current.png, lhdl_hulls.png, lhdl_step_<j>.png (bones and action lines),
@@ -52,6 +53,7 @@ def main(argv=None):
 
     inputs = lhdl.load(os.path.join(data, "lhdl_hip_r"), args.motion, args.frame)
     frame = inputs.pop("frame")
+    inputs.pop("model")
     pipeline = mdexamples.interpolation_pipeline(inputs, args.steps, args.mode)
     view = mdexamples.make_view()
     images, figures = mdexamples.run(pipeline, view, lateral_camera, args.output, "lhdl")

@@ -1,5 +1,7 @@
 #include "MDBlocks.h"
 
+#include <vtkStreamingDemandDrivenPipeline.h>
+
 #include <vtkCellArray.h>
 #include <vtkCellArrayIterator.h>
 #include <vtkCompositeDataSet.h>
@@ -168,6 +170,21 @@ bool PairLeaves(const std::vector<Leaf>& a, const std::string& nameA, const std:
     partner[i] = i;
   }
   return true;
+}
+
+void CopyTimeSteps(vtkInformation* from, vtkInformation* to)
+{
+  using SDDP = vtkStreamingDemandDrivenPipeline;
+  to->Remove(SDDP::TIME_STEPS());
+  to->Remove(SDDP::TIME_RANGE());
+  if (from && from->Has(SDDP::TIME_STEPS()))
+  {
+    to->CopyEntry(from, SDDP::TIME_STEPS());
+  }
+  if (from && from->Has(SDDP::TIME_RANGE()))
+  {
+    to->CopyEntry(from, SDDP::TIME_RANGE());
+  }
 }
 
 void AssignLeaves(

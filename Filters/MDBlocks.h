@@ -54,6 +54,10 @@ void AddFieldValue(vtkFieldData* fieldData, const char* name, double value);
 void AddFieldValue(vtkFieldData* fieldData, const char* name, int value);
 void AddFieldValue(vtkFieldData* fieldData, const char* name, std::int64_t value);
 
+/// Advertises the time steps and range of `from` (an input's information) on `to` (an output's),
+/// or none when `from` has none.
+void CopyTimeSteps(vtkInformation* from, vtkInformation* to);
+
 /// Accept vtkPolyData or vtkMultiBlockDataSet on an input port.
 void AcceptPolyDataOrMultiBlock(vtkInformation* info);
 

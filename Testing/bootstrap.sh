@@ -17,6 +17,7 @@ MD_PACKAGES=(
   xvfb xauth libgl1-mesa-dri
   qtbase5-dev qttools5-dev qtxmlpatterns5-dev-tools
   libopenmpi-dev libdouble-conversion-dev liblz4-dev libutfcpp-dev
+  libpugixml-dev
 )
 
 md_install_dependencies() {

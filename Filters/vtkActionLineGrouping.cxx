@@ -1,0 +1,187 @@
+#include "vtkActionLineGrouping.h"
+
+#include "MDBlocks.h"
+#include "OpenSimAttachment.h"
+
+#include <vtkAppendPolyData.h>
+#include <vtkCellData.h>
+#include <vtkCompositeDataSet.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
+#include <vtkMultiBlockDataSet.h>
+#include <vtkObjectFactory.h>
+#include <vtkOutputWindow.h>
+#include <vtkPolyData.h>
+#include <vtkStringArray.h>
+
+#include <sstream>
+
+vtkStandardNewMacro(vtkActionLineGrouping);
+
+vtkActionLineGrouping::vtkActionLineGrouping()
+{
+  this->SetNumberOfInputPorts(3);
+  this->SetNumberOfOutputPorts(2);
+}
+
+vtkActionLineGrouping::~vtkActionLineGrouping()
+{
+  this->SetPathsOfMuscle(nullptr);
+}
+
+int vtkActionLineGrouping::FillInputPortInformation(int port, vtkInformation* info)
+{
+  mdvtk::AcceptPolyDataOrMultiBlock(info);
+  if (port == 2)
+  {
+    info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  }
+  return 1;
+}
+
+int vtkActionLineGrouping::RequestInformation(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  // The current pose's paths carry the motion's time.
+  mdvtk::CopyTimeSteps(inputVector[2]->GetInformationObject(0), outputVector->GetInformationObject(1));
+  return 1;
+}
+
+int vtkActionLineGrouping::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  this->Decision.clear();
+  std::vector<mdvtk::Leaf> muscles, paths, current;
+  std::string error;
+  const bool haveCurrent = inputVector[2]->GetNumberOfInformationObjects() > 0;
+  if (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[0], 0), "Input", muscles, error) ||
+    !mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[1], 0), "Paths", paths, error) ||
+    (haveCurrent &&
+      !mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[2], 0), "PathsCurrent", current, error)))
+  {
+    vtkErrorMacro(<< error);
+    return 0;
+  }
+  std::vector<size_t> currentOf;
+  if (haveCurrent && !mdvtk::PairLeaves(paths, "Paths", current, "PathsCurrent", currentOf, error))
+  {
+    vtkErrorMacro(<< error);
+    return 0;
+  }
+  std::vector<md::TriangleMesh> meshes(muscles.size());
+  std::vector<std::string> muscleNames, pathNames;
+  for (size_t m = 0; m < muscles.size(); ++m)
+  {
+    if (!muscles[m].data || mdvtk::ReadTriangles(muscles[m].data, meshes[m]) < 0 || meshes[m].triangles.rows() == 0)
+    {
+      vtkErrorMacro(<< muscles[m].label << " has no triangles: the muscles must be closed surfaces");
+      return 0;
+    }
+    muscleNames.push_back(muscles[m].name.empty() ? "muscle " + std::to_string(m) : muscles[m].name);
+  }
+  std::vector<md::Points> lines;
+  for (size_t p = 0; p < paths.size(); ++p)
+  {
+    const std::vector<md::Points> polylines = paths[p].data ? mdvtk::ToPolylines(paths[p].data) : std::vector<md::Points>();
+    if (polylines.size() != 1 || polylines[0].rows() < 2)
+    {
+      vtkErrorMacro(<< paths[p].label << " must hold one polyline of at least 2 points (one path)");
+      return 0;
+    }
+    lines.push_back(polylines[0]);
+    pathNames.push_back(paths[p].name.empty() ? "path " + std::to_string(p) : paths[p].name);
+  }
+  md::osim::PathGrouping grouping;
+  try
+  {
+    grouping = md::osim::GroupPaths(
+      meshes, muscleNames, lines, pathNames, md::osim::ParseAssignments(this->PathsOfMuscle ? this->PathsOfMuscle : ""));
+  }
+  catch (const md::InputError& e)
+  {
+    vtkErrorMacro(<< "PathsOfMuscle: " << e.what());
+    return 0;
+  }
+  std::ostringstream decision, unassigned;
+  for (size_t p = 0; p < paths.size(); ++p)
+  {
+    if (grouping.muscleOfPath[p] < 0)
+    {
+      unassigned << (unassigned.tellp() > 0 ? ", " : "") << pathNames[p];
+      continue;
+    }
+    decision << pathNames[p] << " -> " << muscleNames[grouping.muscleOfPath[p]] << " ("
+             << (grouping.assignedByUser[p] ? "as given, " : "") << static_cast<int>(100 * grouping.insideFraction[p] + 0.5)
+             << " % of its length inside)\n";
+  }
+  for (size_t m = 0; m < muscles.size(); ++m)
+  {
+    if (std::find(grouping.muscleOfPath.begin(), grouping.muscleOfPath.end(), static_cast<int>(m)) ==
+      grouping.muscleOfPath.end())
+    {
+      vtkErrorMacro(<< muscles[m].label << ": no path runs inside this muscle; name its paths in PathsOfMuscle "
+                    << "(e.g. " << muscleNames[m] << "=" << pathNames.front() << ")");
+      return 0;
+    }
+  }
+  this->Decision = decision.str();
+  vtkOutputWindow::GetInstance()->DisplayText(("ActionLineGrouping:\n" + this->Decision).c_str());
+  if (unassigned.tellp() > 0)
+  {
+    vtkWarningMacro(<< "paths that run inside no muscle (less than 5 % of their length) are left out: " << unassigned.str());
+  }
+
+  auto build = [&](const std::vector<mdvtk::Leaf>& source, bool isCurrent, vtkMultiBlockDataSet* output) {
+    for (size_t m = 0; m < muscles.size(); ++m)
+    {
+      vtkNew<vtkAppendPolyData> append;
+      vtkNew<vtkStringArray> names;
+      names->SetName("ActionLinePaths");
+      vtkNew<vtkDoubleArray> shares;
+      shares->SetName("PathInsideFraction");
+      for (size_t p = 0; p < paths.size(); ++p)
+      {
+        if (grouping.muscleOfPath[p] != static_cast<int>(m))
+        {
+          continue;
+        }
+        vtkPolyData* line = source[isCurrent ? currentOf[p] : p].data;
+        auto copy = vtkSmartPointer<vtkPolyData>::New();
+        copy->ShallowCopy(line);
+        copy->GetFieldData()->Initialize();
+        if (!copy->GetCellData()->GetAbstractArray("ActionLineName"))
+        {
+          vtkNew<vtkStringArray> lineName;
+          lineName->SetName("ActionLineName");
+          lineName->InsertNextValue(pathNames[p]);
+          copy->GetCellData()->AddArray(lineName);
+        }
+        append->AddInputData(copy);
+        names->InsertNextValue(pathNames[p]);
+        shares->InsertNextValue(grouping.insideFraction[p]);
+      }
+      append->Update();
+      auto block = vtkSmartPointer<vtkPolyData>::New();
+      block->ShallowCopy(append->GetOutput());
+      block->GetFieldData()->AddArray(names);
+      block->GetFieldData()->AddArray(shares);
+      const unsigned int index = output->GetNumberOfBlocks();
+      output->SetBlock(index, block);
+      output->GetMetaData(index)->Set(vtkCompositeDataSet::NAME(), muscleNames[m].c_str());
+    }
+  };
+  build(paths, false, vtkMultiBlockDataSet::GetData(outputVector, 0));
+  if (haveCurrent)
+  {
+    build(current, true, vtkMultiBlockDataSet::GetData(outputVector, 1));
+  }
+  return 1;
+}
+
+void vtkActionLineGrouping::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "PathsOfMuscle: " << (this->PathsOfMuscle ? this->PathsOfMuscle : "") << "\n";
+}

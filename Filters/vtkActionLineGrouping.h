@@ -1,0 +1,55 @@
+/**
+ * @class   vtkActionLineGrouping
+ * @brief   Groups muscle paths (one polyline per path, e.g. an OpenSim model's) into the action
+ *          lines of muscle surfaces: one block per surface, holding its paths.
+ *
+ * Input 0: the muscle surfaces (rest pose). Input 1 (Paths): the paths in the rest pose, one
+ * block per path (OpenSimModelReader's MusclePathsRest). Input 2 (PathsCurrent, optional): the
+ * same paths in the current pose (the reader's MusclePaths). Each path goes to the surface that
+ * holds the largest share of its length (at least 5 %), unless PathsOfMuscle names it
+ * ("gluteus_maximus_r=glut_max1_r,glut_max2_r; ..."). What was decided is said in the output
+ * (field data ActionLinePaths and PathInsideFraction on each block) and in a message.
+ * Outputs: 0 the grouped paths in the rest pose, 1 in the current pose (empty without input 2),
+ * each block named as its muscle: the ActionLinesRest and ActionLinesCurrent of
+ * InterpolatedMuscleDeformation.
+ */
+#pragma once
+
+#include "MuscleDeformationFiltersModule.h"
+
+#include <vtkMultiBlockDataSetAlgorithm.h>
+
+#include <string>
+
+class MUSCLEDEFORMATIONFILTERS_EXPORT vtkActionLineGrouping : public vtkMultiBlockDataSetAlgorithm
+{
+public:
+  static vtkActionLineGrouping* New();
+  vtkTypeMacro(vtkActionLineGrouping, vtkMultiBlockDataSetAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  void SetPathsConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(1, output); }
+  void SetPathsCurrentConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(2, output); }
+
+  /// "muscle=path,path; muscle=path": paths given to muscles by hand (the others are decided).
+  vtkGetStringMacro(PathsOfMuscle);
+  vtkSetStringMacro(PathsOfMuscle);
+
+  /// What was decided at the last update, one line per path.
+  const std::string& GetDecision() const { return this->Decision; }
+
+protected:
+  vtkActionLineGrouping();
+  ~vtkActionLineGrouping() override;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  char* PathsOfMuscle = nullptr;
+  std::string Decision;
+
+private:
+  vtkActionLineGrouping(const vtkActionLineGrouping&) = delete;
+  void operator=(const vtkActionLineGrouping&) = delete;
+};

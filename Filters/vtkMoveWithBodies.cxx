@@ -1,0 +1,145 @@
+#include "vtkMoveWithBodies.h"
+
+#include "MDBlocks.h"
+#include "OpenSimAttachment.h"
+#include "RigidMotion.h"
+
+#include <vtkAbstractArray.h>
+#include <vtkDataArray.h>
+#include <vtkFieldData.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
+#include <vtkObjectFactory.h>
+#include <vtkPolyData.h>
+#include <vtkStringArray.h>
+#include <vtkTable.h>
+
+#include <algorithm>
+
+vtkStandardNewMacro(vtkMoveWithBodies);
+
+vtkMoveWithBodies::vtkMoveWithBodies()
+{
+  this->SetNumberOfInputPorts(2);
+}
+
+vtkMoveWithBodies::~vtkMoveWithBodies()
+{
+  this->SetBodyOfSurface(nullptr);
+}
+
+int vtkMoveWithBodies::FillInputPortInformation(int port, vtkInformation* info)
+{
+  if (port == 1)
+  {
+    info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkTable");
+    return 1;
+  }
+  mdvtk::AcceptPolyDataOrMultiBlock(info);
+  return 1;
+}
+
+int vtkMoveWithBodies::RequestInformation(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  // The surfaces move in the body transforms' time.
+  mdvtk::CopyTimeSteps(inputVector[1]->GetInformationObject(0), outputVector->GetInformationObject(0));
+  return 1;
+}
+
+int vtkMoveWithBodies::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkDataObject* input = vtkDataObject::GetData(inputVector[0], 0);
+  vtkTable* table = vtkTable::GetData(inputVector[1], 0);
+  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
+  std::vector<mdvtk::Leaf> leaves;
+  std::string error;
+  if (!mdvtk::CollectLeaves(input, "Input", leaves, error))
+  {
+    vtkErrorMacro(<< error);
+    return 0;
+  }
+  static const char* columns[12] = { "R00", "R01", "R02", "R10", "R11", "R12", "R20", "R21", "R22", "Tx", "Ty", "Tz" };
+  vtkStringArray* bodies = table ? vtkStringArray::SafeDownCast(table->GetColumnByName("Body")) : nullptr;
+  std::vector<vtkDataArray*> values;
+  for (const char* name : columns)
+  {
+    values.push_back(table ? vtkDataArray::SafeDownCast(table->GetColumnByName(name)) : nullptr);
+  }
+  if (!bodies || std::find(values.begin(), values.end(), nullptr) != values.end())
+  {
+    vtkErrorMacro(<< "BodyTransforms must be the BodyTransforms output of an OpenSim Model Reader "
+                     "(a table with columns Body, R00 ... R22, Tx, Ty, Tz)");
+    return 0;
+  }
+  std::vector<std::string> bodyNames;
+  std::vector<md::RigidTransform> motions;
+  for (vtkIdType row = 0; row < table->GetNumberOfRows(); ++row)
+  {
+    bodyNames.push_back(bodies->GetValue(row));
+    md::RigidTransform t;
+    for (int i = 0; i < 9; ++i)
+    {
+      t.rotation(i / 3, i % 3) = values[i]->GetComponent(row, 0);
+    }
+    for (int i = 0; i < 3; ++i)
+    {
+      t.translation[i] = values[9 + i]->GetComponent(row, 0);
+    }
+    motions.push_back(t);
+  }
+  std::vector<vtkSmartPointer<vtkPolyData>> results(leaves.size());
+  try
+  {
+    const auto assignments = md::osim::ParseAssignments(this->BodyOfSurface ? this->BodyOfSurface : "");
+    for (size_t i = 0; i < leaves.size(); ++i)
+    {
+      if (!leaves[i].data)
+      {
+        continue;
+      }
+      const std::string name = leaves[i].name.empty() ? "Input" : leaves[i].name;
+      const int body = md::osim::BodyOfSurface(name, bodyNames, assignments);
+      if (body < 0)
+      {
+        std::string list;
+        for (const std::string& b : bodyNames)
+        {
+          list += (list.empty() ? "" : ", ") + b;
+        }
+        vtkErrorMacro(<< leaves[i].label << ": no body of the model is named after '" << name
+                      << "'; say which body it moves with in BodyOfSurface (e.g. " << md::osim::WithoutExtension(name)
+                      << "=pelvis). The bodies: " << list);
+        return 0;
+      }
+      auto moved = vtkSmartPointer<vtkPolyData>::New();
+      moved->ShallowCopy(leaves[i].data);
+      if (leaves[i].data->GetPoints())
+      {
+        moved->SetPoints(mdvtk::ToVtkPoints(motions[body].Apply(mdvtk::ToPoints(leaves[i].data->GetPoints()))));
+      }
+      vtkNew<vtkFieldData> fieldData;
+      fieldData->ShallowCopy(leaves[i].data->GetFieldData());
+      vtkNew<vtkStringArray> bodyArray;
+      bodyArray->SetName("Body");
+      bodyArray->InsertNextValue(bodyNames[body]);
+      fieldData->AddArray(bodyArray);
+      moved->SetFieldData(fieldData);
+      results[i] = moved;
+    }
+  }
+  catch (const md::InputError& e)
+  {
+    vtkErrorMacro(<< "BodyOfSurface: " << e.what());
+    return 0;
+  }
+  mdvtk::AssignLeaves(input, output, results);
+  return 1;
+}
+
+void vtkMoveWithBodies::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "BodyOfSurface: " << (this->BodyOfSurface ? this->BodyOfSurface : "") << "\n";
+}

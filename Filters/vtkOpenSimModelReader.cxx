@@ -1,0 +1,556 @@
+#include "vtkOpenSimModelReader.h"
+
+#include "MDBlocks.h"
+#include "OpenSimKinematics.h"
+#include "OpenSimMotion.h"
+
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkCompositeDataSet.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
+#include <vtkMultiBlockDataSet.h>
+#include <vtkOBJReader.h>
+#include <vtkObjectFactory.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataReader.h>
+#include <vtkSTLReader.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
+#include <vtkStringArray.h>
+#include <vtkTable.h>
+#include <vtkXMLPolyDataReader.h>
+#include <vtksys/SystemTools.hxx>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+vtkStandardNewMacro(vtkOpenSimModelReader);
+
+namespace
+{
+using md::RigidTransform;
+namespace osim = md::osim;
+
+RigidTransform Compose(const RigidTransform& a, const RigidTransform& b)
+{
+  RigidTransform t;
+  t.rotation = a.rotation * b.rotation;
+  t.translation = a.rotation * b.translation + a.translation;
+  return t;
+}
+
+/// The motion from pose `from` to pose `to` of a body: exactly the identity where they are the
+/// same (a body that does not move does not move by rounding).
+RigidTransform Motion(const RigidTransform& to, const RigidTransform& from);
+
+RigidTransform Inverse(const RigidTransform& a)
+{
+  RigidTransform t;
+  t.rotation = a.rotation.transpose();
+  t.translation = -(t.rotation * a.translation);
+  return t;
+}
+
+RigidTransform Motion(const RigidTransform& to, const RigidTransform& from)
+{
+  if (to.rotation == from.rotation && to.translation == from.translation)
+  {
+    return RigidTransform();
+  }
+  return Compose(to, Inverse(from));
+}
+
+std::string Text(const char* s)
+{
+  return s ? std::string(s) : std::string();
+}
+
+/// A body's meshes in the body's frame, in model units.
+struct BodyMesh
+{
+  md::Points points;
+  vtkSmartPointer<vtkCellArray> polys;
+};
+
+vtkSmartPointer<vtkPolyData> ReadMeshFile(const std::string& path)
+{
+  const std::string extension = vtksys::SystemTools::LowerCase(vtksys::SystemTools::GetFilenameLastExtension(path));
+  vtkSmartPointer<vtkPolyData> mesh;
+  if (extension == ".vtp")
+  {
+    vtkNew<vtkXMLPolyDataReader> reader;
+    reader->SetFileName(path.c_str());
+    reader->Update();
+    mesh = reader->GetOutput();
+  }
+  else if (extension == ".stl")
+  {
+    vtkNew<vtkSTLReader> reader;
+    reader->SetFileName(path.c_str());
+    reader->Update();
+    mesh = reader->GetOutput();
+  }
+  else if (extension == ".obj")
+  {
+    vtkNew<vtkOBJReader> reader;
+    reader->SetFileName(path.c_str());
+    reader->Update();
+    mesh = reader->GetOutput();
+  }
+  else if (extension == ".vtk")
+  {
+    vtkNew<vtkPolyDataReader> reader;
+    reader->SetFileName(path.c_str());
+    reader->Update();
+    mesh = reader->GetOutput();
+  }
+  if (mesh && (!mesh->GetPoints() || mesh->GetNumberOfPoints() == 0))
+  {
+    mesh = nullptr;
+  }
+  return mesh;
+}
+
+void AddBlock(vtkMultiBlockDataSet* tree, const std::string& name, vtkDataObject* block)
+{
+  const unsigned int index = tree->GetNumberOfBlocks();
+  tree->SetBlock(index, block);
+  tree->GetMetaData(index)->Set(vtkCompositeDataSet::NAME(), name.c_str());
+}
+
+vtkSmartPointer<vtkStringArray> Strings(const char* name)
+{
+  auto array = vtkSmartPointer<vtkStringArray>::New();
+  array->SetName(name);
+  return array;
+}
+}
+
+struct vtkOpenSimModelReader::Internals
+{
+  std::string modelKey, motionKey, poseKey;
+  osim::Model model;
+  bool haveModel = false;
+  osim::CoordinateTrajectory trajectory; ///< empty without a motion
+  std::vector<BodyMesh> meshes;          ///< per body
+  std::vector<md::TriangleMesh> wraps;   ///< per wrap object, in its body's frame
+  std::vector<double> rest;
+  std::vector<RigidTransform> restPoses;
+  RigidTransform toOutput; ///< ground -> the reference body's rest frame, lengths not yet scaled
+};
+
+vtkOpenSimModelReader::vtkOpenSimModelReader()
+  : Internal(new Internals)
+{
+  this->SetNumberOfInputPorts(0);
+  this->SetNumberOfOutputPorts(6);
+}
+
+vtkOpenSimModelReader::~vtkOpenSimModelReader()
+{
+  this->SetFileName(nullptr);
+  this->SetMotionFileName(nullptr);
+  this->SetGeometrySearchPath(nullptr);
+  this->SetRestPoseCoordinates(nullptr);
+  this->SetReferenceBody(nullptr);
+}
+
+int vtkOpenSimModelReader::FillOutputPortInformation(int port, vtkInformation* info)
+{
+  info->Set(vtkDataObject::DATA_TYPE_NAME(), port == BODY_TRANSFORMS ? "vtkTable" : "vtkMultiBlockDataSet");
+  return 1;
+}
+
+int vtkOpenSimModelReader::GetNumberOfTimeSteps()
+{
+  return static_cast<int>(this->Internal->trajectory.times.size());
+}
+
+double vtkOpenSimModelReader::GetTimeStep(int index)
+{
+  const std::vector<double>& times = this->Internal->trajectory.times;
+  return index >= 0 && index < static_cast<int>(times.size()) ? times[index] : 0.0;
+}
+
+bool vtkOpenSimModelReader::Load()
+{
+  Internals& in = *this->Internal;
+  const std::string fileName = Text(this->FileName);
+  if (fileName.empty())
+  {
+    vtkErrorMacro(<< "no FileName: give the OpenSim model (.osim) to read");
+    return false;
+  }
+  const std::string modelKey = fileName + "|" + Text(this->GeometrySearchPath) + "|" + std::to_string(this->LoadGeometry);
+  std::vector<std::string> warnings;
+  try
+  {
+    if (!in.haveModel || modelKey != in.modelKey)
+    {
+      in.haveModel = false;
+      in.motionKey.clear();
+      in.poseKey.clear();
+      in.model = osim::ReadModel(fileName);
+      ++this->ModelReadCount;
+      warnings = in.model.warnings;
+      // Meshes: beside the model, in its Geometry/ and geometry/ folders, then the search path.
+      const std::string folder = vtksys::SystemTools::GetFilenamePath(fileName);
+      std::vector<std::string> folders = { folder, folder + "/Geometry", folder + "/geometry" };
+      std::stringstream search(Text(this->GeometrySearchPath));
+      std::string entry;
+      while (std::getline(search, entry, ';'))
+      {
+        if (!entry.empty())
+        {
+          folders.push_back(entry);
+        }
+      }
+      in.meshes.assign(in.model.bodies.size(), BodyMesh());
+      std::string missing;
+      for (size_t b = 0; b < in.model.bodies.size() && this->LoadGeometry; ++b)
+      {
+        std::vector<md::Points> parts;
+        vtkNew<vtkCellArray> polys;
+        vtkIdType offset = 0;
+        for (const osim::Geometry& g : in.model.bodies[b].geometry)
+        {
+          // Models made on Windows name files with backslashes (".\\geometry\\x.vtp"): try the
+          // name as given and its last part, in every folder.
+          std::string relative = g.file;
+          std::replace(relative.begin(), relative.end(), '\\', '/');
+          const std::string bare = vtksys::SystemTools::GetFilenameName(relative);
+          vtkSmartPointer<vtkPolyData> mesh;
+          for (const std::string& f : folders)
+          {
+            for (const std::string& name : { relative, bare })
+            {
+              const std::string path = vtksys::SystemTools::FileIsFullPath(name) ? name : f + "/" + name;
+              if (!mesh && vtksys::SystemTools::FileExists(path, true))
+              {
+                mesh = ReadMeshFile(path);
+              }
+            }
+          }
+          if (!mesh)
+          {
+            missing += (missing.empty() ? "" : ", ") + g.file + " (" + in.model.bodies[b].name + ")";
+            continue;
+          }
+          md::Points local = mdvtk::ToPoints(mesh->GetPoints());
+          local = local * g.scale.asDiagonal();
+          parts.push_back(g.placement.Apply(local));
+          vtkCellArray* cells = mesh->GetPolys();
+          const vtkIdType* ids = nullptr;
+          vtkIdType count = 0;
+          std::vector<vtkIdType> shifted;
+          for (cells->InitTraversal(); cells->GetNextCell(count, ids);)
+          {
+            shifted.assign(ids, ids + count);
+            for (vtkIdType& id : shifted)
+            {
+              id += offset;
+            }
+            polys->InsertNextCell(count, shifted.data());
+          }
+          offset += local.rows();
+        }
+        BodyMesh& target = in.meshes[b];
+        target.points.resize(offset, 3);
+        vtkIdType row = 0;
+        for (const md::Points& p : parts)
+        {
+          target.points.middleRows(row, p.rows()) = p;
+          row += p.rows();
+        }
+        target.polys = polys;
+      }
+      if (!missing.empty())
+      {
+        warnings.push_back("mesh files not found (the bodies still move): " + missing);
+      }
+      in.wraps.clear();
+      for (const osim::WrapObject& w : in.model.wrapObjects)
+      {
+        in.wraps.push_back(osim::WrapSurface(w));
+      }
+      std::string wrapped;
+      for (const osim::Path& p : in.model.paths)
+      {
+        if (!p.wrapObjects.empty())
+        {
+          wrapped += (wrapped.empty() ? "" : ", ") + p.name;
+        }
+      }
+      if (!wrapped.empty())
+      {
+        warnings.push_back("paths are not wrapped yet: these muscles have wrap objects and are drawn as "
+                           "straight polylines through their path points: " + wrapped);
+      }
+      in.modelKey = modelKey;
+      in.haveModel = true;
+    }
+    const std::string motionKey = Text(this->MotionFileName) + "|" + std::to_string(this->AngleUnit) + "|" +
+      std::to_string(this->IgnoreUnknownColumns);
+    if (motionKey != in.motionKey)
+    {
+      in.trajectory = osim::CoordinateTrajectory();
+      in.motionKey.clear();
+      if (!Text(this->MotionFileName).empty())
+      {
+        osim::MotionOptions options;
+        options.angles = this->AngleUnit == ANGLES_IN_DEGREES ? osim::AngleUnit::Degrees
+          : this->AngleUnit == ANGLES_IN_RADIANS             ? osim::AngleUnit::Radians
+                                                             : osim::AngleUnit::FromFile;
+        options.ignoreUnknownColumns = this->IgnoreUnknownColumns;
+        in.trajectory = osim::MapMotion(in.model, osim::ReadMotion(this->MotionFileName), options);
+        warnings.insert(warnings.end(), in.trajectory.warnings.begin(), in.trajectory.warnings.end());
+      }
+      in.motionKey = motionKey;
+    }
+    const std::string poseKey = Text(this->RestPoseCoordinates) + "|" + Text(this->ReferenceBody);
+    if (poseKey != in.poseKey)
+    {
+      in.poseKey.clear();
+      in.rest = osim::DefaultCoordinates(in.model);
+      osim::SetCoordinates(in.model, Text(this->RestPoseCoordinates), true, in.rest);
+      in.restPoses = osim::BodyPoses(in.model, in.rest);
+      in.toOutput = RigidTransform();
+      const std::string reference = Text(this->ReferenceBody);
+      if (!reference.empty())
+      {
+        const int body = in.model.FindBody(reference);
+        if (body < 0)
+        {
+          throw md::InputError("ReferenceBody '" + reference + "' is not a body of the model");
+        }
+        in.toOutput = Inverse(in.restPoses[body]);
+      }
+      in.poseKey = poseKey;
+    }
+  }
+  catch (const md::InputError& e)
+  {
+    vtkErrorMacro(<< e.what());
+    return false;
+  }
+  catch (const std::exception& e)
+  {
+    vtkErrorMacro(<< "reading '" << fileName << "' failed: " << e.what());
+    return false;
+  }
+  for (const std::string& w : warnings)
+  {
+    vtkWarningMacro(<< "OpenSim model '" << fileName << "': " << w);
+  }
+  return true;
+}
+
+int vtkOpenSimModelReader::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  if (!this->Load())
+  {
+    return 0;
+  }
+  static const std::vector<double> none;
+  const std::vector<double>& times = this->PlayMotion ? this->Internal->trajectory.times : none;
+  for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
+  {
+    vtkInformation* info = outputVector->GetInformationObject(port);
+    info->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+    info->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+    if (!times.empty())
+    {
+      info->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
+      const double range[2] = { times.front(), times.back() };
+      info->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+    }
+  }
+  return 1;
+}
+
+int vtkOpenSimModelReader::RequestData(
+  vtkInformation* request, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  if (!this->Load())
+  {
+    return 0;
+  }
+  const Internals& in = *this->Internal;
+  const osim::Model& model = in.model;
+  // The frame nearest the requested time.
+  std::vector<double> q = in.rest;
+  double time = 0.0;
+  if (!in.trajectory.times.empty())
+  {
+    const std::vector<double>& times = in.trajectory.times;
+    // The time asked for on the port whose request this is (the other ports keep older times).
+    int port = request->Has(vtkDemandDrivenPipeline::FROM_OUTPUT_PORT())
+      ? request->Get(vtkDemandDrivenPipeline::FROM_OUTPUT_PORT())
+      : 0;
+    port = port < 0 || port >= this->GetNumberOfOutputPorts() ? 0 : port;
+    vtkInformation* info = outputVector->GetInformationObject(port);
+    double requested = this->CurrentPoseTime;
+    if (this->PlayMotion && info->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
+    {
+      requested = info->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+    }
+    size_t k = static_cast<size_t>(std::lower_bound(times.begin(), times.end(), requested) - times.begin());
+    if (k == times.size() || (k > 0 && requested - times[k - 1] < times[k] - requested))
+    {
+      k = k == 0 ? 0 : k - 1;
+    }
+    q = in.trajectory.frames[k];
+    time = times[k];
+  }
+  const std::vector<RigidTransform> poses = osim::BodyPoses(model, q);
+  const double scale = this->Scale;
+  // Body frame -> output frame (scaled separately).
+  auto placed = [&](const std::vector<RigidTransform>& p, size_t body) { return Compose(in.toOutput, p[body]); };
+  auto toOutput = [&](const RigidTransform& t, const md::Points& local) {
+    md::Points out = t.Apply(local);
+    out *= scale;
+    return out;
+  };
+
+  auto bodies = [&](const std::vector<RigidTransform>& p, vtkMultiBlockDataSet* tree) {
+    for (size_t b = 0; b < model.bodies.size(); ++b)
+    {
+      if (b == 0 && model.bodies[0].geometry.empty())
+      {
+        continue;
+      }
+      auto block = vtkSmartPointer<vtkPolyData>::New();
+      const BodyMesh& mesh = in.meshes[b];
+      if (mesh.points.rows() > 0)
+      {
+        block->SetPoints(mdvtk::ToVtkPoints(toOutput(placed(p, b), mesh.points)));
+        block->SetPolys(mesh.polys);
+      }
+      // Rest to this pose, in the output frame and units.
+      const RigidTransform motion = Motion(placed(p, b), placed(in.restPoses, b));
+      vtkNew<vtkDoubleArray> transform;
+      transform->SetName("RestToCurrentTransform");
+      transform->SetNumberOfComponents(12);
+      double values[12];
+      for (int i = 0; i < 9; ++i)
+      {
+        values[i] = motion.rotation(i / 3, i % 3);
+      }
+      for (int i = 0; i < 3; ++i)
+      {
+        values[9 + i] = scale * motion.translation[i];
+      }
+      transform->InsertNextTuple(values);
+      block->GetFieldData()->AddArray(transform);
+      AddBlock(tree, model.bodies[b].name, block);
+    }
+  };
+  auto paths = [&](const std::vector<double>& coordinates, const std::vector<RigidTransform>& p,
+                 vtkMultiBlockDataSet* tree) {
+    for (const osim::Path& path : model.paths)
+    {
+      const osim::PathGeometry g = osim::PathAt(model, path, coordinates, p);
+      md::Points points = g.points;
+      for (Eigen::Index i = 0; i < points.rows(); ++i)
+      {
+        points.row(i) = scale * in.toOutput.Apply(Eigen::Vector3d(points.row(i).transpose())).transpose();
+      }
+      auto block = vtkSmartPointer<vtkPolyData>::New();
+      block->SetPoints(mdvtk::ToVtkPoints(points));
+      vtkNew<vtkCellArray> line;
+      line->InsertNextCell(static_cast<vtkIdType>(points.rows()));
+      auto names = Strings("PathPointName"), onBody = Strings("PathPointBody"), lineName = Strings("ActionLineName");
+      for (Eigen::Index i = 0; i < points.rows(); ++i)
+      {
+        line->InsertCellPoint(i);
+        const osim::PathPoint& point = path.points[g.pointIndex[i]];
+        names->InsertNextValue(point.name);
+        onBody->InsertNextValue(model.bodies[point.body].name);
+      }
+      lineName->InsertNextValue(path.name);
+      block->SetLines(line);
+      block->GetPointData()->AddArray(names);
+      block->GetPointData()->AddArray(onBody);
+      block->GetCellData()->AddArray(lineName);
+      mdvtk::AddFieldValue(block->GetFieldData(), "PathLength", scale * osim::PolylineLength(g.points));
+      AddBlock(tree, path.name, block);
+    }
+  };
+
+  bodies(poses, vtkMultiBlockDataSet::GetData(outputVector, BODIES));
+  bodies(in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, BODIES_REST));
+  paths(q, poses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS));
+  paths(in.rest, in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS_REST));
+
+  vtkMultiBlockDataSet* wraps = vtkMultiBlockDataSet::GetData(outputVector, WRAP_OBJECTS);
+  for (size_t w = 0; w < model.wrapObjects.size(); ++w)
+  {
+    md::TriangleMesh mesh = in.wraps[w];
+    mesh.points = toOutput(placed(poses, model.wrapObjects[w].body), mesh.points);
+    AddBlock(wraps, model.wrapObjects[w].name, mdvtk::ToPolyData(mesh));
+  }
+
+  vtkTable* table = vtkTable::GetData(outputVector, BODY_TRANSFORMS);
+  auto bodyNames = Strings("Body");
+  table->AddColumn(bodyNames);
+  std::vector<vtkSmartPointer<vtkDoubleArray>> columns;
+  static const char* names[12] = { "R00", "R01", "R02", "R10", "R11", "R12", "R20", "R21", "R22", "Tx", "Ty", "Tz" };
+  for (const char* name : names)
+  {
+    auto column = vtkSmartPointer<vtkDoubleArray>::New();
+    column->SetName(name);
+    table->AddColumn(column);
+    columns.push_back(column);
+  }
+  for (size_t b = 0; b < model.bodies.size(); ++b)
+  {
+    const RigidTransform motion = Motion(placed(poses, b), placed(in.restPoses, b));
+    bodyNames->InsertNextValue(model.bodies[b].name);
+    for (int i = 0; i < 9; ++i)
+    {
+      columns[i]->InsertNextValue(motion.rotation(i / 3, i % 3));
+    }
+    for (int i = 0; i < 3; ++i)
+    {
+      columns[9 + i]->InsertNextValue(scale * motion.translation[i]);
+    }
+  }
+
+  mdvtk::AddFieldValue(table->GetFieldData(), "Time", time);
+  for (size_t c = 0; c < model.coordinates.size(); ++c)
+  {
+    const bool rotational = model.coordinates[c].motionType == osim::MotionType::Rotational;
+    mdvtk::AddFieldValue(table->GetFieldData(), model.coordinates[c].name.c_str(), rotational ? q[c] * 180.0 / M_PI : q[c]);
+  }
+  if (this->PlayMotion && !in.trajectory.times.empty())
+  {
+    for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
+    {
+      vtkDataObject* output = outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT());
+      output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), time);
+    }
+  }
+  return 1;
+}
+
+void vtkOpenSimModelReader::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "FileName: " << Text(this->FileName) << "\n";
+  os << indent << "MotionFileName: " << Text(this->MotionFileName) << "\n";
+  os << indent << "GeometrySearchPath: " << Text(this->GeometrySearchPath) << "\n";
+  os << indent << "RestPoseCoordinates: " << Text(this->RestPoseCoordinates) << "\n";
+  os << indent << "ReferenceBody: " << Text(this->ReferenceBody) << "\n";
+  os << indent << "Scale: " << this->Scale << "\n";
+  os << indent << "CurrentPoseTime: " << this->CurrentPoseTime << "\n";
+  os << indent << "PlayMotion: " << this->PlayMotion << "\n";
+  os << indent << "AngleUnit: " << this->AngleUnit << "\n";
+  os << indent << "IgnoreUnknownColumns: " << this->IgnoreUnknownColumns << "\n";
+  os << indent << "LoadGeometry: " << this->LoadGeometry << "\n";
+}

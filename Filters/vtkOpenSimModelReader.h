@@ -1,0 +1,141 @@
+/**
+ * @class   vtkOpenSimModelReader
+ * @brief   Reads an OpenSim model (.osim) and, optionally, a motion (.mot/.sto): bodies, muscle
+ *          paths, body transforms and wrap objects in the rest pose and at the current time.
+ *
+ * Forward kinematics of the model's coordinates (OpenSim 3.x and 4.x files; CustomJoint and the
+ * other joint types; SimmSpline and the other functions; conditional and moving path points;
+ * coordinate couplers). The motion's times (seconds) are advertised as time steps.
+ *
+ * Output ports (each but 4 a vtkMultiBlockDataSet of named vtkPolyData blocks):
+ * 0 Bodies at the current time (one block per body, its mesh files; field data
+ *   RestToCurrentTransform), 1 MusclePaths at the current time (one polyline per muscle; point
+ *   data PathPointName, PathPointBody), 2 BodiesRest, 3 MusclePathsRest, 4 BodyTransforms (a
+ *   vtkTable: each body's rigid transform from the rest pose to the current time, x_CP = R x_RP +
+ *   t), 5 WrapObjects at the current time.
+ *
+ * Every output is in the frame that ReferenceBody has at the rest pose (ground when empty), in
+ * the model's units times Scale (1000: millimetres for a model in metres), so that surfaces
+ * scanned in that body's frame, in the rest pose, lie where the model's bodies do.
+ */
+#pragma once
+
+#include "MuscleDeformationFiltersModule.h"
+
+#include <vtkMultiBlockDataSetAlgorithm.h>
+
+#include <memory>
+#include <string>
+
+class MUSCLEDEFORMATIONFILTERS_EXPORT vtkOpenSimModelReader : public vtkMultiBlockDataSetAlgorithm
+{
+public:
+  static vtkOpenSimModelReader* New();
+  vtkTypeMacro(vtkOpenSimModelReader, vtkMultiBlockDataSetAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  enum OutputPorts
+  {
+    BODIES = 0,
+    MUSCLE_PATHS = 1,
+    BODIES_REST = 2,
+    MUSCLE_PATHS_REST = 3,
+    BODY_TRANSFORMS = 4,
+    WRAP_OBJECTS = 5
+  };
+
+  enum AngleUnits
+  {
+    ANGLES_AS_FILE_SAYS = 0,
+    ANGLES_IN_DEGREES = 1,
+    ANGLES_IN_RADIANS = 2
+  };
+
+  /// The .osim file.
+  vtkGetStringMacro(FileName);
+  vtkSetStringMacro(FileName);
+
+  /// The motion (.mot or .sto); none: the model stands in its rest pose.
+  vtkGetStringMacro(MotionFileName);
+  vtkSetStringMacro(MotionFileName);
+
+  /// Further folders to search for mesh files (separated by ';'), after the model's folder and
+  /// its Geometry/ and geometry/ subfolders.
+  vtkGetStringMacro(GeometrySearchPath);
+  vtkSetStringMacro(GeometrySearchPath);
+
+  /// Coordinates of the rest pose, "name=value ..." (rotational ones in degrees); the others keep
+  /// their default values.
+  vtkGetStringMacro(RestPoseCoordinates);
+  vtkSetStringMacro(RestPoseCoordinates);
+
+  /// The body whose rest-pose frame the outputs are expressed in; empty: ground.
+  vtkGetStringMacro(ReferenceBody);
+  vtkSetStringMacro(ReferenceBody);
+
+  /// Multiplies every length (1000: millimetres for a model in metres). Default 1.
+  vtkSetClampMacro(Scale, double, 1e-9, 1e9);
+  vtkGetMacro(Scale, double);
+
+  /// How the motion's angles are read. Default: as the file says.
+  vtkSetClampMacro(AngleUnit, int, ANGLES_AS_FILE_SAYS, ANGLES_IN_RADIANS);
+  vtkGetMacro(AngleUnit, int);
+
+  /// Skip motion columns that name no coordinate of the model (with a warning) instead of failing.
+  vtkSetMacro(IgnoreUnknownColumns, bool);
+  vtkGetMacro(IgnoreUnknownColumns, bool);
+  vtkBooleanMacro(IgnoreUnknownColumns, bool);
+
+  /// The motion time (seconds) of the current pose when the pipeline asks for no time: for
+  /// filters that advertise time steps of their own, such as InterpolatedMuscleDeformation.
+  /// The frame nearest to it is used. Default 0 (the first frame).
+  vtkSetMacro(CurrentPoseTime, double);
+  vtkGetMacro(CurrentPoseTime, double);
+
+  /// Play the motion: advertise its times as time steps and show the frame of the animation time.
+  /// Off: no time steps; the outputs hold the pose at CurrentPoseTime (a fixed current pose for
+  /// the interpolation method). Default on.
+  vtkSetMacro(PlayMotion, bool);
+  vtkGetMacro(PlayMotion, bool);
+  vtkBooleanMacro(PlayMotion, bool);
+
+  /// Read the bodies' mesh files. Default on.
+  vtkSetMacro(LoadGeometry, bool);
+  vtkGetMacro(LoadGeometry, bool);
+  vtkBooleanMacro(LoadGeometry, bool);
+
+  /// Times of the motion (seconds), after RequestInformation.
+  int GetNumberOfTimeSteps();
+  double GetTimeStep(int index);
+  /// How many times the model file was read (a change of time does not read it again).
+  vtkGetMacro(ModelReadCount, int);
+
+protected:
+  vtkOpenSimModelReader();
+  ~vtkOpenSimModelReader() override;
+
+  int FillOutputPortInformation(int port, vtkInformation* info) override;
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  char* FileName = nullptr;
+  char* MotionFileName = nullptr;
+  char* GeometrySearchPath = nullptr;
+  char* RestPoseCoordinates = nullptr;
+  char* ReferenceBody = nullptr;
+  double Scale = 1.0;
+  double CurrentPoseTime = 0.0;
+  bool PlayMotion = true;
+  int AngleUnit = ANGLES_AS_FILE_SAYS;
+  bool IgnoreUnknownColumns = false;
+  bool LoadGeometry = true;
+  int ModelReadCount = 0;
+
+private:
+  vtkOpenSimModelReader(const vtkOpenSimModelReader&) = delete;
+  void operator=(const vtkOpenSimModelReader&) = delete;
+
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
+  bool Load(); ///< (re)reads what changed; reports and returns false on failure
+};

@@ -1,0 +1,125 @@
+// OpenSim models: loading and updating to a new time, in the core and through the reader
+// (vtkOpenSimModelReader, as ParaView runs it), on gait2392 (23 coordinates, 92 muscles, 20
+// meshes) and the other models of ../shared/data/opensim. Prints figures; asserts nothing.
+//
+//   BenchmarkOpenSim [data folder]
+#include "OpenSimKinematics.h"
+#include "OpenSimMotion.h"
+#include "RealData.h"
+#include "vtkOpenSimModelReader.h"
+
+#include <vtkInformation.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <vector>
+
+namespace
+{
+double Seconds(std::chrono::steady_clock::time_point since)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+double Median(std::vector<double> values)
+{
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+void Measure(const std::string& label, const std::string& model, const std::string& motion)
+{
+  namespace osim = md::osim;
+  // Core: read, map the motion, then bodies and every path at each frame.
+  std::vector<double> reads;
+  osim::Model parsed;
+  for (int run = 0; run < 5; ++run)
+  {
+    const auto start = std::chrono::steady_clock::now();
+    parsed = osim::ReadModel(model);
+    reads.push_back(Seconds(start));
+  }
+  osim::MotionOptions options;
+  options.ignoreUnknownColumns = true;
+  const osim::CoordinateTrajectory trajectory = osim::MapMotion(parsed, osim::ReadMotion(motion), options);
+  std::vector<double> frames;
+  for (int run = 0; run < 5; ++run)
+  {
+    const auto start = std::chrono::steady_clock::now();
+    double total = 0;
+    for (const std::vector<double>& q : trajectory.frames)
+    {
+      const std::vector<md::RigidTransform> poses = osim::BodyPoses(parsed, q);
+      for (const osim::Path& path : parsed.paths)
+      {
+        total += osim::PolylineLength(osim::PathAt(parsed, path, q, poses).points);
+      }
+    }
+    frames.push_back(Seconds(start) / trajectory.frames.size());
+    if (total < 0)
+    {
+      std::printf("impossible\n");
+    }
+  }
+  // The reader: first update (model, motion, meshes), then the bodies and paths at every time.
+  std::vector<double> loads, updates;
+  for (int run = 0; run < 3; ++run)
+  {
+    vtkNew<vtkOpenSimModelReader> reader;
+    reader->SetFileName(model.c_str());
+    reader->SetMotionFileName(motion.c_str());
+    reader->IgnoreUnknownColumnsOn();
+    auto start = std::chrono::steady_clock::now();
+    reader->Update();
+    loads.push_back(Seconds(start));
+    start = std::chrono::steady_clock::now();
+    for (double time : trajectory.times)
+    {
+      for (int port : { vtkOpenSimModelReader::BODIES, vtkOpenSimModelReader::MUSCLE_PATHS })
+      {
+        reader->GetOutputInformation(port)->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(), time);
+        reader->Update(port);
+      }
+    }
+    updates.push_back(Seconds(start) / trajectory.times.size());
+  }
+  std::printf("%-16s %3zu bodies %2zu coordinates %3zu paths %4zu frames | core: read %.1f ms, bodies + paths "
+              "%.3f ms a frame | reader: load %.0f ms (meshes included), update to a new time (bodies and "
+              "paths) %.2f ms (medians)\n",
+    label.c_str(), parsed.bodies.size(), parsed.coordinates.size(), parsed.paths.size(), trajectory.frames.size(),
+    1e3 * Median(reads), 1e3 * Median(frames), 1e3 * Median(loads), 1e3 * Median(updates));
+}
+}
+
+int main(int argc, char** argv)
+{
+  const std::string folder = argc > 1 ? argv[1] : "";
+  struct Case
+  {
+    const char* label;
+    const char* model;
+    const char* motion;
+  };
+  const Case cases[] = {
+    { "gait2392", "opensim/gait2392_walk_forward/subject01_simbody_adjusted.osim",
+      "opensim/gait2392_walk_forward/subject01_walk1_Kinematics_q.mot" },
+    { "gait10dof18musc", "opensim/gait10dof18musc_walk/walk_gait1018_subject01.osim",
+      "opensim/gait10dof18musc_walk/walk_gait1018_state_reference.mot" },
+    { "rajagopal2016", "opensim/rajagopal2016_walk_armless_18musc/subject_walk_armless_18musc.osim",
+      "opensim/rajagopal2016_walk_armless_18musc/subject_walk_armless_coordinates.mot" },
+    { "LHDL hip", "lhdl_hip_r/LHDL_hip_r.osim", "lhdl_hip_r/kinematics/hip_flexion.mot" },
+  };
+  for (const Case& c : cases)
+  {
+    const std::string model = RealDataFile(c.model, folder), motion = RealDataFile(c.motion, folder);
+    if (model.empty() || motion.empty())
+    {
+      std::printf("%-16s skipped: %s not found (give the data folder or set MUSCLEDEFORMATION_DATA_DIR)\n", c.label, c.model);
+      continue;
+    }
+    Measure(c.label, model, motion);
+  }
+  return 0;
+}
