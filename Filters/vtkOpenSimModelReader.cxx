@@ -33,36 +33,20 @@ vtkStandardNewMacro(vtkOpenSimModelReader);
 
 namespace
 {
+using md::Compose;
+using md::Inverse;
 using md::RigidTransform;
 namespace osim = md::osim;
 
-RigidTransform Compose(const RigidTransform& a, const RigidTransform& b)
-{
-  RigidTransform t;
-  t.rotation = a.rotation * b.rotation;
-  t.translation = a.rotation * b.translation + a.translation;
-  return t;
-}
-
 /// The motion from pose `from` to pose `to` of a body: exactly the identity where they are the
 /// same (a body that does not move does not move by rounding).
-RigidTransform Motion(const RigidTransform& to, const RigidTransform& from);
-
-RigidTransform Inverse(const RigidTransform& a)
-{
-  RigidTransform t;
-  t.rotation = a.rotation.transpose();
-  t.translation = -(t.rotation * a.translation);
-  return t;
-}
-
 RigidTransform Motion(const RigidTransform& to, const RigidTransform& from)
 {
   if (to.rotation == from.rotation && to.translation == from.translation)
   {
     return RigidTransform();
   }
-  return Compose(to, Inverse(from));
+  return md::Compose(to, md::Inverse(from));
 }
 
 std::string Text(const char* s)
@@ -77,38 +61,24 @@ struct BodyMesh
   vtkSmartPointer<vtkCellArray> polys;
 };
 
+template <typename Reader>
+vtkSmartPointer<vtkPolyData> ReadWith(const std::string& path)
+{
+  vtkNew<Reader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  return reader->GetOutput();
+}
+
+/// A mesh file (.vtp, .stl, .obj, .vtk); null when it cannot be read or has no points.
 vtkSmartPointer<vtkPolyData> ReadMeshFile(const std::string& path)
 {
   const std::string extension = vtksys::SystemTools::LowerCase(vtksys::SystemTools::GetFilenameLastExtension(path));
-  vtkSmartPointer<vtkPolyData> mesh;
-  if (extension == ".vtp")
-  {
-    vtkNew<vtkXMLPolyDataReader> reader;
-    reader->SetFileName(path.c_str());
-    reader->Update();
-    mesh = reader->GetOutput();
-  }
-  else if (extension == ".stl")
-  {
-    vtkNew<vtkSTLReader> reader;
-    reader->SetFileName(path.c_str());
-    reader->Update();
-    mesh = reader->GetOutput();
-  }
-  else if (extension == ".obj")
-  {
-    vtkNew<vtkOBJReader> reader;
-    reader->SetFileName(path.c_str());
-    reader->Update();
-    mesh = reader->GetOutput();
-  }
-  else if (extension == ".vtk")
-  {
-    vtkNew<vtkPolyDataReader> reader;
-    reader->SetFileName(path.c_str());
-    reader->Update();
-    mesh = reader->GetOutput();
-  }
+  vtkSmartPointer<vtkPolyData> mesh = extension == ".vtp" ? ReadWith<vtkXMLPolyDataReader>(path)
+    : extension == ".stl"                               ? ReadWith<vtkSTLReader>(path)
+    : extension == ".obj"                               ? ReadWith<vtkOBJReader>(path)
+    : extension == ".vtk"                               ? ReadWith<vtkPolyDataReader>(path)
+                                                        : nullptr;
   if (mesh && (!mesh->GetPoints() || mesh->GetNumberOfPoints() == 0))
   {
     mesh = nullptr;

@@ -34,6 +34,18 @@ void CheckKnots(const std::vector<double>& x, const std::vector<double>& y, cons
   }
 }
 
+/// Knot spacing h_i = x_i+1 - x_i and the slope of each span.
+void Spans(const std::vector<double>& x, const std::vector<double>& y, std::vector<double>& h, std::vector<double>& slope)
+{
+  h.resize(x.size() - 1);
+  slope.resize(x.size() - 1);
+  for (size_t i = 0; i + 1 < x.size(); ++i)
+  {
+    h[i] = x[i + 1] - x[i];
+    slope[i] = (y[i + 1] - y[i]) / h[i];
+  }
+}
+
 /// Solves the tridiagonal system with diagonal `diagonal`, symmetric off-diagonal `off`
 /// (off[i] couples unknowns i and i+1) and right-hand side `rhs`, in place (Thomas algorithm).
 void SolveTridiagonal(std::vector<double>& diagonal, const std::vector<double>& off, std::vector<double>& rhs)
@@ -90,34 +102,34 @@ Function Function::Multiplier(const Function& inner, double scale)
   return f;
 }
 
-Function Function::PiecewiseLinear(std::vector<double> x, std::vector<double> y)
+Function Function::WithKnots(Kind kind, std::vector<double> x, std::vector<double> y)
 {
-  CheckKnots(x, y, "PiecewiseLinearFunction");
+  CheckKnots(x, y, KindName(kind));
   Function f;
-  f.kind = Kind::PiecewiseLinear;
-  const size_t n = x.size();
-  f.b.assign(n, 0.0);
-  f.c.assign(n, 0.0);
-  f.d.assign(n, 0.0);
-  for (size_t i = 0; i + 1 < n; ++i)
-  {
-    f.b[i] = (y[i + 1] - y[i]) / (x[i + 1] - x[i]);
-  }
-  f.b[n - 1] = f.b[n - 2];
+  f.kind = kind;
+  f.b.assign(x.size(), 0.0);
+  f.c.assign(x.size(), 0.0);
+  f.d.assign(x.size(), 0.0);
   f.x = std::move(x);
   f.y = std::move(y);
   return f;
 }
 
-Function Function::SimmSpline(std::vector<double> x, std::vector<double> y)
+Function Function::PiecewiseLinear(std::vector<double> knotsX, std::vector<double> knotsY)
 {
-  CheckKnots(x, y, "SimmSpline");
-  Function f;
-  f.kind = Kind::SimmSpline;
+  Function f = WithKnots(Kind::PiecewiseLinear, std::move(knotsX), std::move(knotsY));
+  std::vector<double> h;
+  Spans(f.x, f.y, h, f.b);
+  f.b.push_back(f.b.back());
+  return f;
+}
+
+Function Function::SimmSpline(std::vector<double> knotsX, std::vector<double> knotsY)
+{
+  Function f = WithKnots(Kind::SimmSpline, std::move(knotsX), std::move(knotsY));
+  const std::vector<double>& x = f.x;
+  const std::vector<double>& y = f.y;
   const size_t n = x.size();
-  f.b.assign(n, 0.0);
-  f.c.assign(n, 0.0);
-  f.d.assign(n, 0.0);
   if (n == 2)
   {
     f.b[0] = f.b[1] = (y[1] - y[0]) / (x[1] - x[0]);
@@ -126,12 +138,8 @@ Function Function::SimmSpline(std::vector<double> x, std::vector<double> y)
   {
     // sigma_i = s''(x_i) / 6 from the continuity of the first derivative at the inner knots and,
     // at the ends, third derivatives equal to those of the cubics through the end four knots.
-    std::vector<double> h(n - 1), slope(n - 1);
-    for (size_t i = 0; i + 1 < n; ++i)
-    {
-      h[i] = x[i + 1] - x[i];
-      slope[i] = (y[i + 1] - y[i]) / h[i];
-    }
+    std::vector<double> h, slope;
+    Spans(x, y, h, slope);
     std::vector<double> diagonal(n), sigma(n, 0.0);
     diagonal[0] = -h[0];
     diagonal[n - 1] = -h[n - 2];
@@ -159,26 +167,17 @@ Function Function::SimmSpline(std::vector<double> x, std::vector<double> y)
     f.c[n - 1] = 3.0 * sigma[n - 1];
     f.d[n - 1] = f.d[n - 2];
   }
-  f.x = std::move(x);
-  f.y = std::move(y);
   return f;
 }
 
-Function Function::NaturalCubicSpline(std::vector<double> x, std::vector<double> y)
+Function Function::NaturalCubicSpline(std::vector<double> knotsX, std::vector<double> knotsY)
 {
-  CheckKnots(x, y, "NaturalCubicSpline");
-  Function f;
-  f.kind = Kind::NaturalCubicSpline;
+  Function f = WithKnots(Kind::NaturalCubicSpline, std::move(knotsX), std::move(knotsY));
+  const std::vector<double>& x = f.x;
+  const std::vector<double>& y = f.y;
   const size_t n = x.size();
-  f.b.assign(n, 0.0);
-  f.c.assign(n, 0.0);
-  f.d.assign(n, 0.0);
-  std::vector<double> h(n - 1), slope(n - 1);
-  for (size_t i = 0; i + 1 < n; ++i)
-  {
-    h[i] = x[i + 1] - x[i];
-    slope[i] = (y[i + 1] - y[i]) / h[i];
-  }
+  std::vector<double> h, slope;
+  Spans(x, y, h, slope);
   // Second derivatives m_i, zero at both ends; the inner ones from a tridiagonal system.
   std::vector<double> m(n, 0.0);
   if (n > 2)
@@ -204,8 +203,6 @@ Function Function::NaturalCubicSpline(std::vector<double> x, std::vector<double>
   }
   const size_t last = n - 2;
   f.b[n - 1] = f.b[last] + 2.0 * f.c[last] * h[last] + 3.0 * f.d[last] * h[last] * h[last];
-  f.x = std::move(x);
-  f.y = std::move(y);
   return f;
 }
 

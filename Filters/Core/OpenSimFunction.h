@@ -52,6 +52,8 @@ public:
 
 private:
   Function() = default;
+  /// A function of `kind` on checked knots, with zero cubic pieces to fill in.
+  static Function WithKnots(Kind kind, std::vector<double> x, std::vector<double> y);
   double EvaluateSpline(double x) const;
 
   Kind kind = Kind::Constant;

@@ -42,15 +42,8 @@ std::vector<RigidTransform> BodyPoses(const Model& model, const std::vector<doub
     mobiliser.translation =
       value[3] * joint.axes[3].axis + value[4] * joint.axes[4].axis + value[5] * joint.axes[5].axis;
     // child-in-ground = parent-in-ground * parentOffset * mobiliser * inverse(childOffset)
-    const RigidTransform& parent = poses[joint.parentBody];
-    Eigen::Matrix3d rotation = parent.rotation * joint.parentOffset.rotation * mobiliser.rotation;
-    Eigen::Vector3d translation = parent.rotation * (joint.parentOffset.rotation * mobiliser.translation +
-                                                      joint.parentOffset.translation) +
-      parent.translation;
-    const Eigen::Matrix3d childInverse = joint.childOffset.rotation.transpose();
-    RigidTransform& child = poses[joint.childBody];
-    child.rotation = rotation * childInverse;
-    child.translation = translation - child.rotation * joint.childOffset.translation;
+    poses[joint.childBody] =
+      Compose(Compose(poses[joint.parentBody], Compose(joint.parentOffset, mobiliser)), Inverse(joint.childOffset));
   }
   return poses;
 }

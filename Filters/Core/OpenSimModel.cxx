@@ -13,40 +13,35 @@
 
 namespace md::osim
 {
-int Model::FindBody(const std::string& bodyName) const
+namespace
 {
-  for (size_t i = 0; i < this->bodies.size(); ++i)
+template <typename Item>
+int IndexOfName(const std::vector<Item>& items, const std::string& name)
+{
+  for (size_t i = 0; i < items.size(); ++i)
   {
-    if (this->bodies[i].name == bodyName)
+    if (items[i].name == name)
     {
       return static_cast<int>(i);
     }
   }
   return -1;
+}
+}
+
+int Model::FindBody(const std::string& bodyName) const
+{
+  return IndexOfName(this->bodies, bodyName);
 }
 
 int Model::FindCoordinate(const std::string& coordinateName) const
 {
-  for (size_t i = 0; i < this->coordinates.size(); ++i)
-  {
-    if (this->coordinates[i].name == coordinateName)
-    {
-      return static_cast<int>(i);
-    }
-  }
-  return -1;
+  return IndexOfName(this->coordinates, coordinateName);
 }
 
 int Model::FindPath(const std::string& pathName) const
 {
-  for (size_t i = 0; i < this->paths.size(); ++i)
-  {
-    if (this->paths[i].name == pathName)
-    {
-      return static_cast<int>(i);
-    }
-  }
-  return -1;
+  return IndexOfName(this->paths, pathName);
 }
 
 namespace
@@ -268,14 +263,6 @@ RigidTransform Offset(const Eigen::Vector3d& translation, const Eigen::Vector3d&
   RigidTransform t;
   t.rotation = BodyFixedXYZ(orientation);
   t.translation = translation;
-  return t;
-}
-
-RigidTransform Compose(const RigidTransform& a, const RigidTransform& b)
-{
-  RigidTransform t;
-  t.rotation = a.rotation * b.rotation;
-  t.translation = a.rotation * b.translation + a.translation;
   return t;
 }
 
@@ -693,6 +680,12 @@ private:
       j.axes[axis].function = Function::Linear(1.0, 0.0);
       this->model.coordinates[coordinates[coordinate]].motionType = motion;
     };
+    // Pin and planar joints turn about the joint frame's z.
+    auto rotateAboutZFirst = [&]() {
+      j.axes[0].axis = Eigen::Vector3d::UnitZ();
+      j.axes[1].axis = Eigen::Vector3d::UnitX();
+      j.axes[2].axis = Eigen::Vector3d::UnitY();
+    };
     if (type == "CustomJoint")
     {
       this->ReadSpatialTransform(joint, j, coordinates);
@@ -700,9 +693,7 @@ private:
     else if (type == "PinJoint")
     {
       needs(1);
-      j.axes[0].axis = Eigen::Vector3d::UnitZ();
-      j.axes[1].axis = Eigen::Vector3d::UnitX();
-      j.axes[2].axis = Eigen::Vector3d::UnitY();
+      rotateAboutZFirst();
       drive(0, 0, MotionType::Rotational);
     }
     else if (type == "WeldJoint")
@@ -731,9 +722,7 @@ private:
     else if (type == "PlanarJoint")
     {
       needs(3);
-      j.axes[0].axis = Eigen::Vector3d::UnitZ();
-      j.axes[1].axis = Eigen::Vector3d::UnitX();
-      j.axes[2].axis = Eigen::Vector3d::UnitY();
+      rotateAboutZFirst();
       drive(0, 0, MotionType::Rotational);
       drive(3, 1, MotionType::Translational);
       drive(4, 2, MotionType::Translational);

@@ -7,6 +7,22 @@
 
 namespace md
 {
+RigidTransform Compose(const RigidTransform& a, const RigidTransform& b)
+{
+  RigidTransform t;
+  t.rotation = a.rotation * b.rotation;
+  t.translation = a.rotation * b.translation + a.translation;
+  return t;
+}
+
+RigidTransform Inverse(const RigidTransform& t)
+{
+  RigidTransform inverse;
+  inverse.rotation = t.rotation.transpose();
+  inverse.translation = -(inverse.rotation * t.translation);
+  return inverse;
+}
+
 Points RigidTransform::Apply(const Points& points) const
 {
   Points out = points * this->rotation.transpose();

@@ -20,6 +20,11 @@ struct RigidTransform
     const Eigen::Vector3d& axis, double angleRadians, const Eigen::Vector3d& centre);
 };
 
+/// a after b: x -> a(b(x)).
+RigidTransform Compose(const RigidTransform& a, const RigidTransform& b);
+/// The transform undoing `t`.
+RigidTransform Inverse(const RigidTransform& t);
+
 struct RigidFit
 {
   RigidTransform transform;

@@ -11,6 +11,9 @@ import mdexamples  # noqa: E402
 from paraview import simple  # noqa: E402
 from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow  # noqa: E402
 
+import numpy  # noqa: E402
+from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
+
 SKIPPED = 77  # ctest SKIP_RETURN_CODE
 BASELINE_DIR = os.path.join(SOURCE_DIR, "Testing", "Baseline")
 
@@ -21,6 +24,19 @@ def output_dir(name):
     path = os.path.join(root, name)
     os.makedirs(path, exist_ok=True)
     return path
+
+
+def points(data):
+    """The points of a dataset as an n x 3 float64 array."""
+    return vtk_to_numpy(data.GetPoints().GetData()).astype(numpy.float64)
+
+
+def block(data, name):
+    """The block of a multiblock named `name`."""
+    for index in range(data.GetNumberOfBlocks()):
+        if data.GetMetaData(index).Get(data.NAME()) == name:
+            return data.GetBlock(index)
+    raise KeyError(name)
 
 
 def load_plugin():

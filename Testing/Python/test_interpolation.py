@@ -11,15 +11,8 @@ mdtesting.load_plugin()
 MUSCLES = ("Iliopsoas", "GluteusMaximus", "RectusFemoris")
 
 
-def points(data):
-    return vtk_to_numpy(data.GetPoints().GetData()).astype(numpy.float64)
-
-
-def block(data, name):
-    for index in range(data.GetNumberOfBlocks()):
-        if data.GetMetaData(index).Get(data.NAME()) == name:
-            return data.GetBlock(index)
-    raise KeyError(name)
+points = mdtesting.points
+block = mdtesting.block
 
 
 def field(data, name):

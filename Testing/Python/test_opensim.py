@@ -11,7 +11,6 @@ import numpy
 import mdtesting
 import mdexamples
 from paraview import servermanager, simple
-from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkFiltersSources import vtkCubeSource
 from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter
 
@@ -68,15 +67,8 @@ def write(folder, name, text):
     return path
 
 
-def points(data):
-    return vtk_to_numpy(data.GetPoints().GetData()).astype(numpy.float64)
-
-
-def block(data, name):
-    for index in range(data.GetNumberOfBlocks()):
-        if data.GetMetaData(index).Get(data.NAME()) == name:
-            return data.GetBlock(index)
-    raise KeyError(name)
+points = mdtesting.points
+block = mdtesting.block
 
 
 def output(proxy, port=0):
@@ -145,6 +137,11 @@ class SmallModel(unittest.TestCase):
             self.assertLess(numpy.abs(rest_bone @ r.T + t - bone).max(), 1e-9)
             wrap = points(block(output(reader, 5), "ball"))
             self.assertLess(abs(numpy.linalg.norm(wrap.mean(axis=0) - insertion) - 0.0), 1.0)
+
+    def test_file_open_offers_the_reader(self):
+        reader = simple.OpenDataFile(os.path.join(self.folder, "arm.osim"))
+        self.assertEqual(reader.GetXMLName(), "OpenSimModelReader")
+        simple.Delete(reader)
 
     def test_a_fixed_pose(self):
         reader, _ = self.reader(MotionFileName=os.path.join(self.folder, "arm.mot"))

@@ -11,15 +11,8 @@ from vtkmodules.util.numpy_support import vtk_to_numpy
 mdtesting.load_plugin()
 
 
-def points(data):
-    return vtk_to_numpy(data.GetPoints().GetData()).astype(numpy.float64)
-
-
-def block(data, name):
-    for index in range(data.GetNumberOfBlocks()):
-        if data.GetMetaData(index).Get(data.NAME()) == name:
-            return data.GetBlock(index)
-    raise KeyError(name)
+points = mdtesting.points
+block = mdtesting.block
 
 
 class ServerManagerXML(unittest.TestCase):
