@@ -4,7 +4,6 @@ gait2392 played through, and the LHDL hip from its own OpenSim files."""
 import csv
 import math
 import os
-import tempfile
 import unittest
 
 import numpy
@@ -81,8 +80,8 @@ def field(data, name):
 
 
 def small_model_folder():
-    folder = tempfile.mkdtemp(prefix="opensim-")
-    os.makedirs(os.path.join(folder, "geometry"))
+    folder = mdtesting.output_dir("opensim-small-model")
+    os.makedirs(os.path.join(folder, "geometry"), exist_ok=True)
     cube = vtkCubeSource()
     cube.SetCenter(0, -0.25, 0)
     cube.SetXLength(0.1)
