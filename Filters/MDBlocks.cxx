@@ -13,8 +13,10 @@
 #include <vtkInformation.h>
 #include <vtkInformationVector.h>
 #include <vtkMultiBlockDataSet.h>
+#include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkAbstractArray.h>
 #include <vtkAlgorithm.h>
 #include <vtkIdTypeArray.h>
 #include <vtkTriangleFilter.h>
@@ -72,6 +74,44 @@ void AcceptPolyDataOrMultiBlock(vtkInformation* info)
   info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkMultiBlockDataSet");
 }
 
+/// Fails, naming the block, on a cell that refers to a point the block does not have or a point
+/// array whose tuples do not match the points: what would otherwise be read past an array's end.
+static bool CheckLeaf(vtkPolyData* data, const std::string& label, std::string& error)
+{
+  const vtkIdType points = data->GetNumberOfPoints();
+  vtkCellArray* cellArrays[4] = { data->GetVerts(), data->GetLines(), data->GetPolys(), data->GetStrips() };
+  static const char* kinds[4] = { "vertex", "line", "polygon", "strip" };
+  for (int k = 0; k < 4; ++k)
+  {
+    vtkCellArray* cells = cellArrays[k];
+    if (!cells || cells->GetNumberOfConnectivityIds() == 0)
+    {
+      continue;
+    }
+    double range[2];
+    cells->GetConnectivityArray()->GetRange(range, 0);
+    if (range[0] < 0 || range[1] >= static_cast<double>(points))
+    {
+      const double bad = range[0] < 0 ? range[0] : range[1];
+      error = label + " has a " + kinds[k] + " cell that refers to point " + std::to_string(static_cast<long long>(bad)) +
+        ", but it has " + std::to_string(points) + " points (ids 0 to " + std::to_string(points - 1) + ")";
+      return false;
+    }
+  }
+  vtkPointData* pointData = data->GetPointData();
+  for (int a = 0; a < pointData->GetNumberOfArrays(); ++a)
+  {
+    vtkAbstractArray* array = pointData->GetAbstractArray(a);
+    if (array && array->GetNumberOfTuples() != points)
+    {
+      error = label + ": point array '" + (array->GetName() ? array->GetName() : "") + "' has " +
+        std::to_string(array->GetNumberOfTuples()) + " values but the block has " + std::to_string(points) + " points";
+      return false;
+    }
+  }
+  return true;
+}
+
 bool CollectLeaves(
   vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves, std::string& error)
 {
@@ -84,7 +124,7 @@ bool CollectLeaves(
   if (auto* polyData = vtkPolyData::SafeDownCast(input))
   {
     leaves.push_back(Leaf{ "", polyData, inputName });
-    return true;
+    return CheckLeaf(polyData, inputName, error);
   }
   auto* tree = vtkMultiBlockDataSet::SafeDownCast(input);
   if (!tree)
@@ -108,6 +148,10 @@ bool CollectLeaves(
     {
       error = label + " is a " + leaf->GetClassName() + ", not a vtkPolyData";
       ok = false;
+    }
+    if (polyData && ok)
+    {
+      ok = CheckLeaf(polyData, label, error);
     }
     leaves.push_back(Leaf{ name, polyData, label });
   });

@@ -47,9 +47,16 @@ bool ReadBones(vtkDataObject* rest, vtkDataObject* current, std::vector<md::Bone
   {
     const mdvtk::Leaf& r = restLeaves[b];
     const mdvtk::Leaf& c = currentLeaves[partner[b]];
+    if (!r.data && !c.data)
+    {
+      continue; // an empty block in both poses
+    }
     if (!r.data || !c.data)
     {
-      continue;
+      // Dropping it would silently take an obstacle away.
+      error = (r.data ? c.label : r.label) + " is empty but " + (r.data ? r.label : c.label) +
+        " is not: a bone needs its surface in both poses";
+      return false;
     }
     md::BoneMotion bone;
     bone.name = r.name.empty() ? r.label : r.name;

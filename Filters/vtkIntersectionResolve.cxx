@@ -1,6 +1,7 @@
 #include "vtkIntersectionResolve.h"
 
 #include "MDBlocks.h"
+#include "MeshChecks.h"
 #include "MuscleDeformer.h"
 #include "StaticIntersections.h"
 
@@ -191,9 +192,14 @@ int vtkIntersectionResolve::RequestData(
       shift->SetTuple(i, resolved.shift[k].row(i).data());
     }
     output->GetPointData()->AddArray(shift);
+    // Field data describes this output only: the upstream measures (a deformation's volume
+    // change, iterations, ...) no longer hold once points have moved.
     vtkNew<vtkFieldData> fieldData;
-    fieldData->DeepCopy(leaves[b].data->GetFieldData());
     const md::StaticResolveReport& r = resolved.reports[k];
+    const md::TriangleMesh& reference = restGiven ? deformableRest[k] : deformable[k];
+    const double referenceVolume = md::SignedVolume(reference.points, reference.triangles);
+    const double volume = md::SignedVolume(resolved.points[k], deformable[k].triangles);
+    mdvtk::AddFieldValue(fieldData, "VolumeChangePercent", 100.0 * (volume - referenceVolume) / referenceVolume);
     mdvtk::AddFieldValue(fieldData, "PenetratingPointCount", r.penetratingPoints);
     mdvtk::AddFieldValue(fieldData, "PenetratingGroupCount", r.groups);
     mdvtk::AddFieldValue(fieldData, "MaxPenetrationDepth", r.maxDepth);

@@ -137,6 +137,15 @@ int vtkMuscleDeformation::RequestData(
     blockOf.push_back(b);
   }
 
+  // Obstacles: every block of every connection of port 2.
+  std::vector<std::string> obstacleNames;
+  std::vector<md::TriangleMesh> obstacleMeshes;
+  if (!mdvtk::ReadMeshes(inputVector[2], "Obstacles", obstacleNames, obstacleMeshes, error))
+  {
+    vtkErrorMacro(<< error);
+    return 0;
+  }
+
   // Hulls: given (and checked to enclose the muscle), or built.
   for (size_t m = 0; m < toDeform.size(); ++m)
   {
@@ -192,15 +201,6 @@ int vtkMuscleDeformation::RequestData(
     }
     toDeform[m].hull = &hulls[b];
     hullSeconds[b] = SecondsSince(hullStart);
-  }
-
-  // Obstacles: every block of every connection of port 2.
-  std::vector<std::string> obstacleNames;
-  std::vector<md::TriangleMesh> obstacleMeshes;
-  if (!mdvtk::ReadMeshes(inputVector[2], "Obstacles", obstacleNames, obstacleMeshes, error))
-  {
-    vtkErrorMacro(<< error);
-    return 0;
   }
 
   md::DeformationParameters parameters;

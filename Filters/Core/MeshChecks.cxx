@@ -59,12 +59,19 @@ EdgeReport CheckEdges(const Triangles& triangles)
 
 double SignedVolume(const Points& points, const Triangles& triangles)
 {
+  if (triangles.rows() == 0)
+  {
+    return 0.0;
+  }
+  // Tetrahedra from a point of the surface, not from the coordinates' origin: far from the
+  // origin (a scan 1e12 away from it) the products would cancel to noise.
+  const Eigen::Vector3d origin = points.row(triangles(0, 0)).transpose();
   double sixTimesVolume = 0;
   for (Eigen::Index t = 0; t < triangles.rows(); ++t)
   {
-    const Eigen::Vector3d a = points.row(triangles(t, 0));
-    const Eigen::Vector3d b = points.row(triangles(t, 1));
-    const Eigen::Vector3d c = points.row(triangles(t, 2));
+    const Eigen::Vector3d a = points.row(triangles(t, 0)).transpose() - origin;
+    const Eigen::Vector3d b = points.row(triangles(t, 1)).transpose() - origin;
+    const Eigen::Vector3d c = points.row(triangles(t, 2)).transpose() - origin;
     sixTimesVolume += a.cross(b).dot(c);
   }
   return sixTimesVolume / 6.0;

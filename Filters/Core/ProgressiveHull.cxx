@@ -1039,6 +1039,23 @@ MuscleHull BuildMuscleHull(const TriangleMesh& muscle, const HullParameters& par
   MuscleHull built;
   built.clean = RepairClosedSurface(muscle, built.report);
   built.result = BuildProgressiveHull(built.clean, parameters, &built.report.pointsToEnclose);
+  // A hull that is no closed manifold, or leaves muscle points outside, would map the muscle
+  // wrongly (mean value coordinates extrapolate): refuse it rather than hand it on.
+  const TriangleMesh& hull = built.result.hull;
+  const EdgeReport edges = CheckEdges(hull.triangles);
+  if (!edges.IsClosedOrientedManifold() || !(SignedVolume(hull.points, hull.triangles) > 0))
+  {
+    throw InputError("its hull came out as no closed, outward-oriented manifold surface (" +
+      std::to_string(edges.boundaryEdges) + " open, " + std::to_string(edges.nonManifoldEdges) +
+      " non-manifold and " + std::to_string(edges.inconsistentEdges) +
+      " inconsistently oriented edges): the surface is too noisy or too thin for a hull; smooth or remesh it");
+  }
+  const std::int64_t outside = CountPointsOutsideHull(hull, muscle);
+  if (outside > 0)
+  {
+    throw InputError("its hull leaves " + std::to_string(outside) +
+      " of its points outside: the surface is too noisy for a hull; smooth or remesh it");
+  }
   return built;
 }
 

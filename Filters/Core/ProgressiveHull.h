@@ -58,6 +58,9 @@ struct MuscleHull
   RepairReport report;
   HullResult result;
 };
+/// Repairs `muscle` and builds its hull. Throws InputError when the muscle cannot be repaired,
+/// or when the hull is not a closed, outward-oriented manifold or leaves a muscle point outside
+/// (every point is checked): a hull is never handed on unchecked.
 MuscleHull BuildMuscleHull(const TriangleMesh& muscle, const HullParameters& parameters);
 
 /// Points of `muscle` (those its triangles use) outside `hull`; points within

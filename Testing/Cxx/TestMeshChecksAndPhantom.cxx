@@ -28,6 +28,18 @@ TEST(MeshChecks, ClosedTetrahedron)
   EXPECT_NEAR(md::WindingNumber(tet.points, tet.triangles, Eigen::Vector3d(2, 2, 2)), 0.0, 1e-12);
 }
 
+TEST(MeshChecks, VolumeDoesNotDependOnWhereTheSurfaceSits)
+{
+  // The phantom's gluteus maximus 1e12 mm from the origin (an offset in the data, not in the
+  // anatomy): its volume must stay its volume.
+  const md::Phantom phantom = md::BuildPhantom(md::PhantomParameters());
+  md::TriangleMesh muscle = phantom.muscles[1].rest;
+  const double volume = md::SignedVolume(muscle.points, muscle.triangles);
+  muscle.points.rowwise() += Eigen::RowVector3d(1e12, -1e12, 1e12);
+  // Coordinates near 1e12 are rounded to about 1e-4 mm: the volume moves by that rounding only.
+  EXPECT_NEAR(md::SignedVolume(muscle.points, muscle.triangles) / volume, 1.0, 1e-6);
+}
+
 TEST(MeshChecks, DetectsHolesFlipsAndNonManifoldEdges)
 {
   md::TriangleMesh tet = Tetrahedron();

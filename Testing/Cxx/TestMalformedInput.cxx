@@ -1,0 +1,245 @@
+// Malformed input through every filter: cells that refer to points a block does not have, and
+// point arrays shorter than the points. Each must be refused with a message naming the input and
+// the block, never read past an array's end (these crashed ParaView before).
+#include "FilterTestUtilities.h"
+
+#include "vtkActionLineGrouping.h"
+#include "vtkActionLineMatching.h"
+#include "vtkBoneInterpolation.h"
+#include "vtkHullDecimation.h"
+#include "vtkInterpolatedMuscleDeformation.h"
+#include "vtkIntersectionResolve.h"
+#include "vtkMoveWithBodies.h"
+#include "vtkMuscleDeformation.h"
+#include "vtkMusculoskeletalPhantom.h"
+
+#include <vtkCellArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkPointData.h>
+#include <vtkFieldData.h>
+#include <vtkTable.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+namespace
+{
+constexpr vtkIdType kFarAway = 1000000000;
+
+/// A copy of `source` with one more cell whose last point id is out of range: a polyline
+/// [0, 1, 2, 3, 1e9] or a triangle (0, 1, 1e9).
+vtkSmartPointer<vtkPolyData> WithBadCell(vtkPolyData* source, bool line)
+{
+  auto copy = vtkSmartPointer<vtkPolyData>::New();
+  copy->DeepCopy(source);
+  if (line)
+  {
+    const vtkIdType ids[5] = { 0, 1, 2, 3, kFarAway };
+    copy->GetLines()->InsertNextCell(5, ids);
+  }
+  else
+  {
+    const vtkIdType ids[3] = { 0, 1, kFarAway };
+    copy->GetPolys()->InsertNextCell(3, ids);
+  }
+  return copy;
+}
+
+/// `tree` with its first block replaced by `block`.
+vtkSmartPointer<vtkMultiBlockDataSet> WithFirstBlock(vtkMultiBlockDataSet* tree, vtkPolyData* block)
+{
+  auto copy = vtkSmartPointer<vtkMultiBlockDataSet>::New();
+  copy->ShallowCopy(tree);
+  copy->SetBlock(0, block);
+  return copy;
+}
+
+vtkPolyData* FirstBlock(vtkDataObject* tree)
+{
+  return vtkPolyData::SafeDownCast(vtkMultiBlockDataSet::SafeDownCast(tree)->GetBlock(0));
+}
+
+struct Phantom
+{
+  vtkNew<vtkMusculoskeletalPhantom> source;
+  vtkNew<vtkActionLineMatching> matching;
+  vtkMultiBlockDataSet* Output(int port) { return vtkMultiBlockDataSet::SafeDownCast(this->source->GetOutputDataObject(port)); }
+  Phantom()
+  {
+    this->source->SetResolution(12);
+    this->source->Update();
+    this->matching->SetInputConnection(this->source->GetOutputPort(3));
+    this->matching->SetCurrentPoseConnection(this->source->GetOutputPort(4));
+    this->matching->Update();
+  }
+  vtkMultiBlockDataSet* Matched() { return vtkMultiBlockDataSet::SafeDownCast(this->matching->GetOutputDataObject(0)); }
+  vtkSmartPointer<vtkMultiBlockDataSet> BadLines(int port)
+  {
+    return WithFirstBlock(this->Output(port), WithBadCell(FirstBlock(this->Output(port)), true));
+  }
+  vtkSmartPointer<vtkMultiBlockDataSet> BadMeshes(int port)
+  {
+    return WithFirstBlock(this->Output(port), WithBadCell(FirstBlock(this->Output(port)), false));
+  }
+};
+
+/// Runs `filter` (inputs already set) and returns what it reported; the run must fail cleanly.
+std::string Refusal(vtkAlgorithm* filter)
+{
+  CapturedMessages messages;
+  filter->Update();
+  return messages.Text();
+}
+}
+
+TEST(MalformedInput, OutOfRangePointIdsAreRefusedByEveryFilter)
+{
+  Phantom phantom;
+  const std::string far = "refers to point 1000000000";
+  {
+    vtkNew<vtkActionLineMatching> f;
+    f->SetInputDataObject(0, phantom.BadLines(vtkMusculoskeletalPhantom::ACTION_LINES_REST));
+    f->SetInputDataObject(1, phantom.Output(vtkMusculoskeletalPhantom::ACTION_LINES_CURRENT));
+    const std::string text = Refusal(f);
+    EXPECT_NE(text.find("Input block 'Iliopsoas' has a line cell that " + far), std::string::npos) << text;
+  }
+  {
+    vtkNew<vtkBoneInterpolation> f;
+    f->SetInputDataObject(0, phantom.Output(vtkMusculoskeletalPhantom::BONES_REST));
+    f->SetInputDataObject(1, phantom.BadMeshes(vtkMusculoskeletalPhantom::BONES_CURRENT));
+    const std::string text = Refusal(f);
+    EXPECT_NE(text.find("CurrentPose block 'Pelvis' has a polygon cell that " + far), std::string::npos) << text;
+  }
+  {
+    vtkNew<vtkHullDecimation> f;
+    f->SetInputDataObject(0, phantom.BadMeshes(vtkMusculoskeletalPhantom::MUSCLES));
+    EXPECT_NE(Refusal(f).find(far), std::string::npos);
+  }
+  {
+    vtkNew<vtkMuscleDeformation> f;
+    f->SetInputDataObject(0, phantom.Output(vtkMusculoskeletalPhantom::MUSCLES));
+    f->SetInputDataObject(1, phantom.Matched());
+    f->AddInputDataObject(2, phantom.BadMeshes(vtkMusculoskeletalPhantom::BONES_CURRENT));
+    const std::string text = Refusal(f);
+    EXPECT_NE(text.find("Obstacles connection 1 block 'Pelvis' has a polygon cell that " + far), std::string::npos) << text;
+  }
+  {
+    // A CurrentPosition array shorter than the points of its lines.
+    auto lines = vtkSmartPointer<vtkPolyData>::New();
+    lines->DeepCopy(FirstBlock(phantom.Matched()));
+    vtkNew<vtkDoubleArray> shortPositions;
+    shortPositions->SetName("CurrentPosition");
+    shortPositions->SetNumberOfComponents(3);
+    shortPositions->InsertNextTuple3(0, 0, 0);
+    lines->GetPointData()->AddArray(shortPositions);
+    vtkNew<vtkMuscleDeformation> f;
+    f->SetInputDataObject(0, phantom.Output(vtkMusculoskeletalPhantom::MUSCLES));
+    f->SetInputDataObject(1, WithFirstBlock(phantom.Matched(), lines));
+    const std::string text = Refusal(f);
+    EXPECT_NE(text.find("point array 'CurrentPosition' has 1 values but the block has"), std::string::npos) << text;
+  }
+  {
+    vtkNew<vtkIntersectionResolve> f;
+    f->SetInputDataObject(0, phantom.BadMeshes(vtkMusculoskeletalPhantom::MUSCLES));
+    f->AddInputDataObject(1, phantom.Output(vtkMusculoskeletalPhantom::BONES_CURRENT));
+    EXPECT_NE(Refusal(f).find(far), std::string::npos);
+  }
+  {
+    vtkNew<vtkIntersectionResolve> f;
+    f->SetInputDataObject(0, phantom.Output(vtkMusculoskeletalPhantom::MUSCLES));
+    f->AddInputDataObject(1, phantom.BadMeshes(vtkMusculoskeletalPhantom::BONES_CURRENT));
+    EXPECT_NE(Refusal(f).find(far), std::string::npos);
+  }
+  {
+    vtkNew<vtkInterpolatedMuscleDeformation> f;
+    f->SetInputDataObject(0, phantom.Output(vtkMusculoskeletalPhantom::MUSCLES));
+    f->SetInputDataObject(1, phantom.Output(vtkMusculoskeletalPhantom::BONES_REST));
+    f->SetInputDataObject(2, phantom.BadMeshes(vtkMusculoskeletalPhantom::BONES_CURRENT));
+    f->SetInputDataObject(3, phantom.Output(vtkMusculoskeletalPhantom::ACTION_LINES_REST));
+    f->SetInputDataObject(4, phantom.BadLines(vtkMusculoskeletalPhantom::ACTION_LINES_CURRENT));
+    EXPECT_NE(Refusal(f).find(far), std::string::npos);
+  }
+  {
+    vtkNew<vtkActionLineGrouping> f;
+    f->SetInputDataObject(0, phantom.Output(vtkMusculoskeletalPhantom::MUSCLES));
+    f->SetInputDataObject(1, phantom.BadLines(vtkMusculoskeletalPhantom::ACTION_LINES_REST));
+    EXPECT_NE(Refusal(f).find(far), std::string::npos);
+  }
+  {
+    vtkNew<vtkMoveWithBodies> f;
+    vtkNew<vtkTable> transforms;
+    f->SetInputDataObject(0, phantom.BadMeshes(vtkMusculoskeletalPhantom::BONES_REST));
+    f->SetInputDataObject(1, transforms);
+    EXPECT_NE(Refusal(f).find(far), std::string::npos);
+  }
+}
+
+TEST(MalformedInput, ABoneEmptyInOnePoseIsAnError)
+{
+  Phantom phantom;
+  auto current = vtkSmartPointer<vtkMultiBlockDataSet>::New();
+  current->ShallowCopy(phantom.Output(vtkMusculoskeletalPhantom::BONES_CURRENT));
+  current->SetBlock(1, nullptr); // the femur's current pose is missing
+  vtkNew<vtkInterpolatedMuscleDeformation> f;
+  f->SetInputDataObject(0, phantom.Output(vtkMusculoskeletalPhantom::MUSCLES));
+  f->SetInputDataObject(1, phantom.Output(vtkMusculoskeletalPhantom::BONES_REST));
+  f->SetInputDataObject(2, current);
+  f->SetInputDataObject(3, phantom.Output(vtkMusculoskeletalPhantom::ACTION_LINES_REST));
+  f->SetInputDataObject(4, phantom.Output(vtkMusculoskeletalPhantom::ACTION_LINES_CURRENT));
+  const std::string text = Refusal(f);
+  EXPECT_NE(text.find("BonesCurrent block 'Femur' is empty but BonesRest block 'Femur' is not"), std::string::npos) << text;
+}
+
+TEST(MalformedInput, IntersectionResolveReportsItsOwnVolumeChange)
+{
+  // A muscle with upstream field data claiming no volume change: after the resolution the
+  // output must say what the resolution did, not pass the claim on.
+  Phantom phantom;
+  auto muscles = vtkSmartPointer<vtkMultiBlockDataSet>::New();
+  muscles->ShallowCopy(phantom.Output(vtkMusculoskeletalPhantom::MUSCLES));
+  auto claimed = vtkSmartPointer<vtkPolyData>::New();
+  claimed->ShallowCopy(FirstBlock(muscles));
+  vtkNew<vtkFieldData> fieldData;
+  vtkNew<vtkDoubleArray> stale;
+  stale->SetName("VolumeChangePercent");
+  stale->InsertNextValue(0.0);
+  fieldData->AddArray(stale);
+  claimed->SetFieldData(fieldData);
+  muscles->SetBlock(0, claimed);
+  vtkNew<vtkIntersectionResolve> f;
+  f->SetInputDataObject(0, muscles);
+  // The bones in the current pose (60 degrees): the femur has swept into the rectus femoris.
+  f->AddInputDataObject(1, phantom.Output(vtkMusculoskeletalPhantom::BONES_CURRENT));
+  f->Update();
+  auto* out = vtkMultiBlockDataSet::SafeDownCast(f->GetOutputDataObject(0));
+  for (unsigned int b = 0; b < out->GetNumberOfBlocks(); ++b)
+  {
+    auto* muscle = vtkPolyData::SafeDownCast(out->GetBlock(b));
+    auto* input = vtkPolyData::SafeDownCast(muscles->GetBlock(b));
+    vtkDataArray* change = muscle->GetFieldData()->GetArray("VolumeChangePercent");
+    ASSERT_NE(change, nullptr);
+    ASSERT_EQ(muscle->GetFieldData()->GetNumberOfArrays(), 7);
+    // Recomputed independently: the divergence theorem over the output's triangles.
+    auto volume = [](vtkPolyData* mesh) {
+      double sum = 0;
+      vtkCellArray* polys = mesh->GetPolys();
+      const vtkIdType* ids;
+      vtkIdType n;
+      for (polys->InitTraversal(); polys->GetNextCell(n, ids);)
+      {
+        double a[3], p[3], c[3];
+        mesh->GetPoint(ids[0], a);
+        mesh->GetPoint(ids[1], p);
+        mesh->GetPoint(ids[2], c);
+        sum += (a[0] * (p[1] * c[2] - p[2] * c[1]) - a[1] * (p[0] * c[2] - p[2] * c[0]) + a[2] * (p[0] * c[1] - p[1] * c[0])) / 6;
+      }
+      return sum;
+    };
+    EXPECT_NEAR(change->GetTuple1(0), 100 * (volume(muscle) - volume(input)) / volume(input), 1e-9);
+  }
+  auto* rectus = vtkPolyData::SafeDownCast(out->GetBlock(2));
+  EXPECT_GT(rectus->GetFieldData()->GetArray("MaxStaticShift")->GetTuple1(0), 1.0);
+  EXPECT_GT(std::abs(rectus->GetFieldData()->GetArray("VolumeChangePercent")->GetTuple1(0)), 1e-3);
+}
