@@ -16,6 +16,7 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkAOSDataArrayTemplate.h>
 #include <vtkAbstractArray.h>
 #include <vtkAlgorithm.h>
 #include <vtkIdTypeArray.h>
@@ -76,9 +77,62 @@ void AcceptPolyDataOrMultiBlock(vtkInformation* info)
 
 /// Fails, naming the block, on a cell that refers to a point the block does not have or a point
 /// array whose tuples do not match the points: what would otherwise be read past an array's end.
+/// The first id of `ids` outside [0, points), or -1 when there is none (-2 stands for an id of
+/// -1 itself; other negative ids are returned as they are).
+template <typename Value>
+vtkIdType FirstOutOfRange(const Value* ids, vtkIdType count, vtkIdType points)
+{
+  for (vtkIdType i = 0; i < count; ++i)
+  {
+    if (ids[i] < 0 || static_cast<vtkIdType>(ids[i]) >= points)
+    {
+      return ids[i] == -1 ? -2 : static_cast<vtkIdType>(ids[i]);
+    }
+  }
+  return -1;
+}
+
+vtkIdType FirstIdOutOfRange(vtkDataArray* ids, vtkIdType points)
+{
+  const vtkIdType count = ids->GetNumberOfValues();
+  if (auto* wide = vtkAOSDataArrayTemplate<vtkTypeInt64>::FastDownCast(ids))
+  {
+    return FirstOutOfRange(wide->GetPointer(0), count, points);
+  }
+  if (auto* narrow = vtkAOSDataArrayTemplate<vtkTypeInt32>::FastDownCast(ids))
+  {
+    return FirstOutOfRange(narrow->GetPointer(0), count, points);
+  }
+  for (vtkIdType i = 0; i < count; ++i)
+  {
+    const auto id = static_cast<vtkIdType>(ids->GetComponent(i, 0));
+    if (id < 0 || id >= points)
+    {
+      return id == -1 ? -2 : id;
+    }
+  }
+  return -1;
+}
+
 static bool CheckLeaf(vtkPolyData* data, const std::string& label, std::string& error)
 {
   const vtkIdType points = data->GetNumberOfPoints();
+  // Coordinates: finite, and small enough that products of three of them (volumes) stay finite.
+  const Points coordinates = ToPoints(data->GetPoints());
+  for (Eigen::Index i = 0; i < coordinates.rows(); ++i)
+  {
+    if (!coordinates.row(i).allFinite())
+    {
+      error = label + " has NaN or infinite coordinates (point " + std::to_string(i) + ")";
+      return false;
+    }
+    if (coordinates.row(i).cwiseAbs().maxCoeff() > 1e100)
+    {
+      error = label + " has coordinates beyond 1e100 in magnitude (point " + std::to_string(i) +
+        "), where the geometry's arithmetic would overflow";
+      return false;
+    }
+  }
   vtkCellArray* cellArrays[4] = { data->GetVerts(), data->GetLines(), data->GetPolys(), data->GetStrips() };
   static const char* kinds[4] = { "vertex", "line", "polygon", "strip" };
   for (int k = 0; k < 4; ++k)
@@ -88,12 +142,12 @@ static bool CheckLeaf(vtkPolyData* data, const std::string& label, std::string& 
     {
       continue;
     }
-    double range[2];
-    cells->GetConnectivityArray()->GetRange(range, 0);
-    if (range[0] < 0 || range[1] >= static_cast<double>(points))
+    // Every id is read (not the array's cached range, which an array changed without
+    // Modified() would leave stale).
+    const vtkIdType bad = FirstIdOutOfRange(cells->GetConnectivityArray(), points);
+    if (bad >= 0 || bad < -1)
     {
-      const double bad = range[0] < 0 ? range[0] : range[1];
-      error = label + " has a " + kinds[k] + " cell that refers to point " + std::to_string(static_cast<long long>(bad)) +
+      error = label + " has a " + kinds[k] + " cell that refers to point " + std::to_string(bad == -2 ? -1 : bad) +
         ", but it has " + std::to_string(points) + " points (ids 0 to " + std::to_string(points - 1) + ")";
       return false;
     }
@@ -359,10 +413,30 @@ vtkIdType ReadTriangles(vtkPolyData* input, TriangleMesh& mesh)
     triangles = triangulate->GetOutput();
   }
   mesh.points = ToPoints(triangles->GetPoints());
-  vtkNew<vtkIdTypeArray> connectivity;
-  connectivity->DeepCopy(triangles->GetPolys()->GetConnectivityArray());
-  mesh.triangles.resize(triangles->GetNumberOfPolys(), 3);
-  std::copy(connectivity->GetPointer(0), connectivity->GetPointer(0) + mesh.triangles.size(), mesh.triangles.data());
+  vtkCellArray* cells = triangles->GetPolys();
+  if (cells->GetNumberOfConnectivityIds() == 3 * cells->GetNumberOfCells())
+  {
+    vtkNew<vtkIdTypeArray> connectivity;
+    connectivity->DeepCopy(cells->GetConnectivityArray());
+    mesh.triangles.resize(cells->GetNumberOfCells(), 3);
+    std::copy(connectivity->GetPointer(0), connectivity->GetPointer(0) + mesh.triangles.size(), mesh.triangles.data());
+    return converted;
+  }
+  // Cells the triangulation left as they were (polygons of one or two points): not triangles.
+  std::vector<std::int64_t> ids;
+  auto it = vtk::TakeSmartPointer(cells->NewIterator());
+  for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
+  {
+    vtkIdType size;
+    const vtkIdType* cell;
+    it->GetCurrentCell(size, cell);
+    if (size == 3)
+    {
+      ids.insert(ids.end(), cell, cell + 3);
+    }
+  }
+  mesh.triangles.resize(static_cast<Eigen::Index>(ids.size() / 3), 3);
+  std::copy(ids.begin(), ids.end(), mesh.triangles.data());
   return converted;
 }
 bool ReadMeshes(vtkInformationVector* port, const std::string& portName, std::vector<std::string>& names,
