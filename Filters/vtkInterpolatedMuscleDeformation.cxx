@@ -237,6 +237,10 @@ int vtkInterpolatedMuscleDeformation::RequestData(
           const md::MatchedActionLines matched = md::MatchActionLines(rest[l], current[l], this->MatchingTolerance);
           motion.lines.push_back({ matched.rest, matched.current });
         }
+        for (const std::string& note : md::LimitActionLinePoints(motion.lines))
+        {
+          vtkWarningMacro(<< restLeaf.label << ": " << note);
+        }
       }
       catch (const md::InputError& e)
       {

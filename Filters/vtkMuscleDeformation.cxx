@@ -30,8 +30,10 @@ double SecondsSince(Clock::time_point start)
 }
 
 /// The action lines of one block: each polyline's points and their
-/// CurrentPosition (from ActionLineMatching). Fails with a message.
-bool ReadMatchedLines(const mdvtk::Leaf& leaf, std::vector<md::MatchedLine>& lines, std::string& error)
+/// CurrentPosition (from ActionLineMatching), lines of too many points cut down (said in
+/// `notes`). Fails with a message.
+bool ReadMatchedLines(const mdvtk::Leaf& leaf, std::vector<md::MatchedLine>& lines, std::vector<std::string>& notes,
+  std::string& error)
 {
   vtkPolyData* data = leaf.data;
   if (!data || !data->GetLines() || data->GetLines()->GetNumberOfCells() == 0)
@@ -53,6 +55,7 @@ bool ReadMatchedLines(const mdvtk::Leaf& leaf, std::vector<md::MatchedLine>& lin
   {
     lines.push_back({ rest[l], moved[l] });
   }
+  notes = md::LimitActionLinePoints(lines);
   return true;
 }
 }
@@ -128,10 +131,15 @@ int vtkMuscleDeformation::RequestData(
     md::MuscleToDeform muscle;
     muscle.name = leaf.name.empty() ? leaf.label : leaf.name;
     muscle.muscle = &surfaces[b];
-    if (!ReadMatchedLines(lineLeaves[lineOf[b]], muscle.lines, error))
+    std::vector<std::string> notes;
+    if (!ReadMatchedLines(lineLeaves[lineOf[b]], muscle.lines, notes, error))
     {
       vtkErrorMacro(<< error << " (for " << leaf.label << ")");
       return 0;
+    }
+    for (const std::string& note : notes)
+    {
+      vtkWarningMacro(<< lineLeaves[lineOf[b]].label << ": " << note);
     }
     toDeform.push_back(std::move(muscle));
     blockOf.push_back(b);

@@ -103,7 +103,11 @@ MatchedActionLines MatchActionLines(const Points& rest, const Points& current, d
   for (size_t i = 0; i < tR.size(); ++i)
   {
     Pair pair{ tR[i], tR[i], static_cast<Eigen::Index>(i), -1 };
-    for (size_t j = 0; j < tC.size(); ++j)
+    // The first unmatched partner within eps. Arc lengths increase, so the partners lie in a
+    // window: searched from a little before it (2 eps, so that rounding cannot move the answer)
+    // rather than from the start, which made long lines quadratic.
+    const auto from = std::lower_bound(tC.begin(), tC.end(), tR[i] - 2 * eps) - tC.begin();
+    for (size_t j = static_cast<size_t>(from); j < tC.size() && tC[j] <= tR[i] + 2 * eps; ++j)
     {
       if (!currentMatched[j] && std::abs(tR[i] - tC[j]) <= eps)
       {

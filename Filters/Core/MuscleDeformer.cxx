@@ -7,6 +7,9 @@
 #include <Eigen/SparseCholesky>
 
 #include <algorithm>
+#include <queue>
+#include <iomanip>
+#include <sstream>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -855,6 +858,102 @@ double FullVolume(const MuscleState& s, Points& hullGradient)
   hullGradient = s.weights->transpose() * gradient;
   return volume;
 }
+}
+
+namespace
+{
+double SegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+{
+  const Eigen::Vector3d ab = b - a;
+  const double length2 = ab.squaredNorm();
+  const double t = length2 > 0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+  return (p - (a + t * ab)).norm();
+}
+}
+
+std::vector<std::string> LimitActionLinePoints(std::vector<MatchedLine>& lines, Eigen::Index maximumPoints)
+{
+  std::vector<std::string> notes;
+  maximumPoints = std::max<Eigen::Index>(maximumPoints, 2);
+  for (size_t l = 0; l < lines.size(); ++l)
+  {
+    MatchedLine& line = lines[l];
+    const Eigen::Index n = line.rest.rows();
+    if (n <= maximumPoints || line.current.rows() != n)
+    {
+      continue;
+    }
+    // The point of (first, last) that deviates most from its chord, in either pose.
+    struct Span
+    {
+      double deviation;
+      Eigen::Index first, last, worst;
+      bool operator<(const Span& other) const { return this->deviation < other.deviation; }
+    };
+    auto span = [&](Eigen::Index first, Eigen::Index last) {
+      Span out{ 0.0, first, last, -1 };
+      for (Eigen::Index k = first + 1; k < last; ++k)
+      {
+        const double d = std::max(
+          SegmentDistance(line.rest.row(k).transpose(), line.rest.row(first).transpose(), line.rest.row(last).transpose()),
+          SegmentDistance(line.current.row(k).transpose(), line.current.row(first).transpose(),
+            line.current.row(last).transpose()));
+        if (d > out.deviation || out.worst < 0)
+        {
+          out.deviation = d;
+          out.worst = k;
+        }
+      }
+      return out;
+    };
+    // Deviations below rounding of the line's size: the points lie on the kept line.
+    const double negligible =
+      1e-12 * (line.rest.colwise().maxCoeff() - line.rest.colwise().minCoeff()).norm();
+    std::vector<char> keep(static_cast<size_t>(n), 0);
+    keep.front() = keep.back() = 1;
+    Eigen::Index kept = 2;
+    std::priority_queue<Span> queue;
+    queue.push(span(0, n - 1));
+    double left = 0.0;
+    while (!queue.empty())
+    {
+      const Span top = queue.top();
+      if (top.worst < 0)
+      {
+        queue.pop();
+        continue;
+      }
+      if (kept >= maximumPoints || top.deviation <= negligible)
+      {
+        left = top.deviation;
+        break;
+      }
+      queue.pop();
+      keep[static_cast<size_t>(top.worst)] = 1;
+      ++kept;
+      queue.push(span(top.first, top.worst));
+      queue.push(span(top.worst, top.last));
+    }
+    MatchedLine reduced;
+    reduced.rest.resize(kept, 3);
+    reduced.current.resize(kept, 3);
+    Eigen::Index r = 0;
+    for (Eigen::Index k = 0; k < n; ++k)
+    {
+      if (keep[static_cast<size_t>(k)])
+      {
+        reduced.rest.row(r) = line.rest.row(k);
+        reduced.current.row(r) = line.current.row(k);
+        ++r;
+      }
+    }
+    line = std::move(reduced);
+    std::ostringstream note;
+    note << "action line " << l + 1 << " has " << n << " points; it was cut down to " << kept
+         << " (the points left out lie within " << std::setprecision(3) << left << " of it)";
+    notes.push_back(note.str());
+  }
+  return notes;
 }
 
 void SampleMatchedLines(

@@ -160,6 +160,13 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
   const std::vector<Obstacle>& bones, const DeformationParameters& parameters,
   const std::function<void(double)>& progress = {});
 
+/// Lines of more than `maximumPoints` points (a path sampled densely, a scanned centreline) are
+/// cut down to `maximumPoints`, keeping the points that deviate most from the kept line in either
+/// pose (greedy Douglas-Peucker on both poses at once), so that the action-line rows, which grow
+/// with the points, stay bounded. Lines within the limit are left exactly as they are. Returns
+/// one note per line cut down (its index, points before and after, largest deviation left).
+std::vector<std::string> LimitActionLinePoints(std::vector<MatchedLine>& lines, Eigen::Index maximumPoints = 256);
+
 /// Samples along matched lines: `samplesPerSegment` per segment plus the last
 /// point of each line, the same parameters on both poses.
 void SampleMatchedLines(

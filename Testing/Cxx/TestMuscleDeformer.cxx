@@ -310,3 +310,50 @@ TEST(MuscleDeformer, BadInputIsRefusedWithTheMuscleNamed)
   withNaN.muscle = &broken;
   EXPECT_THROW(md::DeformMuscles({ withNaN }, {}, md::DeformationParameters{}), md::InputError);
 }
+
+TEST(ActionLineLimit, DenseLinesAreCutDownKeepingTheirCornersAndShortOnesAreUntouched)
+{
+  // A path through three corners, sampled every 0.01 mm over about 300 mm (30,000 points), its
+  // current pose a rotated copy.
+  const Eigen::Vector3d corners[4] = { { 0, 0, 0 }, { 100, 0, 0 }, { 100, 100, 0 }, { 100, 100, 100 } };
+  std::vector<Eigen::Vector3d> dense;
+  for (int c = 0; c < 3; ++c)
+  {
+    for (int k = 0; k < 10000; ++k)
+    {
+      dense.push_back(corners[c] + (corners[c + 1] - corners[c]) * (k / 10000.0));
+    }
+  }
+  dense.push_back(corners[3]);
+  md::MatchedLine line;
+  line.rest.resize(static_cast<Eigen::Index>(dense.size()), 3);
+  for (size_t i = 0; i < dense.size(); ++i)
+  {
+    line.rest.row(static_cast<Eigen::Index>(i)) = dense[i].transpose();
+  }
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  line.current = line.rest * turn.transpose();
+  md::MatchedLine shortLine;
+  shortLine.rest = line.rest.topRows(100);
+  shortLine.current = line.current.topRows(100);
+  std::vector<md::MatchedLine> lines = { shortLine, line };
+  const std::vector<std::string> notes = md::LimitActionLinePoints(lines, 256);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("action line 2 has 30001 points"), std::string::npos) << notes[0];
+  // The short line: exactly as it was.
+  EXPECT_EQ(lines[0].rest, shortLine.rest);
+  EXPECT_EQ(lines[0].current, shortLine.current);
+  // The dense one: within the limit, ends and corners kept, both poses cut at the same points.
+  ASSERT_LE(lines[1].rest.rows(), 256);
+  ASSERT_GE(lines[1].rest.rows(), 4);
+  for (const Eigen::Vector3d& corner : corners)
+  {
+    bool found = false;
+    for (Eigen::Index k = 0; k < lines[1].rest.rows(); ++k)
+    {
+      found = found || (lines[1].rest.row(k).transpose() - corner).norm() < 1e-9;
+    }
+    EXPECT_TRUE(found) << corner.transpose();
+  }
+  EXPECT_LT((lines[1].current - lines[1].rest * turn.transpose()).cwiseAbs().maxCoeff(), 1e-9);
+}
