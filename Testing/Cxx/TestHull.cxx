@@ -374,6 +374,9 @@ TEST(MeanValueCoordinates, WeightMatrixOfManyPoints)
 
 TEST(MuscleHull, ANoisyScanGetsAClosedEnclosingHullOrAClearRefusal)
 {
+  // (At this noise the surface crosses itself in about 1,900 triangle pairs: the repair refuses
+  // it in well under a second; at 10 % noise, 1.15 million pairs, in 2.5 s and 90 MB, where it
+  // used to smooth for 70 s and take 3.9 GB.)
   // Gaussian vertex noise of 0.5 % of the gluteus medius's size (about 1 mm): its progressive
   // hull once came out with an edge shared by four triangles and was handed on unchecked.
   const std::string file = RealDataFile("lhdl_hip_r/gluteus_medius_r.vtk");
@@ -400,6 +403,6 @@ TEST(MuscleHull, ANoisyScanGetsAClosedEnclosingHullOrAClearRefusal)
   }
   catch (const md::InputError& e)
   {
-    EXPECT_NE(std::string(e.what()).find("too noisy"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("noisy"), std::string::npos) << e.what();
   }
 }
