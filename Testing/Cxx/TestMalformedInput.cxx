@@ -2,6 +2,7 @@
 // point arrays shorter than the points. Each must be refused with a message naming the input and
 // the block, never read past an array's end (these crashed ParaView before).
 #include "FilterTestUtilities.h"
+#include "MeshChecks.h"
 
 #include "vtkActionLineGrouping.h"
 #include "vtkActionLineMatching.h"
@@ -262,4 +263,50 @@ TEST(MalformedInput, IdsChangedBehindTheArraysBackAreStillChecked)
   f->SetInputDataObject(0, muscle);
   const std::string text = Refusal(f);
   EXPECT_NE(text.find("refers to point 1000000000"), std::string::npos) << text;
+}
+
+TEST(MalformedInput, AFlatMuscleGetsAnErrorNotABrokenHull)
+{
+  // The phantom's gluteus maximus squashed to 1e-4 of its thickness: closed, but flat. Its hull
+  // came out with non-manifold edges and no message; now either a clear error or a true hull.
+  Phantom phantom;
+  for (double thickness : { 0.0, 1e-4 })
+  {
+    auto muscle = vtkSmartPointer<vtkPolyData>::New();
+    muscle->DeepCopy(vtkPolyData::SafeDownCast(phantom.Output(vtkMusculoskeletalPhantom::MUSCLES)->GetBlock(1)));
+    vtkPoints* points = muscle->GetPoints();
+    for (vtkIdType i = 0; i < points->GetNumberOfPoints(); ++i)
+    {
+      double p[3];
+      points->GetPoint(i, p);
+      p[2] *= thickness;
+      points->SetPoint(i, p);
+    }
+    vtkNew<vtkHullDecimation> f;
+    f->SetInputDataObject(0, muscle);
+    CapturedMessages messages;
+    f->Update();
+    auto* hull = vtkPolyData::SafeDownCast(f->GetOutputDataObject(0));
+    if (hull->GetNumberOfPolys() == 0)
+    {
+      EXPECT_TRUE(messages.Contains("ERR") || messages.Contains("ERROR")) << thickness;
+      continue;
+    }
+    md::TriangleMesh mesh;
+    mesh.points.resize(hull->GetNumberOfPoints(), 3);
+    for (vtkIdType i = 0; i < hull->GetNumberOfPoints(); ++i)
+    {
+      hull->GetPoint(i, mesh.points.row(i).data());
+    }
+    vtkCellArray* polys = hull->GetPolys();
+    mesh.triangles.resize(polys->GetNumberOfCells(), 3);
+    const vtkIdType* ids;
+    vtkIdType n;
+    Eigen::Index t = 0;
+    for (polys->InitTraversal(); polys->GetNextCell(n, ids); ++t)
+    {
+      mesh.triangles.row(t) << ids[0], ids[1], ids[2];
+    }
+    EXPECT_TRUE(md::CheckEdges(mesh.triangles).IsClosedOrientedManifold()) << thickness;
+  }
 }
