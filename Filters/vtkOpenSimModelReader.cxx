@@ -127,6 +127,7 @@ vtkOpenSimModelReader::~vtkOpenSimModelReader()
   this->SetMotionFileName(nullptr);
   this->SetGeometrySearchPath(nullptr);
   this->SetRestPoseCoordinates(nullptr);
+  this->SetRestPoseFileName(nullptr);
   this->SetReferenceBody(nullptr);
 }
 
@@ -264,6 +265,11 @@ bool vtkOpenSimModelReader::Load()
       in.modelKey = modelKey;
       in.haveModel = true;
     }
+    osim::MotionOptions options;
+    options.angles = this->AngleUnit == ANGLES_IN_DEGREES ? osim::AngleUnit::Degrees
+      : this->AngleUnit == ANGLES_IN_RADIANS             ? osim::AngleUnit::Radians
+                                                         : osim::AngleUnit::FromFile;
+    options.ignoreUnknownColumns = this->IgnoreUnknownColumns;
     const std::string motionKey = Text(this->MotionFileName) + "|" + std::to_string(this->AngleUnit) + "|" +
       std::to_string(this->IgnoreUnknownColumns);
     if (motionKey != in.motionKey)
@@ -272,21 +278,23 @@ bool vtkOpenSimModelReader::Load()
       in.motionKey.clear();
       if (!Text(this->MotionFileName).empty())
       {
-        osim::MotionOptions options;
-        options.angles = this->AngleUnit == ANGLES_IN_DEGREES ? osim::AngleUnit::Degrees
-          : this->AngleUnit == ANGLES_IN_RADIANS             ? osim::AngleUnit::Radians
-                                                             : osim::AngleUnit::FromFile;
-        options.ignoreUnknownColumns = this->IgnoreUnknownColumns;
         in.trajectory = osim::MapMotion(in.model, osim::ReadMotion(this->MotionFileName), options);
         warnings.insert(warnings.end(), in.trajectory.warnings.begin(), in.trajectory.warnings.end());
       }
       in.motionKey = motionKey;
     }
-    const std::string poseKey = Text(this->RestPoseCoordinates) + "|" + Text(this->ReferenceBody);
+    const std::string poseKey = Text(this->RestPoseFileName) + "|" + Text(this->RestPoseCoordinates) + "|" +
+      Text(this->ReferenceBody) + "|" + motionKey;
     if (poseKey != in.poseKey)
     {
       in.poseKey.clear();
       in.rest = osim::DefaultCoordinates(in.model);
+      if (!Text(this->RestPoseFileName).empty())
+      {
+        // The first row of a motion file (a static trial in the scan pose), read as the motion is.
+        const osim::CoordinateTrajectory pose = osim::MapMotion(in.model, osim::ReadMotion(this->RestPoseFileName), options);
+        in.rest = pose.frames.front();
+      }
       osim::SetCoordinates(in.model, Text(this->RestPoseCoordinates), true, in.rest);
       in.restPoses = osim::BodyPoses(in.model, in.rest);
       in.toOutput = RigidTransform();
@@ -516,6 +524,7 @@ void vtkOpenSimModelReader::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MotionFileName: " << Text(this->MotionFileName) << "\n";
   os << indent << "GeometrySearchPath: " << Text(this->GeometrySearchPath) << "\n";
   os << indent << "RestPoseCoordinates: " << Text(this->RestPoseCoordinates) << "\n";
+  os << indent << "RestPoseFileName: " << Text(this->RestPoseFileName) << "\n";
   os << indent << "ReferenceBody: " << Text(this->ReferenceBody) << "\n";
   os << indent << "Scale: " << this->Scale << "\n";
   os << indent << "CurrentPoseTime: " << this->CurrentPoseTime << "\n";

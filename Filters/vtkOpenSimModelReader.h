@@ -69,6 +69,11 @@ public:
   vtkGetStringMacro(RestPoseCoordinates);
   vtkSetStringMacro(RestPoseCoordinates);
 
+  /// A motion file whose first row is the rest pose (a static trial in the scan pose), read as
+  /// MotionFileName is; RestPoseCoordinates, when given, override its values.
+  vtkGetStringMacro(RestPoseFileName);
+  vtkSetStringMacro(RestPoseFileName);
+
   /// The body whose rest-pose frame the outputs are expressed in; empty: ground.
   vtkGetStringMacro(ReferenceBody);
   vtkSetStringMacro(ReferenceBody);
@@ -122,6 +127,7 @@ protected:
   char* MotionFileName = nullptr;
   char* GeometrySearchPath = nullptr;
   char* RestPoseCoordinates = nullptr;
+  char* RestPoseFileName = nullptr;
   char* ReferenceBody = nullptr;
   double Scale = 1.0;
   double CurrentPoseTime = 0.0;

@@ -101,6 +101,22 @@ TEST(OpenSimModelReader, FramesFollowTheRequestedTimeAndTheModelIsReadOnce)
   EXPECT_EQ(reader->GetModelReadCount(), 2);
 }
 
+TEST(OpenSimModelReader, TheRestPoseCanComeFromAMotionFilesFirstRow)
+{
+  vtkNew<vtkOpenSimModelReader> reader;
+  reader->SetFileName(Write("knee.osim", kModel).c_str());
+  reader->SetRestPoseFileName(Write("static.mot", "static\nversion=1\ninDegrees=yes\nendheader\ntime angle\n0 90\n1 0\n").c_str());
+  reader->Update();
+  // The rest pose (90 degrees, the first row): rest and current outputs agree without a motion.
+  auto* rest = vtkMultiBlockDataSet::SafeDownCast(reader->GetOutputDataObject(vtkOpenSimModelReader::MUSCLE_PATHS_REST));
+  EXPECT_NEAR(Field(rest->GetBlock(0), "PathLength"), std::hypot(1.0, 1.0), 1e-12);
+  // Coordinates given by value override the file's.
+  reader->SetRestPoseCoordinates("angle=0");
+  reader->Update();
+  rest = vtkMultiBlockDataSet::SafeDownCast(reader->GetOutputDataObject(vtkOpenSimModelReader::MUSCLE_PATHS_REST));
+  EXPECT_NEAR(Field(rest->GetBlock(0), "PathLength"), 2.0, 1e-12);
+}
+
 TEST(OpenSimModelReader, BadInputLeavesEmptyOutputs)
 {
   CapturedMessages messages;
