@@ -23,6 +23,7 @@
 #include <vtkTriangleFilter.h>
 
 #include <map>
+#include <optional>
 #include <set>
 
 namespace mdvtk
@@ -75,24 +76,24 @@ void AcceptPolyDataOrMultiBlock(vtkInformation* info)
   info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkMultiBlockDataSet");
 }
 
-/// Fails, naming the block, on a cell that refers to a point the block does not have or a point
-/// array whose tuples do not match the points: what would otherwise be read past an array's end.
-/// The first id of `ids` outside [0, points), or -1 when there is none (-2 stands for an id of
-/// -1 itself; other negative ids are returned as they are).
+namespace
+{
+/// The first of `count` ids outside [0, points), if any.
 template <typename Value>
-vtkIdType FirstOutOfRange(const Value* ids, vtkIdType count, vtkIdType points)
+std::optional<vtkIdType> FirstOutOfRange(const Value* ids, vtkIdType count, vtkIdType points)
 {
   for (vtkIdType i = 0; i < count; ++i)
   {
     if (ids[i] < 0 || static_cast<vtkIdType>(ids[i]) >= points)
     {
-      return ids[i] == -1 ? -2 : static_cast<vtkIdType>(ids[i]);
+      return static_cast<vtkIdType>(ids[i]);
     }
   }
-  return -1;
+  return std::nullopt;
 }
 
-vtkIdType FirstIdOutOfRange(vtkDataArray* ids, vtkIdType points)
+/// The same for a cell array's connectivity, read in place when it is of VTK's usual storage.
+std::optional<vtkIdType> FirstIdOutOfRange(vtkDataArray* ids, vtkIdType points)
 {
   const vtkIdType count = ids->GetNumberOfValues();
   if (auto* wide = vtkAOSDataArrayTemplate<vtkTypeInt64>::FastDownCast(ids))
@@ -103,18 +104,15 @@ vtkIdType FirstIdOutOfRange(vtkDataArray* ids, vtkIdType points)
   {
     return FirstOutOfRange(narrow->GetPointer(0), count, points);
   }
-  for (vtkIdType i = 0; i < count; ++i)
-  {
-    const auto id = static_cast<vtkIdType>(ids->GetComponent(i, 0));
-    if (id < 0 || id >= points)
-    {
-      return id == -1 ? -2 : id;
-    }
-  }
-  return -1;
+  vtkNew<vtkIdTypeArray> copy;
+  copy->DeepCopy(ids);
+  return FirstOutOfRange(copy->GetPointer(0), count, points);
 }
 
-static bool CheckLeaf(vtkPolyData* data, const std::string& label, std::string& error)
+/// Fails, naming the block, on coordinates that are not finite or beyond 1e100, a cell that
+/// refers to a point the block does not have, or a point array whose tuples do not match the
+/// points: what would otherwise be read past an array's end or overflow.
+bool CheckLeaf(vtkPolyData* data, const std::string& label, std::string& error)
 {
   const vtkIdType points = data->GetNumberOfPoints();
   // Coordinates: finite, and small enough that products of three of them (volumes) stay finite.
@@ -144,10 +142,10 @@ static bool CheckLeaf(vtkPolyData* data, const std::string& label, std::string& 
     }
     // Every id is read (not the array's cached range, which an array changed without
     // Modified() would leave stale).
-    const vtkIdType bad = FirstIdOutOfRange(cells->GetConnectivityArray(), points);
-    if (bad >= 0 || bad < -1)
+    const std::optional<vtkIdType> bad = FirstIdOutOfRange(cells->GetConnectivityArray(), points);
+    if (bad)
     {
-      error = label + " has a " + kinds[k] + " cell that refers to point " + std::to_string(bad == -2 ? -1 : bad) +
+      error = label + " has a " + kinds[k] + " cell that refers to point " + std::to_string(*bad) +
         ", but it has " + std::to_string(points) + " points (ids 0 to " + std::to_string(points - 1) + ")";
       return false;
     }
@@ -164,6 +162,7 @@ static bool CheckLeaf(vtkPolyData* data, const std::string& label, std::string& 
     }
   }
   return true;
+}
 }
 
 bool CollectLeaves(
@@ -458,9 +457,9 @@ bool ReadMeshes(vtkInformationVector* port, const std::string& portName, std::ve
       }
       TriangleMesh mesh;
       ReadTriangles(leaf.data, mesh);
-      if (mesh.triangles.rows() == 0 || !md::AllFinite(mesh.points))
+      if (mesh.triangles.rows() == 0)
       {
-        error = leaf.label + " is not a usable mesh: it needs triangles and finite coordinates";
+        error = leaf.label + " is not a usable mesh: it has no triangles";
         return false;
       }
       names.push_back(leaf.name.empty() ? leaf.label : leaf.name);

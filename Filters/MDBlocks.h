@@ -33,7 +33,9 @@ struct Leaf
 
 /// The polydata leaves of `input` (a vtkPolyData or a vtkMultiBlockDataSet),
 /// in iteration order. Fails, with a message in `error`, when a leaf is not a
-/// vtkPolyData or when the input is missing or has no leaves.
+/// vtkPolyData, when the input is missing or has no leaves, or when a leaf has
+/// non-finite coordinates (or beyond 1e100), a cell referring to a point it does
+/// not have, or a point array whose length is not its number of points.
 bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves,
   std::string& error);
 

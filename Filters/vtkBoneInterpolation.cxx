@@ -135,11 +135,8 @@ bool vtkBoneInterpolation::ReadPoses(
       }
       pose.current = mdvtk::ToPoints(position);
     }
-    if (!md::AllFinite(pose.rest))
-    {
-      vtkErrorMacro(<< rest.label << " has NaN or infinite coordinates");
-      return false;
-    }
+    // The points of both inputs were checked by CollectLeaves; a CurrentPosition array's values
+    // were not.
     if (!md::AllFinite(pose.current))
     {
       vtkErrorMacro(<< (currentInput ? currentLeaves[partner[b]].label : rest.label + " CurrentPosition")

@@ -208,11 +208,6 @@ int vtkInterpolatedMuscleDeformation::RequestData(
         vtkErrorMacro(<< leaf.label << " has no surface (no polygons); a muscle must be a closed triangle surface");
         return 0;
       }
-      if (!md::AllFinite(motion.muscle.points))
-      {
-        vtkErrorMacro(<< leaf.label << " has non-finite coordinates (NaN or infinity)");
-        return 0;
-      }
       const mdvtk::Leaf& restLeaf = restLines[restLinesOf[b]];
       const mdvtk::Leaf& currentLeaf = currentLines[currentLinesOf[restLinesOf[b]]];
       const std::vector<md::Points> rest = restLeaf.data ? mdvtk::ToPolylines(restLeaf.data) : std::vector<md::Points>{};

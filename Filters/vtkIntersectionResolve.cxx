@@ -49,9 +49,9 @@ bool ReadLeafMeshes(const std::vector<mdvtk::Leaf>& leaves, std::vector<md::Tria
       continue;
     }
     mdvtk::ReadTriangles(leaves[b].data, meshes[b]);
-    if (meshes[b].triangles.rows() == 0 || !md::AllFinite(meshes[b].points))
+    if (meshes[b].triangles.rows() == 0)
     {
-      error = leaves[b].label + " is not a usable surface: it needs triangles and finite coordinates";
+      error = leaves[b].label + " is not a usable surface: it has no triangles";
       return false;
     }
   }

@@ -122,12 +122,7 @@ int vtkMuscleDeformation::RequestData(
       vtkErrorMacro(<< leaf.label << " has no surface (no polygons); a muscle must be a closed triangle surface");
       return 0;
     }
-    mdvtk::ReadTriangles(leaf.data, surfaces[b]);
-    if (!md::AllFinite(surfaces[b].points))
-    {
-      vtkErrorMacro(<< leaf.label << " has non-finite coordinates (NaN or infinity)");
-      return 0;
-    }
+    mdvtk::ReadTriangles(leaf.data, surfaces[b]); // coordinates checked finite by CollectLeaves
     md::MuscleToDeform muscle;
     muscle.name = leaf.name.empty() ? leaf.label : leaf.name;
     muscle.muscle = &surfaces[b];

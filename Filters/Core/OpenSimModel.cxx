@@ -161,23 +161,37 @@ public:
     return this->Numbers(node, child, 1)[0];
   }
 
+  /// `make()`, whose complaints (knots that do not increase, ...) are told with this node's place
+  /// in the file.
+  template <typename Make>
+  Function Located(Node node, Make make) const
+  {
+    try
+    {
+      return make();
+    }
+    catch (const InputError& e)
+    {
+      this->Fail(node, e.what());
+    }
+  }
+
   Function ReadFunction(Node node) const
   {
     const std::string type = node.name();
-    try
+    if (type == "Constant")
     {
-      if (type == "Constant")
-      {
-        return Function::Constant(this->Number(node, "value", 0.0));
-      }
-      if (type == "LinearFunction")
-      {
-        const std::vector<double> c = this->Numbers(node, "coefficients", 2);
-        return Function::Linear(c[0], c[1]);
-      }
-      if (type == "SimmSpline" || type == "NaturalCubicSpline" || type == "PiecewiseLinearFunction")
-      {
-        std::vector<double> x = this->Numbers(node, "x"), y = this->Numbers(node, "y");
+      return Function::Constant(this->Number(node, "value", 0.0));
+    }
+    if (type == "LinearFunction")
+    {
+      const std::vector<double> c = this->Numbers(node, "coefficients", 2);
+      return Function::Linear(c[0], c[1]);
+    }
+    if (type == "SimmSpline" || type == "NaturalCubicSpline" || type == "PiecewiseLinearFunction")
+    {
+      std::vector<double> x = this->Numbers(node, "x"), y = this->Numbers(node, "y");
+      return this->Located(node, [&]() {
         if (type == "SimmSpline")
         {
           return Function::SimmSpline(std::move(x), std::move(y));
@@ -187,28 +201,21 @@ public:
           return Function::NaturalCubicSpline(std::move(x), std::move(y));
         }
         return Function::PiecewiseLinear(std::move(x), std::move(y));
-      }
-      if (type == "PolynomialFunction")
-      {
-        return Function::Polynomial(this->Numbers(node, "coefficients"));
-      }
-      if (type == "MultiplierFunction")
-      {
-        Node inner = this->FunctionChild(node, "function");
-        if (!inner)
-        {
-          this->Fail(node, "MultiplierFunction without a function");
-        }
-        return Function::Multiplier(this->ReadFunction(inner), this->Number(node, "scale", 1.0));
-      }
+      });
     }
-    catch (const InputError& e)
+    if (type == "PolynomialFunction")
     {
-      if (std::strncmp(e.what(), "OpenSim model", 13) == 0)
+      const std::vector<double> coefficients = this->Numbers(node, "coefficients");
+      return this->Located(node, [&]() { return Function::Polynomial(coefficients); });
+    }
+    if (type == "MultiplierFunction")
+    {
+      Node inner = this->FunctionChild(node, "function");
+      if (!inner)
       {
-        throw;
+        this->Fail(node, "MultiplierFunction without a function");
       }
-      this->Fail(node, e.what());
+      return Function::Multiplier(this->ReadFunction(inner), this->Number(node, "scale", 1.0));
     }
     this->Fail(node,
       "unknown function type '" + type +
@@ -218,7 +225,7 @@ public:
 
   /// The function element of `owner` for its property `property`: 3.x wraps it
   /// (<property><SimmSpline>), 4.x names it (<SimmSpline name="property">). Empty when absent;
-  /// fails on an element that is no known function.
+  /// ReadFunction says so when the element is no known function.
   Node FunctionChild(Node owner, const char* property) const
   {
     Node wrapper = owner.child(property);
@@ -274,6 +281,15 @@ std::string LastPathPart(std::string path)
   }
   const size_t slash = path.rfind('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+/// The first word of `text`, or "" when it has none.
+std::string FirstWord(const char* text)
+{
+  std::istringstream stream(text);
+  std::string word;
+  stream >> word;
+  return word;
 }
 
 std::vector<std::string> Words(const char* text)
@@ -430,9 +446,7 @@ private:
       for (Node display : visible.child("GeometrySet").child("objects").children("DisplayGeometry"))
       {
         Geometry g;
-        g.file = Words(display.child("geometry_file").text().get()).empty()
-          ? std::string()
-          : Words(display.child("geometry_file").text().get())[0];
+        g.file = FirstWord(display.child("geometry_file").text().get());
         g.scale = overallScale.cwiseProduct(this->reader.Vector(display, "scale_factors", Eigen::Vector3d::Ones()));
         const std::vector<double> t = this->reader.Numbers(display, "transform");
         g.placement = overallPlacement;
@@ -640,9 +654,7 @@ private:
       {
         coordinates.push_back(this->AddCoordinate(c, name));
       }
-      const std::string parentName = Words(joint.child("parent_body").text().get()).empty()
-        ? std::string()
-        : Words(joint.child("parent_body").text().get())[0];
+      const std::string parentName = FirstWord(joint.child("parent_body").text().get());
       j.parentBody = this->model.FindBody(parentName);
       if (j.parentBody < 0)
       {
@@ -963,15 +975,15 @@ private:
     {
       return this->ResolveFrame(point, point.child("socket_parent_frame").text().get(), Node());
     }
-    const std::vector<std::string> body = Words(point.child("body").text().get());
+    const std::string body = FirstWord(point.child("body").text().get());
     if (body.empty())
     {
       this->reader.Fail(point, "the path point names no body");
     }
-    const int index = this->model.FindBody(body[0]);
+    const int index = this->model.FindBody(body);
     if (index < 0)
     {
-      this->reader.Fail(point, "body '" + body[0] + "' is not in the model");
+      this->reader.Fail(point, "body '" + body + "' is not in the model");
     }
     return { index, RigidTransform() };
   }
@@ -1007,7 +1019,7 @@ private:
         const std::string coordinate = pointNode.child("socket_coordinate")
           ? pointNode.child("socket_coordinate").text().get()
           : pointNode.child("coordinate").text().get();
-        p.coordinate = this->CoordinateOf(pointNode, Words(coordinate.c_str()).empty() ? "" : Words(coordinate.c_str())[0]);
+        p.coordinate = this->CoordinateOf(pointNode, FirstWord(coordinate.c_str()));
       }
       else if (type == "MovingPathPoint")
       {
@@ -1024,10 +1036,10 @@ private:
           {
             coordinate = pointNode.child(coordinateName.c_str());
           }
-          const std::vector<std::string> words = Words(coordinate.text().get());
-          if (!words.empty())
+          const std::string name = FirstWord(coordinate.text().get());
+          if (!name.empty())
           {
-            p.locationCoordinate[i] = this->CoordinateOf(pointNode, words[0]);
+            p.locationCoordinate[i] = this->CoordinateOf(pointNode, name);
           }
         }
       }
@@ -1039,10 +1051,10 @@ private:
     }
     for (Node wrap : geometryPath.child("PathWrapSet").child("objects").children("PathWrap"))
     {
-      const std::vector<std::string> words = Words(wrap.child("wrap_object").text().get());
-      if (!words.empty())
+      const std::string name = FirstWord(wrap.child("wrap_object").text().get());
+      if (!name.empty())
       {
-        path.wrapObjects.push_back(words[0]);
+        path.wrapObjects.push_back(name);
       }
     }
     this->model.paths.push_back(path);
