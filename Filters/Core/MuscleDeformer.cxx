@@ -38,6 +38,14 @@ Eigen::Vector3d JustOutside(const TriangleTree::Closest& closest, const Eigen::V
   return closest.point + (offset / closest.distance) * (closest.point - p);
 }
 
+/// The parameter in [0, 1] of the foot of p on the segment from a to b (0 on a segment of no length).
+double SegmentFoot(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+{
+  const Eigen::Vector3d ab = b - a;
+  const double length2 = ab.squaredNorm();
+  return length2 > 0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+}
+
 /// The action-line segment nearest to p (over all lines), as line and index
 /// of its first point, with the parameter of p's foot on it in [0, 1].
 /// Segments of zero length in either pose carry no direction and are skipped.
@@ -59,7 +67,7 @@ struct NearestSegment
         {
           continue;
         }
-        const double foot = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+        const double foot = SegmentFoot(p, a, b);
         const double d = (a + foot * (b - a) - p).norm();
         if (d < nearest)
         {
@@ -864,10 +872,7 @@ namespace
 {
 double SegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b)
 {
-  const Eigen::Vector3d ab = b - a;
-  const double length2 = ab.squaredNorm();
-  const double t = length2 > 0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
-  return (p - (a + t * ab)).norm();
+  return (a + SegmentFoot(p, a, b) * (b - a) - p).norm();
 }
 }
 
@@ -907,8 +912,7 @@ std::vector<std::string> LimitActionLinePoints(std::vector<MatchedLine>& lines, 
       return out;
     };
     // Deviations below rounding of the line's size: the points lie on the kept line.
-    const double negligible =
-      1e-12 * (line.rest.colwise().maxCoeff() - line.rest.colwise().minCoeff()).norm();
+    const double negligible = 1e-12 * Diagonal(line.rest);
     std::vector<char> keep(static_cast<size_t>(n), 0);
     keep.front() = keep.back() = 1;
     Eigen::Index kept = 2;
