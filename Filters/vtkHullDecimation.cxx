@@ -67,7 +67,6 @@ int vtkHullDecimation::RequestData(
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const md::RepairReport& report = built.report;
-    const md::TriangleMesh& clean = built.clean;
     const md::HullResult& hull = built.result;
     if (converted > 0 || report.Changed())
     {
@@ -85,11 +84,9 @@ int vtkHullDecimation::RequestData(
 
     auto output = mdvtk::ToPolyData(hull.hull);
     vtkFieldData* fieldData = output->GetFieldData();
-    const double hullVolume = md::SignedVolume(hull.hull.points, hull.hull.triangles);
-    const double muscleVolume = md::SignedVolume(clean.points, clean.triangles);
-    mdvtk::AddFieldValue(fieldData, "HullVolume", hullVolume);
-    mdvtk::AddFieldValue(fieldData, "MuscleVolume", muscleVolume);
-    mdvtk::AddFieldValue(fieldData, "HullVolumeRatio", hullVolume / muscleVolume);
+    mdvtk::AddFieldValue(fieldData, "HullVolume", built.hullVolume);
+    mdvtk::AddFieldValue(fieldData, "MuscleVolume", built.cleanVolume);
+    mdvtk::AddFieldValue(fieldData, "HullVolumeRatio", built.hullVolume / built.cleanVolume);
     mdvtk::AddFieldValue(fieldData, "NumberOfCollapses", hull.collapses);
     mdvtk::AddFieldValue(fieldData, "ElapsedSeconds", seconds);
     if (report.Changed() || converted > 0)

@@ -117,7 +117,7 @@ int vtkInterpolatedMuscleDeformation::RequestInformation(
     }
     md::InterpolationParameters parameters;
     parameters.numberOfSteps = 0;
-    parameters.maximumStepDisplacement = this->MaximumStepDisplacement;
+    parameters.maximumStepDisplacement = this->MaximumStepDisplacement; // bones in world units here
     try
     {
       steps = md::ResolveNumberOfSteps(bones, parameters);
@@ -192,6 +192,27 @@ int vtkInterpolatedMuscleDeformation::RequestData(
       vtkErrorMacro(<< error);
       return 0;
     }
+    // Everything in the muscles' local frame from here on, the matching of the action lines
+    // too: the same answer wherever the data sits and whatever its units.
+    std::vector<md::Points> worldMuscles;
+    for (const mdvtk::Leaf& leaf : muscles)
+    {
+      if (leaf.data)
+      {
+        worldMuscles.push_back(mdvtk::ToPoints(leaf.data->GetPoints()));
+      }
+    }
+    std::vector<const md::Points*> muscleParts;
+    for (const md::Points& points : worldMuscles)
+    {
+      muscleParts.push_back(&points);
+    }
+    const md::LocalFrame frame = md::LocalFrame::Around(muscleParts);
+    for (md::BoneMotion& bone : bones)
+    {
+      frame.ToLocal(bone.rest.points);
+      frame.ToLocal(bone.current);
+    }
     std::vector<md::MuscleMotion> motions;
     for (size_t b = 0; b < muscles.size(); ++b)
     {
@@ -208,11 +229,19 @@ int vtkInterpolatedMuscleDeformation::RequestData(
         vtkErrorMacro(<< leaf.label << " has no surface (no polygons); a muscle must be a closed triangle surface");
         return 0;
       }
+      frame.ToLocal(motion.muscle.points);
       const mdvtk::Leaf& restLeaf = restLines[restLinesOf[b]];
       const mdvtk::Leaf& currentLeaf = currentLines[currentLinesOf[restLinesOf[b]]];
-      const std::vector<md::Points> rest = restLeaf.data ? mdvtk::ToPolylines(restLeaf.data) : std::vector<md::Points>{};
-      const std::vector<md::Points> current =
+      std::vector<md::Points> rest = restLeaf.data ? mdvtk::ToPolylines(restLeaf.data) : std::vector<md::Points>{};
+      std::vector<md::Points> current =
         currentLeaf.data ? mdvtk::ToPolylines(currentLeaf.data) : std::vector<md::Points>{};
+      for (auto* lines : { &rest, &current })
+      {
+        for (md::Points& line : *lines)
+        {
+          frame.ToLocal(line);
+        }
+      }
       if (rest.empty())
       {
         vtkErrorMacro(<< restLeaf.label << " has no polylines: muscle " << leaf.label
@@ -248,13 +277,13 @@ int vtkInterpolatedMuscleDeformation::RequestData(
 
     md::InterpolationParameters parameters;
     parameters.numberOfSteps = this->ResolvedNumberOfSteps;
-    parameters.maximumStepDisplacement = this->MaximumStepDisplacement;
+    parameters.maximumStepDisplacement = frame.LengthToLocal(this->MaximumStepDisplacement);
     parameters.interpolationMode = static_cast<md::InterpolationMode>(this->BoneInterpolationMode);
     parameters.hullMode = static_cast<md::HullMode>(this->HullMode);
     parameters.refitRegularisation = this->RefitRegularisation;
     parameters.staticResolve.deformableShare = this->DeformableShare;
     parameters.deformation.maximumIterations = this->MaximumNumberOfIterations;
-    parameters.deformation.convergenceTolerance = this->ConvergenceTolerance;
+    parameters.deformation.convergenceTolerance = frame.LengthToLocal(this->ConvergenceTolerance);
     parameters.deformation.preserveVolume = this->PreserveVolume;
     parameters.deformation.contactWeight = this->BoneContactWeight;
     parameters.hull.targetNumberOfPoints = this->HullTargetNumberOfPoints;
@@ -262,6 +291,17 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     {
       cache.result =
         md::DeformByInterpolation(motions, bones, parameters, [this](double f) { this->UpdateProgress(f); });
+      md::ResultToWorld(frame, cache.result);
+      for (size_t m = 0; m < cache.blockOf.size(); ++m)
+      {
+        for (size_t j = 0; j < cache.result.points.size(); ++j)
+        {
+          if (j == 0 || cache.result.zeroMotion)
+          {
+            cache.result.points[j][m] = worldMuscles[m]; // the input itself, not its round trip
+          }
+        }
+      }
     }
     catch (const md::InputError& e)
     {

@@ -1,5 +1,6 @@
 #include "vtkIntersectionResolve.h"
 
+#include "LocalFrame.h"
 #include "MDBlocks.h"
 #include "MeshChecks.h"
 #include "MuscleDeformer.h"
@@ -136,6 +137,22 @@ int vtkIntersectionResolve::RequestData(
     used.push_back(b);
   }
 
+  // In the local frame of the meshes to resolve: the same answer wherever they sit, whatever
+  // their units.
+  std::vector<const md::Points*> parts;
+  for (const md::TriangleMesh& mesh : deformable)
+  {
+    parts.push_back(&mesh.points);
+  }
+  const md::LocalFrame frame = md::LocalFrame::Around(parts);
+  for (auto* list : { &deformable, &deformableRest, &obstacles, &restObstacles })
+  {
+    for (md::TriangleMesh& mesh : *list)
+    {
+      frame.ToLocal(mesh.points);
+    }
+  }
+
   md::OverlapMasks existing;
   std::vector<md::Obstacle> trees, restTrees;
   auto fixedOf = [](const std::vector<md::Obstacle>& list) {
@@ -180,17 +197,18 @@ int vtkIntersectionResolve::RequestData(
   for (size_t k = 0; k < used.size(); ++k)
   {
     const size_t b = used[k];
+    md::Points points = resolved.points[k];
+    frame.ToWorld(points);
+    md::Points shifts = resolved.shift[k];
+    frame.VectorsToWorld(shifts);
     auto output = vtkSmartPointer<vtkPolyData>::New();
     output->ShallowCopy(leaves[b].data);
-    output->SetPoints(mdvtk::ToVtkPoints(resolved.points[k]));
+    output->SetPoints(mdvtk::ToVtkPoints(points));
     vtkNew<vtkDoubleArray> shift;
     shift->SetName("StaticShift");
     shift->SetNumberOfComponents(3);
-    shift->SetNumberOfTuples(resolved.shift[k].rows());
-    for (Eigen::Index i = 0; i < resolved.shift[k].rows(); ++i)
-    {
-      shift->SetTuple(i, resolved.shift[k].row(i).data());
-    }
+    shift->SetNumberOfTuples(shifts.rows());
+    std::copy(shifts.data(), shifts.data() + shifts.size(), shift->GetPointer(0));
     output->GetPointData()->AddArray(shift);
     // Field data describes this output only: the upstream measures (a deformation's volume
     // change, iterations, ...) no longer hold once points have moved.
@@ -202,10 +220,10 @@ int vtkIntersectionResolve::RequestData(
     mdvtk::AddFieldValue(fieldData, "VolumeChangePercent", 100.0 * (volume - referenceVolume) / referenceVolume);
     mdvtk::AddFieldValue(fieldData, "PenetratingPointCount", r.penetratingPoints);
     mdvtk::AddFieldValue(fieldData, "PenetratingGroupCount", r.groups);
-    mdvtk::AddFieldValue(fieldData, "MaxPenetrationDepth", r.maxDepth);
-    mdvtk::AddFieldValue(fieldData, "MaxStaticShift", r.maxShift);
+    mdvtk::AddFieldValue(fieldData, "MaxPenetrationDepth", frame.LengthToWorld(r.maxDepth));
+    mdvtk::AddFieldValue(fieldData, "MaxStaticShift", frame.LengthToWorld(r.maxShift));
     mdvtk::AddFieldValue(fieldData, "NewPenetrationCount", left[k].count);
-    mdvtk::AddFieldValue(fieldData, "MaxNewPenetrationDepth", left[k].maxDepth);
+    mdvtk::AddFieldValue(fieldData, "MaxNewPenetrationDepth", frame.LengthToWorld(left[k].maxDepth));
     output->SetFieldData(fieldData);
     outputs[b] = output;
   }

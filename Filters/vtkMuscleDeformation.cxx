@@ -1,6 +1,8 @@
 #include "vtkMuscleDeformation.h"
 
+#include "LocalFrame.h"
 #include "MDBlocks.h"
+#include "MeanValueCoordinates.h"
 #include "MeshChecks.h"
 #include "MuscleDeformer.h"
 #include "ProgressiveHull.h"
@@ -15,7 +17,9 @@
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 
+#include <algorithm>
 #include <chrono>
+#include <map>
 #include <memory>
 
 vtkStandardNewMacro(vtkMuscleDeformation);
@@ -60,10 +64,47 @@ bool ReadMatchedLines(const mdvtk::Leaf& leaf, std::vector<md::MatchedLine>& lin
 }
 }
 
+namespace
+{
+/// One muscle's rest-pose work: its hull (built or given) and the mean value coordinates of its
+/// points in it, all in the local frame, with what they were made from.
+struct KeptMuscle
+{
+  md::TriangleMesh surface;
+  md::LocalFrame frame;
+  bool hullGiven = false;
+  int target = 0;
+  md::TriangleMesh hull;
+  md::WeightMatrix weights;
+  std::string repairs; ///< what the repair before the hull changed, said again on every run
+
+  bool Holds(const md::TriangleMesh& muscle, const md::LocalFrame& now, bool given, const md::TriangleMesh* givenHull,
+    int targetNumberOfPoints) const
+  {
+    return this->weights.size() > 0 && this->hullGiven == given && Same(this->surface, muscle) &&
+      this->frame.origin == now.origin && this->frame.unit == now.unit &&
+      (given ? Same(this->hull, *givenHull) : this->target == targetNumberOfPoints);
+  }
+  static bool Same(const md::TriangleMesh& a, const md::TriangleMesh& b)
+  {
+    return a.points.rows() == b.points.rows() && a.triangles.rows() == b.triangles.rows() &&
+      a.points == b.points && a.triangles == b.triangles;
+  }
+};
+}
+
+struct vtkMuscleDeformation::RestPoseCache
+{
+  std::map<size_t, KeptMuscle> byBlock;
+};
+
 vtkMuscleDeformation::vtkMuscleDeformation()
+  : Kept(std::make_unique<RestPoseCache>())
 {
   this->SetNumberOfInputPorts(4);
 }
+
+vtkMuscleDeformation::~vtkMuscleDeformation() = default;
 
 int vtkMuscleDeformation::FillInputPortInformation(int port, vtkInformation* info)
 {
@@ -139,6 +180,19 @@ int vtkMuscleDeformation::RequestData(
     toDeform.push_back(std::move(muscle));
     blockOf.push_back(b);
   }
+  if (hullGiven)
+  {
+    for (size_t b : blockOf)
+    {
+      const mdvtk::Leaf& hullLeaf = hullLeaves[hullOf[b]];
+      if (!hullLeaf.data || hullLeaf.data->GetNumberOfPolys() == 0)
+      {
+        vtkErrorMacro(<< hullLeaf.label << " has no surface");
+        return 0;
+      }
+      mdvtk::ReadTriangles(hullLeaf.data, hulls[b]);
+    }
+  }
 
   // Obstacles: every block of every connection of port 2.
   std::vector<std::string> obstacleNames;
@@ -149,67 +203,112 @@ int vtkMuscleDeformation::RequestData(
     return 0;
   }
 
-  // Hulls: given (and checked to enclose the muscle), or built.
+  // The computation runs in the muscles' local frame: the same answer wherever they sit and
+  // whatever their units.
+  std::vector<const md::Points*> muscleParts;
+  for (size_t b : blockOf)
+  {
+    muscleParts.push_back(&surfaces[b].points);
+  }
+  const md::LocalFrame frame = md::LocalFrame::Around(muscleParts);
+  for (size_t m = 0; m < toDeform.size(); ++m)
+  {
+    frame.ToLocal(surfaces[blockOf[m]].points);
+    frame.ToLocal(hulls[blockOf[m]].points);
+    for (md::MatchedLine& line : toDeform[m].lines)
+    {
+      frame.ToLocal(line.rest);
+      frame.ToLocal(line.current);
+    }
+  }
+  for (md::TriangleMesh& obstacle : obstacleMeshes)
+  {
+    frame.ToLocal(obstacle.points);
+  }
+
+  // Hulls and their mean value coordinates: kept from an earlier run when the muscle (and its
+  // given hull, or the hull size) are the same, else checked (given) or built.
+  RestPoseCache& kept = *this->Kept;
+  for (auto entry = kept.byBlock.begin(); entry != kept.byBlock.end();)
+  {
+    entry = std::find(blockOf.begin(), blockOf.end(), entry->first) == blockOf.end() ? kept.byBlock.erase(entry)
+                                                                                      : std::next(entry);
+  }
   for (size_t m = 0; m < toDeform.size(); ++m)
   {
     const size_t b = blockOf[m];
     const mdvtk::Leaf& leaf = muscles[b];
     this->UpdateProgress(0.3 * m / toDeform.size());
-    const auto hullStart = Clock::now();
-    if (hullGiven)
+    if (this->CheckAbort())
     {
-      const mdvtk::Leaf& hullLeaf = hullLeaves[hullOf[b]];
-      if (!hullLeaf.data || hullLeaf.data->GetNumberOfPolys() == 0)
-      {
-        vtkErrorMacro(<< hullLeaf.label << " has no surface");
-        return 0;
-      }
-      mdvtk::ReadTriangles(hullLeaf.data, hulls[b]);
-      if (!md::CheckEdges(hulls[b].triangles).IsClosedOrientedManifold() ||
-        md::SignedVolume(hulls[b].points, hulls[b].triangles) <= 0)
-      {
-        vtkErrorMacro(<< hullLeaf.label
-                      << " is not a closed, outward-oriented manifold surface: build it with HullDecimation");
-        return 0;
-      }
-      const std::int64_t outside = md::CountPointsOutsideHull(hulls[b], surfaces[b]);
-      if (outside > 0)
-      {
-        vtkErrorMacro(<< hullLeaf.label << " does not enclose " << leaf.label << ": " << outside << " of "
-                      << md::UsedPoints(surfaces[b]).rows()
-                      << " muscle points are outside it, where mean value coordinates extrapolate; build the "
-                         "hull with HullDecimation or leave Hull empty");
-        return 0;
-      }
+      return 0;
     }
-    else
+    const auto hullStart = Clock::now();
+    KeptMuscle& entry = kept.byBlock[b];
+    if (!entry.Holds(surfaces[b], frame, hullGiven, hullGiven ? &hulls[b] : nullptr, this->HullTargetNumberOfPoints))
     {
-      md::HullParameters parameters;
-      parameters.targetNumberOfPoints = this->HullTargetNumberOfPoints;
-      try
+      entry = KeptMuscle{};
+      if (hullGiven)
       {
-        const md::MuscleHull built = md::BuildMuscleHull(surfaces[b], parameters);
-        hulls[b] = built.result.hull;
-        if (built.report.Changed())
+        const mdvtk::Leaf& hullLeaf = hullLeaves[hullOf[b]];
+        if (!md::CheckEdges(hulls[b].triangles).IsClosedOrientedManifold() ||
+          md::SignedVolume(hulls[b].points, hulls[b].triangles) <= 0)
         {
-          vtkWarningMacro(<< leaf.label << " was repaired to build its hull: " << built.report.Describe()
-                          << " (the muscle itself is deformed as given)");
+          vtkErrorMacro(<< hullLeaf.label
+                        << " is not a closed, outward-oriented manifold surface: build it with HullDecimation");
+          return 0;
+        }
+        const std::int64_t outside = md::CountPointsOutsideHull(hulls[b], surfaces[b], frame.rounding);
+        if (outside > 0)
+        {
+          vtkErrorMacro(<< hullLeaf.label << " does not enclose " << leaf.label << ": " << outside << " of "
+                        << md::UsedPoints(surfaces[b]).rows()
+                        << " muscle points are outside it, where mean value coordinates extrapolate; build the "
+                           "hull with HullDecimation or leave Hull empty");
+          return 0;
+        }
+        entry.hull = hulls[b];
+      }
+      else
+      {
+        md::HullParameters parameters;
+        parameters.targetNumberOfPoints = this->HullTargetNumberOfPoints;
+        try
+        {
+          const md::MuscleHull built = md::BuildMuscleHull(surfaces[b], parameters);
+          ++this->HullBuildCount;
+          entry.hull = built.result.hull;
+          if (built.report.Changed())
+          {
+            entry.repairs = built.report.Describe();
+          }
+        }
+        catch (const md::InputError& e)
+        {
+          vtkErrorMacro(<< leaf.label << ": " << e.what());
+          return 0;
         }
       }
-      catch (const md::InputError& e)
-      {
-        vtkErrorMacro(<< leaf.label << ": " << e.what());
-        return 0;
-      }
+      entry.weights = md::MeanValueCoordinates(entry.hull, surfaces[b].points);
+      entry.surface = surfaces[b];
+      entry.frame = frame;
+      entry.hullGiven = hullGiven;
+      entry.target = this->HullTargetNumberOfPoints;
     }
-    toDeform[m].hull = &hulls[b];
+    if (!entry.repairs.empty())
+    {
+      vtkWarningMacro(<< leaf.label << " was repaired to build its hull: " << entry.repairs
+                      << " (the muscle itself is deformed as given)");
+    }
+    toDeform[m].hull = &entry.hull;
+    toDeform[m].weights = &entry.weights;
     hullSeconds[b] = SecondsSince(hullStart);
   }
 
   md::DeformationParameters parameters;
   parameters.maximumIterations = this->MaximumNumberOfIterations;
   parameters.maximumCoarseIterations = this->MaximumCoarseIterations;
-  parameters.convergenceTolerance = this->ConvergenceTolerance;
+  parameters.convergenceTolerance = frame.LengthToLocal(this->ConvergenceTolerance);
   parameters.stepLength = this->StepLength;
   parameters.samplesPerSegment = this->SamplesPerSegment;
   parameters.preserveVolume = this->PreserveVolume;
@@ -239,19 +338,19 @@ int vtkMuscleDeformation::RequestData(
     {
       vtkWarningMacro(<< warning);
     }
+    md::Points displacement = r.points - surfaces[b].points;
+    frame.VectorsToWorld(displacement);
+    md::Points points = r.points;
+    frame.ToWorld(points);
     auto output = vtkSmartPointer<vtkPolyData>::New();
     output->ShallowCopy(muscles[b].data);
-    output->SetPoints(mdvtk::ToVtkPoints(r.points));
-    vtkNew<vtkDoubleArray> displacement;
-    displacement->SetName("Displacement");
-    displacement->SetNumberOfComponents(3);
-    displacement->SetNumberOfTuples(r.points.rows());
-    for (Eigen::Index i = 0; i < r.points.rows(); ++i)
-    {
-      const Eigen::RowVector3d d = r.points.row(i) - surfaces[b].points.row(i);
-      displacement->SetTuple(i, d.data());
-    }
-    output->GetPointData()->AddArray(displacement);
+    output->SetPoints(mdvtk::ToVtkPoints(points));
+    vtkNew<vtkDoubleArray> displacementArray;
+    displacementArray->SetName("Displacement");
+    displacementArray->SetNumberOfComponents(3);
+    displacementArray->SetNumberOfTuples(displacement.rows());
+    std::copy(displacement.data(), displacement.data() + displacement.size(), displacementArray->GetPointer(0));
+    output->GetPointData()->AddArray(displacementArray);
     vtkNew<vtkFieldData> fieldData;
     fieldData->DeepCopy(muscles[b].data->GetFieldData());
     mdvtk::AddFieldValue(fieldData, "VolumeChangePercent", r.volumeChangePercent);
@@ -285,4 +384,5 @@ void vtkMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "PreserveVolume: " << this->PreserveVolume << "\n";
   os << indent << "DynamicIntersections: " << this->DynamicIntersections << "\n";
   os << indent << "HullTargetNumberOfPoints: " << this->HullTargetNumberOfPoints << "\n";
+  os << indent << "HullBuildCount: " << this->HullBuildCount << "\n";
 }

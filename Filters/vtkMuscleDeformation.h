@@ -36,6 +36,8 @@
 
 #include <vtkPassInputTypeAlgorithm.h>
 
+#include <memory>
+
 class MUSCLEDEFORMATIONFILTERS_EXPORT vtkMuscleDeformation : public vtkPassInputTypeAlgorithm
 {
 public:
@@ -84,9 +86,15 @@ public:
   vtkSetClampMacro(HullTargetNumberOfPoints, int, 4, VTK_INT_MAX);
   vtkGetMacro(HullTargetNumberOfPoints, int);
 
+  /// Hulls built so far (input 3 empty). A muscle's hull and its mean value coordinates depend on
+  /// its rest-pose surface and HullTargetNumberOfPoints only, so they are kept: a new pose, new
+  /// action lines or another iteration setting reuses them, a changed muscle or hull size
+  /// rebuilds that muscle's.
+  vtkGetMacro(HullBuildCount, int);
+
 protected:
   vtkMuscleDeformation();
-  ~vtkMuscleDeformation() override = default;
+  ~vtkMuscleDeformation() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
@@ -103,4 +111,7 @@ protected:
 private:
   vtkMuscleDeformation(const vtkMuscleDeformation&) = delete;
   void operator=(const vtkMuscleDeformation&) = delete;
+  int HullBuildCount = 0;
+  struct RestPoseCache;
+  std::unique_ptr<RestPoseCache> Kept;
 };

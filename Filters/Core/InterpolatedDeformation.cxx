@@ -189,7 +189,10 @@ int ResolveNumberOfSteps(const std::vector<BoneMotion>& bones, const Interpolati
   return AutomaticNumberOfSteps(largest, parameters.maximumStepDisplacement);
 }
 
-InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscles,
+namespace
+{
+/// DeformByInterpolation on input already in its local frame.
+InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters,
   const std::function<void(double)>& progress)
 {
@@ -473,5 +476,69 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
   result.totalSeconds = SecondsSince(start);
   report(1.0);
   return result;
+}
+}
+
+InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscles,
+  const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters,
+  const std::function<void(double)>& progress)
+{
+  // Everything in the muscles' local frame, lengths given in data units with it.
+  std::vector<const Points*> muscleParts;
+  for (const MuscleMotion& m : muscles)
+  {
+    muscleParts.push_back(&m.muscle.points);
+  }
+  const LocalFrame frame = LocalFrame::Around(muscleParts);
+  std::vector<MuscleMotion> localMuscles = muscles;
+  for (MuscleMotion& m : localMuscles)
+  {
+    frame.ToLocal(m.muscle.points);
+    for (MatchedLine& line : m.lines)
+    {
+      frame.ToLocal(line.rest);
+      frame.ToLocal(line.current);
+    }
+  }
+  std::vector<BoneMotion> localBones = bones;
+  for (BoneMotion& b : localBones)
+  {
+    frame.ToLocal(b.rest.points);
+    frame.ToLocal(b.current);
+  }
+  InterpolationParameters local = parameters;
+  local.maximumStepDisplacement = frame.LengthToLocal(parameters.maximumStepDisplacement);
+  local.deformation.convergenceTolerance = frame.LengthToLocal(parameters.deformation.convergenceTolerance);
+
+  InterpolationResult result = DeformInLocalFrame(localMuscles, localBones, local, progress);
+  ResultToWorld(frame, result);
+  for (size_t m = 0; m < muscles.size(); ++m)
+  {
+    for (size_t j = 0; j < result.points.size(); ++j)
+    {
+      if (j == 0 || result.zeroMotion)
+      {
+        result.points[j][m] = muscles[m].muscle.points; // the input itself, not its round trip
+      }
+    }
+  }
+  return result;
+}
+
+void ResultToWorld(const LocalFrame& frame, InterpolationResult& result)
+{
+  for (size_t j = 0; j < result.points.size(); ++j)
+  {
+    for (size_t m = 0; m < result.points[j].size(); ++m)
+    {
+      frame.ToWorld(result.points[j][m]);
+      MuscleStepMeasures& s = result.measures[j][m];
+      s.maxNewPenetrationDepth = frame.LengthToWorld(s.maxNewPenetrationDepth);
+      s.maxNewBonePenetrationDepth = frame.LengthToWorld(s.maxNewBonePenetrationDepth);
+      s.stepStaticShift = frame.LengthToWorld(s.stepStaticShift);
+      s.maxStaticShift = frame.LengthToWorld(s.maxStaticShift);
+      frame.VectorsToWorld(s.staticShift);
+    }
+  }
 }
 }

@@ -16,6 +16,7 @@
 #pragma once
 
 #include "BoneInterpolation.h"
+#include "LocalFrame.h"
 #include "MeanValueCoordinates.h"
 #include "MuscleDeformer.h"
 #include "ProgressiveHull.h"
@@ -135,9 +136,14 @@ struct InterpolationResult
 /// bone point moves more than `parameters.maximumStepDisplacement` in one.
 int ResolveNumberOfSteps(const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters);
 
-/// Runs the whole method. Throws InputError naming the muscle or bone for
-/// input it cannot use. `progress` (optional) receives fractions in [0, 1].
+/// Runs the whole method, in the muscles' LocalFrame (lengths in `parameters` and in the result
+/// in the data's units). Throws InputError naming the muscle or bone for input it cannot use.
+/// `progress` (optional) receives fractions in [0, 1].
 InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscles,
   const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters,
   const std::function<void(double)>& progress = {});
+
+/// Points and lengths of a result computed in `frame` (for callers that bring their input into
+/// the frame themselves, e.g. to match action lines there) back in world coordinates.
+void ResultToWorld(const LocalFrame& frame, InterpolationResult& result);
 }

@@ -1,6 +1,7 @@
 #include "ProgressiveHull.h"
 
 #include "ConvexProjection.h"
+#include "LocalFrame.h"
 #include "MeshChecks.h"
 #include "TriangleIntersection.h"
 #include "TriangleTree.h"
@@ -1037,8 +1038,13 @@ HullResult BuildProgressiveHull(const TriangleMesh& surface, const HullParameter
 
 MuscleHull BuildMuscleHull(const TriangleMesh& muscle, const HullParameters& parameters)
 {
+  // In the muscle's local frame: the repair's merging, the placement's margins and the checks'
+  // tolerances then mean the same wherever the muscle sits and whatever its units.
+  const LocalFrame frame = LocalFrame::Around({ &muscle.points });
+  TriangleMesh local = muscle;
+  frame.ToLocal(local.points);
   MuscleHull built;
-  built.clean = RepairClosedSurface(muscle, built.report);
+  built.clean = RepairClosedSurface(local, built.report);
   built.result = BuildProgressiveHull(built.clean, parameters, &built.report.pointsToEnclose);
   // A hull that is no closed manifold, or leaves muscle points outside, would map the muscle
   // wrongly (mean value coordinates extrapolate): refuse it rather than hand it on.
@@ -1051,16 +1057,21 @@ MuscleHull BuildMuscleHull(const TriangleMesh& muscle, const HullParameters& par
       " non-manifold and " + std::to_string(edges.inconsistentEdges) +
       " inconsistently oriented edges): the surface is too noisy or too thin for a hull; smooth or remesh it");
   }
-  const std::int64_t outside = CountPointsOutsideHull(hull, muscle);
+  const std::int64_t outside = CountPointsOutsideHull(hull, local);
   if (outside > 0)
   {
     throw InputError("its hull leaves " + std::to_string(outside) +
       " of its points outside: the surface is too noisy for a hull; smooth or remesh it");
   }
+  built.hullVolume = frame.VolumeToWorld(SignedVolume(hull.points, hull.triangles));
+  built.cleanVolume = frame.VolumeToWorld(SignedVolume(built.clean.points, built.clean.triangles));
+  frame.ToWorld(built.clean.points);
+  frame.ToWorld(built.result.hull.points);
+  frame.ToWorld(built.report.pointsToEnclose);
   return built;
 }
 
-std::int64_t CountPointsOutsideHull(const TriangleMesh& hull, const TriangleMesh& muscle)
+std::int64_t CountPointsOutsideHull(const TriangleMesh& hull, const TriangleMesh& muscle, double slack)
 {
   const Points used = UsedPoints(muscle);
   const double size = (used.colwise().maxCoeff() - used.colwise().minCoeff()).norm();
@@ -1084,6 +1095,6 @@ std::int64_t CountPointsOutsideHull(const TriangleMesh& hull, const TriangleMesh
       suspects.row(k++) = used.row(i);
     }
   }
-  return CountOutside(hull, suspects, 1e-9 * size);
+  return CountOutside(hull, suspects, 1e-9 * size + slack);
 }
 }

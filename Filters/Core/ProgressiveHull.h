@@ -57,13 +57,19 @@ struct MuscleHull
   TriangleMesh clean; ///< the repaired surface
   RepairReport report;
   HullResult result;
+  /// Volumes of the hull and of the repaired surface, measured before the points go back to the
+  /// muscle's coordinates (where a muscle far from the origin loses digits).
+  double hullVolume = 0;
+  double cleanVolume = 0;
 };
-/// Repairs `muscle` and builds its hull. Throws InputError when the muscle cannot be repaired,
+/// Repairs `muscle` and builds its hull, in the muscle's LocalFrame (all results in its own
+/// coordinates). Throws InputError when the muscle cannot be repaired,
 /// or when the hull is not a closed, outward-oriented manifold or leaves a muscle point outside
 /// (every point is checked): a hull is never handed on unchecked.
 MuscleHull BuildMuscleHull(const TriangleMesh& muscle, const HullParameters& parameters);
 
 /// Points of `muscle` (those its triangles use) outside `hull`; points within
-/// 1e-9 of the muscle's size from the hull count as inside. Every point is tested.
-std::int64_t CountPointsOutsideHull(const TriangleMesh& hull, const TriangleMesh& muscle);
+/// 1e-9 of the muscle's size (plus `slack`, e.g. LocalFrame::Rounding) from the hull count as
+/// inside. Every point is tested.
+std::int64_t CountPointsOutsideHull(const TriangleMesh& hull, const TriangleMesh& muscle, double slack = 0);
 }

@@ -1,0 +1,97 @@
+// The one-pass filter as a pipeline: what it keeps between runs. A muscle's hull and mean value
+// coordinates depend on its rest-pose surface and the hull size only; a new pose must not
+// rebuild them (at 97k points the hull is most of a pass's time), and a kept hull must give
+// exactly what a new one gives.
+#include "FilterTestUtilities.h"
+
+#include "vtkActionLineMatching.h"
+#include "vtkMuscleDeformation.h"
+#include "vtkMusculoskeletalPhantom.h"
+
+#include <vtkDataArray.h>
+#include <vtkFieldData.h>
+
+#include <gtest/gtest.h>
+
+namespace
+{
+/// Largest difference between the points of two multiblocks of polydata with the same structure.
+double LargestDifference(vtkDataObject* a, vtkDataObject* b)
+{
+  auto* x = vtkMultiBlockDataSet::SafeDownCast(a);
+  auto* y = vtkMultiBlockDataSet::SafeDownCast(b);
+  double largest = 0;
+  for (unsigned int k = 0; k < x->GetNumberOfBlocks(); ++k)
+  {
+    auto* u = vtkPolyData::SafeDownCast(x->GetBlock(k));
+    auto* v = vtkPolyData::SafeDownCast(y->GetBlock(k));
+    for (vtkIdType i = 0; i < u->GetNumberOfPoints(); ++i)
+    {
+      double p[3], q[3];
+      u->GetPoint(i, p);
+      v->GetPoint(i, q);
+      largest = std::max({ largest, std::abs(p[0] - q[0]), std::abs(p[1] - q[1]), std::abs(p[2] - q[2]) });
+    }
+  }
+  return largest;
+}
+
+struct PhantomPipeline
+{
+  vtkNew<vtkMusculoskeletalPhantom> phantom;
+  vtkNew<vtkActionLineMatching> matching;
+  PhantomPipeline()
+  {
+    this->phantom->SetResolution(12);
+    this->matching->SetInputConnection(0, this->phantom->GetOutputPort(vtkMusculoskeletalPhantom::ACTION_LINES_REST));
+    this->matching->SetInputConnection(1, this->phantom->GetOutputPort(vtkMusculoskeletalPhantom::ACTION_LINES_CURRENT));
+  }
+  void Connect(vtkMuscleDeformation* f)
+  {
+    f->SetInputConnection(0, this->phantom->GetOutputPort(vtkMusculoskeletalPhantom::MUSCLES));
+    f->SetInputConnection(1, this->matching->GetOutputPort(0));
+    f->AddInputConnection(2, this->phantom->GetOutputPort(vtkMusculoskeletalPhantom::BONES_CURRENT));
+    f->SetHullTargetNumberOfPoints(100);
+  }
+};
+}
+
+TEST(MuscleDeformationFilter, HullsAreKeptAcrossPosesAndSettingsThatDoNotTouchThem)
+{
+  PhantomPipeline pipeline;
+  vtkNew<vtkMuscleDeformation> f;
+  pipeline.Connect(f);
+  f->Update();
+  ASSERT_EQ(f->GetHullBuildCount(), 3); // one per muscle
+
+  // Another iteration setting, then another pose: the same hulls.
+  f->SetConvergenceTolerance(0.005);
+  f->Update();
+  EXPECT_EQ(f->GetHullBuildCount(), 3);
+  pipeline.phantom->SetFlexion(30);
+  f->Update();
+  EXPECT_EQ(f->GetHullBuildCount(), 3);
+
+  // A kept hull gives exactly what a new filter builds for itself.
+  vtkNew<vtkMuscleDeformation> fresh;
+  pipeline.Connect(fresh);
+  fresh->SetConvergenceTolerance(0.005);
+  fresh->Update();
+  EXPECT_EQ(LargestDifference(f->GetOutputDataObject(0), fresh->GetOutputDataObject(0)), 0.0);
+
+  // Another hull size rebuilds every hull; a changed muscle rebuilds that muscle's only.
+  f->SetHullTargetNumberOfPoints(90);
+  f->Update();
+  EXPECT_EQ(f->GetHullBuildCount(), 6);
+  auto muscles = vtkSmartPointer<vtkMultiBlockDataSet>::New();
+  muscles->DeepCopy(pipeline.phantom->GetOutputDataObject(vtkMusculoskeletalPhantom::MUSCLES));
+  vtkPoints* points = vtkPolyData::SafeDownCast(muscles->GetBlock(1))->GetPoints();
+  double p[3];
+  points->GetPoint(0, p);
+  p[0] += 0.5;
+  points->SetPoint(0, p);
+  f->SetInputDataObject(0, muscles);
+  f->Update();
+  EXPECT_EQ(f->GetHullBuildCount(), 7);
+  EXPECT_NE(vtkPolyData::SafeDownCast(vtkMultiBlockDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetBlock(1)), nullptr);
+}
