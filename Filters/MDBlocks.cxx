@@ -216,8 +216,8 @@ bool CollectLeaves(
   return ok;
 }
 
-bool PairLeaves(const std::vector<Leaf>& a, const std::string& nameA, const std::vector<Leaf>& b,
-  const std::string& nameB, std::vector<size_t>& partner, std::string& error)
+bool PairLeaves(vtkObject* reporter, const std::vector<Leaf>& a, const std::string& nameA,
+  const std::vector<Leaf>& b, const std::string& nameB, std::vector<size_t>& partner, std::string& error)
 {
   partner.assign(a.size(), 0);
   auto uniquelyNamed = [](const std::vector<Leaf>& leaves) {
@@ -231,13 +231,20 @@ bool PairLeaves(const std::vector<Leaf>& a, const std::string& nameA, const std:
     }
     return true;
   };
-  if (uniquelyNamed(a) && uniquelyNamed(b))
+  std::map<std::string, size_t> indexOfName;
+  for (size_t j = 0; j < b.size(); ++j)
   {
-    std::map<std::string, size_t> indexOfName;
-    for (size_t j = 0; j < b.size(); ++j)
-    {
-      indexOfName[b[j].name] = j;
-    }
+    indexOfName[b[j].name] = j;
+  }
+  size_t shared = 0;
+  for (const Leaf& leaf : a)
+  {
+    shared += !leaf.name.empty() && indexOfName.count(leaf.name) ? 1 : 0;
+  }
+  if (uniquelyNamed(a) && uniquelyNamed(b) && (shared > 0 || a.size() != b.size()))
+  {
+    // Names that pair some blocks but not all are a mistake (a block left out or renamed), not
+    // a reason to fall back to the order, which would pair the wrong muscles.
     for (size_t i = 0; i < a.size(); ++i)
     {
       auto found = indexOfName.find(a[i].name);
@@ -259,14 +266,55 @@ bool PairLeaves(const std::vector<Leaf>& a, const std::string& nameA, const std:
   if (a.size() != b.size())
   {
     error = nameA + " has " + std::to_string(a.size()) + " block(s) but " + nameB + " has " +
-      std::to_string(b.size()) + "; blocks pair by name (when every block is uniquely named) or else by order";
+      std::to_string(b.size()) + "; blocks pair by name when both inputs name them alike, or else by order";
     return false;
   }
   for (size_t i = 0; i < a.size(); ++i)
   {
     partner[i] = i;
   }
+  // Named blocks that share no name (the GUI names the blocks of Group Datasets after its
+  // inputs: 'femur_r.vtk' against 'Transform1') pair by order; say which with which.
+  if (reporter && a.size() > 1 && shared == 0 && (uniquelyNamed(a) || uniquelyNamed(b)))
+  {
+    std::string pairs;
+    for (size_t i = 0; i < a.size() && i < 4; ++i)
+    {
+      pairs += (i ? ", '" : "'") + a[i].name + "' with '" + b[i].name + "'";
+    }
+    vtkWarningWithObjectMacro(reporter, << nameA << " and " << nameB
+                                        << " share no block name, so their blocks pair by order: " << pairs
+                                        << (a.size() > 4 ? ", ..." : "")
+                                        << ". Give the blocks the same names to pair them by name.");
+  }
   return true;
+}
+
+std::function<void(double)> ProgressOrCancel(vtkAlgorithm* filter, double offset, double share)
+{
+  return [=](double fraction) {
+    filter->UpdateProgress(offset + share * fraction);
+    if (filter->CheckAbort())
+    {
+      throw md::Cancelled();
+    }
+  };
+}
+
+std::function<bool()> AbortRequested(vtkAlgorithm* filter)
+{
+  return [filter] { return filter->GetAbortExecute() != 0; };
+}
+
+void ClearOutputs(vtkInformationVector* outputVector)
+{
+  for (int port = 0; port < outputVector->GetNumberOfInformationObjects(); ++port)
+  {
+    if (vtkDataObject* output = vtkDataObject::GetData(outputVector, port))
+    {
+      output->Initialize();
+    }
+  }
 }
 
 void CopyTimeSteps(vtkInformation* from, vtkInformation* to)

@@ -8,14 +8,17 @@
 #include <vtkSmartPointer.h>
 #include <vtkType.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
+class vtkAlgorithm;
 class vtkDataArray;
 class vtkDataObject;
 class vtkFieldData;
 class vtkInformation;
 class vtkInformationVector;
+class vtkObject;
 class vtkPoints;
 class vtkPolyData;
 
@@ -39,11 +42,14 @@ struct Leaf
 bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves,
   std::string& error);
 
-/// partner[i] = index in `b` of the leaf paired with a[i]: by name when every
-/// leaf of both inputs has a unique name, otherwise by order. Fails, naming
-/// the unmatched block, when the pairing cannot be made.
-bool PairLeaves(const std::vector<Leaf>& a, const std::string& nameA, const std::vector<Leaf>& b,
-  const std::string& nameB, std::vector<size_t>& partner, std::string& error);
+/// partner[i] = index in `b` of the leaf paired with a[i]: by name when every leaf of both inputs
+/// has a unique name and some names are shared or the counts differ (then all must pair);
+/// otherwise by order, with a
+/// warning through `reporter` (may be null) saying which block goes with which when both inputs
+/// have names but share none (as Group Datasets in the GUI names blocks after its inputs). Fails,
+/// naming the unmatched block, when the pairing cannot be made.
+bool PairLeaves(vtkObject* reporter, const std::vector<Leaf>& a, const std::string& nameA,
+  const std::vector<Leaf>& b, const std::string& nameB, std::vector<size_t>& partner, std::string& error);
 
 /// Puts one result per leaf of `input` into `output`, which is of the same
 /// type as `input` (see vtkPassInputTypeAlgorithm): for a multiblock input the
@@ -59,6 +65,19 @@ void AddFieldValue(vtkFieldData* fieldData, const char* name, std::int64_t value
 /// Advertises the time steps and range of `from` (an input's information) on `to` (an output's),
 /// or none when `from` has none.
 void CopyTimeSteps(vtkInformation* from, vtkInformation* to);
+
+/// A progress callback for the core: reports `offset + share * fraction` as the filter's
+/// progress and throws md::Cancelled when the user has asked the filter to stop (ParaView's
+/// abort). Call only from the filter's own thread.
+std::function<void(double)> ProgressOrCancel(vtkAlgorithm* filter, double offset = 0.0, double share = 1.0);
+/// Whether the user has asked `filter` to stop; safe to ask from worker threads (it only reads
+/// the flag), for md::HullParameters::cancelled.
+std::function<bool()> AbortRequested(vtkAlgorithm* filter);
+
+/// Empties every output. Called when a filter is about to run again (its update extent is
+/// requested only then): if an input then fails upstream, the pipeline never calls RequestData,
+/// and the outputs would otherwise keep the last result, easy to take for the new one.
+void ClearOutputs(vtkInformationVector* outputVector);
 
 /// Accept vtkPolyData or vtkMultiBlockDataSet on an input port.
 void AcceptPolyDataOrMultiBlock(vtkInformation* info);

@@ -49,6 +49,13 @@ int vtkActionLineGrouping::RequestInformation(
   return 1;
 }
 
+int vtkActionLineGrouping::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  mdvtk::ClearOutputs(outputVector); // no stale result if an input fails upstream
+  return this->Superclass::RequestUpdateExtent(request, inputVector, outputVector);
+}
+
 int vtkActionLineGrouping::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -65,7 +72,7 @@ int vtkActionLineGrouping::RequestData(
     return 0;
   }
   std::vector<size_t> currentOf;
-  if (haveCurrent && !mdvtk::PairLeaves(paths, "Paths", current, "PathsCurrent", currentOf, error))
+  if (haveCurrent && !mdvtk::PairLeaves(this, paths, "Paths", current, "PathsCurrent", currentOf, error))
   {
     vtkErrorMacro(<< error);
     return 0;

@@ -92,6 +92,13 @@ int vtkActionLineMatching::FillInputPortInformation(int, vtkInformation* info)
   return 1;
 }
 
+int vtkActionLineMatching::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  mdvtk::ClearOutputs(outputVector); // no stale result if an input fails upstream
+  return this->Superclass::RequestUpdateExtent(request, inputVector, outputVector);
+}
+
 int vtkActionLineMatching::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -102,7 +109,7 @@ int vtkActionLineMatching::RequestData(
   std::string error;
   if (!mdvtk::CollectLeaves(restInput, "Input", restLeaves, error) ||
     !mdvtk::CollectLeaves(currentInput, "CurrentPose", currentLeaves, error) ||
-    !mdvtk::PairLeaves(restLeaves, "Input", currentLeaves, "CurrentPose", partner, error))
+    !mdvtk::PairLeaves(this, restLeaves, "Input", currentLeaves, "CurrentPose", partner, error))
   {
     vtkErrorMacro(<< error);
     return 0;

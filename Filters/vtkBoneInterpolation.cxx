@@ -81,7 +81,7 @@ bool vtkBoneInterpolation::ReadPoses(
   if (!mdvtk::CollectLeaves(restInput, "Input", restLeaves, error) ||
     (currentInput &&
       (!mdvtk::CollectLeaves(currentInput, "CurrentPose", currentLeaves, error) ||
-        !mdvtk::PairLeaves(restLeaves, "Input", currentLeaves, "CurrentPose", partner, error))))
+        !mdvtk::PairLeaves(this, restLeaves, "Input", currentLeaves, "CurrentPose", partner, error))))
   {
     vtkErrorMacro(<< error);
     return false;
@@ -199,8 +199,9 @@ int vtkBoneInterpolation::RequestInformation(
 }
 
 int vtkBoneInterpolation::RequestUpdateExtent(
-  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  mdvtk::ClearOutputs(outputVector);
   // Our time is the interpolation step, not a time of the inputs: ask them for
   // their default.
   for (int port = 0; port < 2; ++port)

@@ -21,6 +21,13 @@ int vtkHullDecimation::FillInputPortInformation(int, vtkInformation* info)
   return 1;
 }
 
+int vtkHullDecimation::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  mdvtk::ClearOutputs(outputVector); // no stale result if an input fails upstream
+  return this->Superclass::RequestUpdateExtent(request, inputVector, outputVector);
+}
+
 int vtkHullDecimation::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -37,11 +44,16 @@ int vtkHullDecimation::RequestData(
   parameters.minimumAngleDegrees = this->MinimumAngle;
   parameters.maximumNormalDeviationDegrees = this->MaximumNormalDeviation;
   parameters.maximumFoldAngleDegrees = this->MaximumFoldAngle;
+  parameters.cancelled = mdvtk::AbortRequested(this);
 
   std::vector<vtkSmartPointer<vtkPolyData>> results(leaves.size());
   for (size_t b = 0; b < leaves.size(); ++b)
   {
     this->UpdateProgress(static_cast<double>(b) / leaves.size());
+    if (this->CheckAbort())
+    {
+      return 1; // stopped by the user: the executive empties the output
+    }
     const mdvtk::Leaf& leaf = leaves[b];
     if (!leaf.data)
     {
@@ -64,6 +76,11 @@ int vtkHullDecimation::RequestData(
     {
       vtkErrorMacro(<< leaf.label << ": " << e.what());
       return 0;
+    }
+    catch (const md::Cancelled&)
+    {
+      this->CheckAbort();
+      return 1;
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const md::RepairReport& report = built.report;

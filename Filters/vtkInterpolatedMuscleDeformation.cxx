@@ -33,13 +33,14 @@ namespace
 const char* const PortNames[] = { "Input", "BonesRest", "BonesCurrent", "ActionLinesRest", "ActionLinesCurrent" };
 
 /// The bones in both poses, paired.
-bool ReadBones(vtkDataObject* rest, vtkDataObject* current, std::vector<md::BoneMotion>& bones, std::string& error)
+bool ReadBones(vtkObject* reporter, vtkDataObject* rest, vtkDataObject* current, std::vector<md::BoneMotion>& bones,
+  std::string& error)
 {
   std::vector<mdvtk::Leaf> restLeaves, currentLeaves;
   std::vector<size_t> partner;
   if (!mdvtk::CollectLeaves(rest, PortNames[1], restLeaves, error) ||
     !mdvtk::CollectLeaves(current, PortNames[2], currentLeaves, error) ||
-    !mdvtk::PairLeaves(restLeaves, PortNames[1], currentLeaves, PortNames[2], partner, error))
+    !mdvtk::PairLeaves(reporter, restLeaves, PortNames[1], currentLeaves, PortNames[2], partner, error))
   {
     return false;
   }
@@ -110,7 +111,8 @@ int vtkInterpolatedMuscleDeformation::RequestInformation(
     }
     std::vector<md::BoneMotion> bones;
     std::string error;
-    if (!ReadBones(vtkDataObject::GetData(inputVector[1], 0), vtkDataObject::GetData(inputVector[2], 0), bones, error))
+    if (!ReadBones(
+          nullptr, vtkDataObject::GetData(inputVector[1], 0), vtkDataObject::GetData(inputVector[2], 0), bones, error))
     {
       vtkErrorMacro(<< error);
       return 0;
@@ -142,8 +144,9 @@ int vtkInterpolatedMuscleDeformation::RequestInformation(
 }
 
 int vtkInterpolatedMuscleDeformation::RequestUpdateExtent(
-  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  mdvtk::ClearOutputs(outputVector);
   // Our time is the interpolation step, not a time of the inputs.
   for (int port = 0; port < 5; ++port)
   {
@@ -185,9 +188,9 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     std::vector<md::BoneMotion> bones;
     if (!mdvtk::CollectLeaves(inputs[3], PortNames[3], restLines, error) ||
       !mdvtk::CollectLeaves(inputs[4], PortNames[4], currentLines, error) ||
-      !mdvtk::PairLeaves(muscles, PortNames[0], restLines, PortNames[3], restLinesOf, error) ||
-      !mdvtk::PairLeaves(restLines, PortNames[3], currentLines, PortNames[4], currentLinesOf, error) ||
-      !ReadBones(inputs[1], inputs[2], bones, error))
+      !mdvtk::PairLeaves(this, muscles, PortNames[0], restLines, PortNames[3], restLinesOf, error) ||
+      !mdvtk::PairLeaves(this, restLines, PortNames[3], currentLines, PortNames[4], currentLinesOf, error) ||
+      !ReadBones(this, inputs[1], inputs[2], bones, error))
     {
       vtkErrorMacro(<< error);
       return 0;
@@ -287,10 +290,10 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     parameters.deformation.preserveVolume = this->PreserveVolume;
     parameters.deformation.contactWeight = this->BoneContactWeight;
     parameters.hull.targetNumberOfPoints = this->HullTargetNumberOfPoints;
+    parameters.hull.cancelled = mdvtk::AbortRequested(this);
     try
     {
-      cache.result =
-        md::DeformByInterpolation(motions, bones, parameters, [this](double f) { this->UpdateProgress(f); });
+      cache.result = md::DeformByInterpolation(motions, bones, parameters, mdvtk::ProgressOrCancel(this));
       md::ResultToWorld(frame, cache.result);
       for (size_t m = 0; m < cache.blockOf.size(); ++m)
       {
@@ -308,6 +311,12 @@ int vtkInterpolatedMuscleDeformation::RequestData(
       vtkErrorMacro(<< e.what());
       cache = Cache{};
       return 0;
+    }
+    catch (const md::Cancelled&)
+    {
+      this->CheckAbort(); // stopped by the user: the executive empties the output
+      cache = Cache{};
+      return 1;
     }
     for (const std::string& warning : cache.result.warnings)
     {

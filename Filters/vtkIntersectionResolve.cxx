@@ -60,6 +60,13 @@ bool ReadLeafMeshes(const std::vector<mdvtk::Leaf>& leaves, std::vector<md::Tria
 }
 }
 
+int vtkIntersectionResolve::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  mdvtk::ClearOutputs(outputVector); // no stale result if an input fails upstream
+  return this->Superclass::RequestUpdateExtent(request, inputVector, outputVector);
+}
+
 int vtkIntersectionResolve::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -75,6 +82,11 @@ int vtkIntersectionResolve::RequestData(
   {
     vtkErrorMacro(<< error);
     return 0;
+  }
+  if (inputVector[1]->GetNumberOfInformationObjects() == 0)
+  {
+    vtkWarningMacro(<< "no Obstacles are connected: only the Input's meshes are kept out of one another, "
+                       "nothing keeps them out of the bones; connect the bones in the current pose as Obstacles");
   }
   const bool restGiven = inputVector[2]->GetNumberOfInformationObjects() > 0;
   if (!restGiven && !restObstacles.empty())
@@ -109,7 +121,7 @@ int vtkIntersectionResolve::RequestData(
   std::vector<md::TriangleMesh> restMeshes;
   if (restGiven &&
     (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[2], 0), "InputRest", restLeaves, error) ||
-      !mdvtk::PairLeaves(leaves, "Input", restLeaves, "InputRest", restOf, error) ||
+      !mdvtk::PairLeaves(this, leaves, "Input", restLeaves, "InputRest", restOf, error) ||
       !ReadLeafMeshes(restLeaves, restMeshes, error)))
   {
     vtkErrorMacro(<< error);

@@ -58,6 +58,7 @@ protected:
   ~vtkIntersectionResolve() override = default;
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   double DeformableShare = 0.6;
 

@@ -47,6 +47,13 @@ int vtkMoveWithBodies::RequestInformation(
   return 1;
 }
 
+int vtkMoveWithBodies::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  mdvtk::ClearOutputs(outputVector); // no stale result if an input fails upstream
+  return this->Superclass::RequestUpdateExtent(request, inputVector, outputVector);
+}
+
 int vtkMoveWithBodies::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {

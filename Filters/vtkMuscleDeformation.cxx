@@ -121,6 +121,13 @@ int vtkMuscleDeformation::FillInputPortInformation(int port, vtkInformation* inf
   return 1;
 }
 
+int vtkMuscleDeformation::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  mdvtk::ClearOutputs(outputVector); // no stale result if an input fails upstream
+  return this->Superclass::RequestUpdateExtent(request, inputVector, outputVector);
+}
+
 int vtkMuscleDeformation::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -131,7 +138,7 @@ int vtkMuscleDeformation::RequestData(
   std::string error;
   if (!mdvtk::CollectLeaves(input, "Input", muscles, error) ||
     !mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[1], 0), "ActionLines", lineLeaves, error) ||
-    !mdvtk::PairLeaves(muscles, "Input", lineLeaves, "ActionLines", lineOf, error))
+    !mdvtk::PairLeaves(this, muscles, "Input", lineLeaves, "ActionLines", lineOf, error))
   {
     vtkErrorMacro(<< error);
     return 0;
@@ -139,7 +146,7 @@ int vtkMuscleDeformation::RequestData(
   const bool hullGiven = inputVector[3]->GetNumberOfInformationObjects() > 0;
   if (hullGiven &&
     (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[3], 0), "Hull", hullLeaves, error) ||
-      !mdvtk::PairLeaves(muscles, "Input", hullLeaves, "Hull", hullOf, error)))
+      !mdvtk::PairLeaves(this, muscles, "Input", hullLeaves, "Hull", hullOf, error)))
   {
     vtkErrorMacro(<< error);
     return 0;
@@ -241,7 +248,7 @@ int vtkMuscleDeformation::RequestData(
     this->UpdateProgress(0.3 * m / toDeform.size());
     if (this->CheckAbort())
     {
-      return 0;
+      return 1; // stopped by the user: the executive empties the output
     }
     const auto hullStart = Clock::now();
     KeptMuscle& entry = kept.byBlock[b];
@@ -273,6 +280,7 @@ int vtkMuscleDeformation::RequestData(
       {
         md::HullParameters parameters;
         parameters.targetNumberOfPoints = this->HullTargetNumberOfPoints;
+        parameters.cancelled = mdvtk::AbortRequested(this);
         try
         {
           const md::MuscleHull built = md::BuildMuscleHull(surfaces[b], parameters);
@@ -287,6 +295,11 @@ int vtkMuscleDeformation::RequestData(
         {
           vtkErrorMacro(<< leaf.label << ": " << e.what());
           return 0;
+        }
+        catch (const md::Cancelled&)
+        {
+          this->CheckAbort();
+          return 1;
         }
       }
       entry.weights = md::MeanValueCoordinates(entry.hull, surfaces[b].points);
@@ -319,13 +332,16 @@ int vtkMuscleDeformation::RequestData(
     const std::vector<md::Obstacle> obstacles = this->DynamicIntersections
       ? md::BuildObstacles(obstacleNames, obstacleMeshes)
       : std::vector<md::Obstacle>{};
-    results = md::DeformMuscles(
-      toDeform, obstacles, parameters, [this](double fraction) { this->UpdateProgress(0.3 + 0.7 * fraction); });
+    results = md::DeformMuscles(toDeform, obstacles, parameters, mdvtk::ProgressOrCancel(this, 0.3, 0.7));
   }
   catch (const md::InputError& e)
   {
     vtkErrorMacro(<< e.what());
     return 0;
+  }
+  catch (const md::Cancelled&)
+  {
+    return 1; // stopped by the user: the executive empties the output
   }
   const double seconds = SecondsSince(start);
 

@@ -10,6 +10,7 @@ MD_DATA_DIR=${MUSCLEDEFORMATION_DATA_DIR:-$MD_SOURCE_DIR/../shared/data}
 # ParaView 5.11 carries its own VTK: never add libvtk9-dev or python3-vtk9 here (python3-vtk9
 # conflicts with python3-paraview). The -dev packages after qtxmlpatterns5-dev-tools are ones
 # ParaView's CMake package looks for when a plugin asks for ParaView::RemotingCore.
+# libqt5svg5: the GUI's toolbar icons are SVG; without it they show blank.
 MD_PACKAGES=(
   cmake g++ make
   paraview-dev python3-paraview
@@ -18,6 +19,7 @@ MD_PACKAGES=(
   qtbase5-dev qttools5-dev qtxmlpatterns5-dev-tools
   libopenmpi-dev libdouble-conversion-dev liblz4-dev libutfcpp-dev
   libpugixml-dev
+  libqt5svg5
 )
 
 md_install_dependencies() {

@@ -39,6 +39,7 @@ std::vector<TriangleMesh> BuildHulls(const std::vector<MuscleMotion>& muscles, c
   std::vector<TriangleMesh> hulls(count);
   errors.assign(count, std::string());
   seconds.assign(count, 0.0);
+  std::vector<char> cancelled(count, 0); // no exception may leave a parallel region
 #pragma omp parallel for schedule(dynamic, 1)
   for (int k = 0; k < static_cast<int>(count); ++k)
   {
@@ -52,7 +53,15 @@ std::vector<TriangleMesh> BuildHulls(const std::vector<MuscleMotion>& muscles, c
     {
       errors[m] = "muscle '" + muscles[m].name + "': " + e.what();
     }
+    catch (const Cancelled&)
+    {
+      cancelled[m] = 1;
+    }
     seconds[m] = SecondsSince(start);
+  }
+  if (std::count(cancelled.begin(), cancelled.end(), 1) > 0)
+  {
+    throw Cancelled();
   }
   return hulls;
 }

@@ -29,6 +29,17 @@ public:
   using std::runtime_error::runtime_error;
 };
 
+/// Thrown through the core by a progress or cancel callback when the user stops a computation
+/// (ParaView's abort): the core unwinds, nothing half-done is handed on.
+class Cancelled : public std::runtime_error
+{
+public:
+  Cancelled()
+    : std::runtime_error("cancelled")
+  {
+  }
+};
+
 /// True when every coordinate is finite (no NaN, no infinity).
 inline bool AllFinite(const Points& points)
 {

@@ -124,8 +124,13 @@ public:
 private:
   void Decimate(HullResult& result)
   {
+    std::uint32_t pops = 0;
     while (this->LiveVertices > this->Parameters.targetNumberOfPoints && !this->Heap.empty())
     {
+      if ((++pops & 1023u) == 0 && this->Parameters.cancelled && this->Parameters.cancelled())
+      {
+        throw Cancelled();
+      }
       const Candidate top = this->Heap.top();
       this->Heap.pop();
       if (!this->VertexAlive[top.a] || !this->VertexAlive[top.b] || this->Stamp[top.a] != top.stampA ||

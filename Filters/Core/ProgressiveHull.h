@@ -5,6 +5,8 @@
 #include "MeshTypes.h"
 #include "SurfaceRepair.h"
 
+#include <functional>
+
 namespace md
 {
 struct HullParameters
@@ -18,6 +20,9 @@ struct HullParameters
   /// Largest angle between the normals of two neighbouring triangles after a
   /// collapse (degrees); above it the surface would fold onto itself.
   double maximumFoldAngleDegrees = 150.0;
+  /// Asked every few hundred collapses; when it returns true the build throws Cancelled. May be
+  /// called from worker threads.
+  std::function<bool()> cancelled;
 };
 
 struct HullResult

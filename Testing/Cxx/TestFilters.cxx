@@ -126,6 +126,27 @@ TEST(ActionLineMatching, PlainPolyDataInputsGivePolyDataOutputs)
   EXPECT_EQ(outRest->GetNumberOfPoints(), 3 + 3);
 }
 
+TEST(ActionLineMatching, BlocksThatShareNoNamePairByOrderWithANote)
+{
+  // Group Datasets in the GUI names blocks after its inputs ('femur_r.vtk', 'Transform1'): such
+  // inputs pair by order, and the warning says which block went with which.
+  auto first = MakePolylines({ { 0, 0, 0, 1, 0, 0 } });
+  auto second = MakePolylines({ { 0, 0, 0, 0, 2, 0 } });
+  auto firstMoved = MakePolylines({ { 0, 0, 1, 1, 0, 1 } });
+  auto secondMoved = MakePolylines({ { 0, 0, 3, 0, 2, 3 } });
+  CapturedMessages messages;
+  vtkNew<vtkActionLineMatching> matching;
+  matching->SetInputData(0, MakeBlocks({ { "Iliacus", first }, { "Psoas", second } }));
+  matching->SetInputData(1, MakeBlocks({ { "Transform1", firstMoved }, { "Transform2", secondMoved } }));
+  ASSERT_EQ(Update(matching), 1) << messages.Text();
+  EXPECT_TRUE(messages.Contains("share no block name, so their blocks pair by order: 'Iliacus' with "
+                                "'Transform1', 'Psoas' with 'Transform2'"))
+    << messages.Text();
+  vtkDataArray* current = Block(matching->GetOutputDataObject(0), 1)->GetPointData()->GetArray("CurrentPosition");
+  ASSERT_NE(current, nullptr);
+  EXPECT_EQ(current->GetComponent(0, 2), 3.0); // the second block's lines moved by 3
+}
+
 TEST(ActionLineMatching, BadInputGivesAClearErrorAndNoOutput)
 {
   struct Case

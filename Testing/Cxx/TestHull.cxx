@@ -406,3 +406,18 @@ TEST(MuscleHull, ANoisyScanGetsAClosedEnclosingHullOrAClearRefusal)
     EXPECT_NE(std::string(e.what()).find("noisy"), std::string::npos) << e.what();
   }
 }
+
+TEST(ProgressiveHull, ACancelledBuildStopsWithCancelledAndAnUncancelledOneIsUnchanged)
+{
+  const md::TriangleMesh sphere = Sphere(Eigen::Vector3d(1, 2, 3), 10.0, 4);
+  md::HullParameters parameters;
+  parameters.targetNumberOfPoints = 60;
+  const md::HullResult plain = md::BuildProgressiveHull(sphere, parameters);
+  int asked = 0;
+  parameters.cancelled = [&asked] { return ++asked >= 3; };
+  EXPECT_THROW(md::BuildProgressiveHull(sphere, parameters), md::Cancelled);
+  EXPECT_EQ(asked, 3); // it stopped when told, not at the end
+  parameters.cancelled = [] { return false; };
+  const md::HullResult asked_never = md::BuildProgressiveHull(sphere, parameters);
+  EXPECT_EQ(asked_never.hull.points, plain.hull.points);
+}

@@ -310,3 +310,73 @@ TEST(MalformedInput, AFlatMuscleGetsAnErrorNotABrokenHull)
     EXPECT_TRUE(md::CheckEdges(mesh.triangles).IsClosedOrientedManifold()) << thickness;
   }
 }
+
+TEST(MalformedInput, NoStaleResultAfterAFailureHereOrUpstream)
+{
+  // After a good run, a failure (of the filter itself, or of a filter upstream, when the
+  // pipeline never calls this one) must leave an empty output, not the last result: in the GUI
+  // that looked like the new result.
+  Phantom phantom;
+  auto points = [](vtkAlgorithm* f) {
+    return vtkCompositeDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetNumberOfPoints();
+  };
+  vtkNew<vtkActionLineMatching> matching;
+  matching->SetInputConnection(0, phantom.source->GetOutputPort(vtkMusculoskeletalPhantom::ACTION_LINES_REST));
+  matching->SetInputConnection(1, phantom.source->GetOutputPort(vtkMusculoskeletalPhantom::ACTION_LINES_CURRENT));
+  vtkNew<vtkMuscleDeformation> pass;
+  pass->SetInputConnection(0, phantom.source->GetOutputPort(vtkMusculoskeletalPhantom::MUSCLES));
+  pass->SetInputConnection(1, matching->GetOutputPort(0));
+  pass->SetHullTargetNumberOfPoints(100);
+  vtkNew<vtkInterpolatedMuscleDeformation> method;
+  method->SetInputConnection(0, phantom.source->GetOutputPort(vtkMusculoskeletalPhantom::MUSCLES));
+  method->SetBonesRestConnection(phantom.source->GetOutputPort(vtkMusculoskeletalPhantom::BONES_REST));
+  method->SetBonesCurrentConnection(phantom.source->GetOutputPort(vtkMusculoskeletalPhantom::BONES_CURRENT));
+  method->SetActionLinesRestConnection(phantom.source->GetOutputPort(vtkMusculoskeletalPhantom::ACTION_LINES_REST));
+  method->SetActionLinesCurrentConnection(matching->GetOutputPort(0));
+  method->SetNumberOfSteps(2);
+  method->SetHullTargetNumberOfPoints(100);
+  vtkNew<vtkHullDecimation> hull;
+  hull->SetInputConnection(pass->GetOutputPort(0));
+  hull->SetTargetNumberOfPoints(100);
+  for (vtkAlgorithm* f : std::initializer_list<vtkAlgorithm*>{ pass, method, hull })
+  {
+    f->Update();
+    ASSERT_GT(points(f), 0) << f->GetClassName();
+  }
+
+  // Upstream: the matching fails (the muscles given as current action lines).
+  matching->SetInputConnection(1, phantom.source->GetOutputPort(vtkMusculoskeletalPhantom::MUSCLES));
+  {
+    CapturedMessages messages;
+    for (vtkAlgorithm* f : std::initializer_list<vtkAlgorithm*>{ pass, method, hull })
+    {
+      f->Update();
+      EXPECT_EQ(points(f), 0) << f->GetClassName();
+    }
+    EXPECT_TRUE(messages.Contains("ActionLineMatching"));
+  }
+
+  // Here: good inputs again, then the raw lines (no CurrentPosition) given to the pass.
+  matching->SetInputConnection(1, phantom.source->GetOutputPort(vtkMusculoskeletalPhantom::ACTION_LINES_CURRENT));
+  pass->Update();
+  ASSERT_GT(points(pass), 0);
+  pass->SetInputConnection(1, phantom.source->GetOutputPort(vtkMusculoskeletalPhantom::ACTION_LINES_REST));
+  {
+    CapturedMessages messages;
+    pass->Update();
+    EXPECT_EQ(points(pass), 0);
+    EXPECT_TRUE(messages.Contains("CurrentPosition"));
+  }
+}
+
+TEST(MalformedInput, IntersectionResolveWithoutObstaclesSaysSo)
+{
+  // Without Obstacles the bones are no part of the resolution: said, not silent.
+  Phantom phantom;
+  vtkNew<vtkIntersectionResolve> f;
+  f->SetInputDataObject(0, phantom.Output(vtkMusculoskeletalPhantom::MUSCLES));
+  CapturedMessages messages;
+  f->Update();
+  EXPECT_TRUE(messages.Contains("no Obstacles are connected")) << messages.Text();
+  EXPECT_FALSE(messages.Contains("ERROR")) << messages.Text();
+}

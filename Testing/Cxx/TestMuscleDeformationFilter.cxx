@@ -1,13 +1,16 @@
 // The one-pass filter as a pipeline: what it keeps between runs. A muscle's hull and mean value
 // coordinates depend on its rest-pose surface and the hull size only; a new pose must not
 // rebuild them (at 97k points the hull is most of a pass's time), and a kept hull must give
-// exactly what a new one gives.
+// exactly what a new one gives. And a user's cancel (AbortExecute) stops a run cleanly.
 #include "FilterTestUtilities.h"
 
 #include "vtkActionLineMatching.h"
+#include "vtkInterpolatedMuscleDeformation.h"
 #include "vtkMuscleDeformation.h"
 #include "vtkMusculoskeletalPhantom.h"
 
+#include <vtkCallbackCommand.h>
+#include <vtkCommand.h>
 #include <vtkDataArray.h>
 #include <vtkFieldData.h>
 
@@ -35,6 +38,32 @@ double LargestDifference(vtkDataObject* a, vtkDataObject* b)
   }
   return largest;
 }
+
+/// Sets the observed filter's AbortExecute (as ParaView's cancel does) once its progress passes
+/// `threshold`, and counts the progress events that still come after.
+struct AbortPast
+{
+  double threshold;
+  int eventsAfterAbort = 0;
+  vtkNew<vtkCallbackCommand> command;
+  explicit AbortPast(double progress)
+    : threshold(progress)
+  {
+    this->command->SetClientData(this);
+    this->command->SetCallback([](vtkObject* caller, unsigned long, void* clientData, void*) {
+      auto* self = static_cast<AbortPast*>(clientData);
+      auto* filter = vtkAlgorithm::SafeDownCast(caller);
+      if (filter->GetAbortExecute())
+      {
+        ++self->eventsAfterAbort;
+      }
+      else if (filter->GetProgress() > self->threshold)
+      {
+        filter->SetAbortExecute(1);
+      }
+    });
+  }
+};
 
 struct PhantomPipeline
 {
@@ -94,4 +123,55 @@ TEST(MuscleDeformationFilter, HullsAreKeptAcrossPosesAndSettingsThatDoNotTouchTh
   f->Update();
   EXPECT_EQ(f->GetHullBuildCount(), 7);
   EXPECT_NE(vtkPolyData::SafeDownCast(vtkMultiBlockDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetBlock(1)), nullptr);
+}
+
+TEST(MuscleDeformationFilter, AbortStopsTheRunWithAnEmptyOutputAndTheNextRunWorks)
+{
+  // ParaView's cancel sets the filter's AbortExecute; here an observer does it once the
+  // deformation has started (progress past the hulls).
+  PhantomPipeline pipeline;
+  vtkNew<vtkMuscleDeformation> f;
+  pipeline.Connect(f);
+  AbortPast stop(0.35); // past the hulls: the pass then reports progress about 40 times
+  const unsigned long observer = f->AddObserver(vtkCommand::ProgressEvent, stop.command);
+  {
+    CapturedMessages messages;
+    f->Update();
+    EXPECT_FALSE(messages.Contains("ERROR")) << messages.Text();
+  }
+  EXPECT_LE(stop.eventsAfterAbort, 1); // at most the executive's own final report
+  EXPECT_EQ(vtkCompositeDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
+
+  f->RemoveObserver(observer);
+  f->SetAbortExecute(0);
+  f->Modified();
+  f->Update();
+  EXPECT_GT(vtkCompositeDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
+}
+
+TEST(MuscleDeformationFilter, AbortStopsTheWholeMethodToo)
+{
+  PhantomPipeline pipeline;
+  vtkNew<vtkInterpolatedMuscleDeformation> f;
+  f->SetInputConnection(0, pipeline.phantom->GetOutputPort(vtkMusculoskeletalPhantom::MUSCLES));
+  for (int port = 1; port < 5; ++port)
+  {
+    f->SetInputConnection(port, pipeline.phantom->GetOutputPort(port));
+  }
+  f->SetNumberOfSteps(3);
+  f->SetHullTargetNumberOfPoints(100);
+  AbortPast stop(0.4); // in the second step
+  const unsigned long observer = f->AddObserver(vtkCommand::ProgressEvent, stop.command);
+  {
+    CapturedMessages messages;
+    f->Update();
+    EXPECT_FALSE(messages.Contains("ERROR")) << messages.Text();
+  }
+  EXPECT_LE(stop.eventsAfterAbort, 1);
+  EXPECT_EQ(vtkCompositeDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
+  f->RemoveObserver(observer);
+  f->SetAbortExecute(0);
+  f->Modified();
+  f->Update();
+  EXPECT_GT(vtkCompositeDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
 }

@@ -37,6 +37,31 @@ class ServerManagerXML(unittest.TestCase):
                     self.assertTrue((prop.findtext("Documentation") or "").strip(),
                                     "%s.%s has no documentation" % (name, prop.get("name")))
 
+    def test_the_gui_asks_for_every_input_a_filter_needs(self):
+        # ParaView's input dialog skips inputs hinted Optional: only inputs a filter truly does
+        # without may carry the hint (BoneInterpolation's CurrentPose and IntersectionResolve's
+        # Obstacles did, so the GUI never asked for them).
+        folder = os.path.join(mdtesting.SOURCE_DIR, "ServerManagerXML")
+        optional = set()
+        for file_name in sorted(os.listdir(folder)):
+            for proxy in ElementTree.parse(os.path.join(folder, file_name)).getroot().findall("./ProxyGroup/SourceProxy"):
+                for prop in proxy.findall("./InputProperty"):
+                    if prop.find("./Hints/Optional") is not None:
+                        optional.add("%s.%s" % (proxy.get("name"), prop.get("name")))
+        self.assertEqual(optional, {"ActionLineGrouping.PathsCurrent",
+                                    "MuscleDeformation.Obstacles", "MuscleDeformation.Hull",
+                                    "IntersectionResolve.InputRest", "IntersectionResolve.ObstaclesRest"})
+
+    def test_the_plugin_folder_offers_the_plugin_alone(self):
+        # Tools > Manage Plugins > Load New... lists the shared libraries of the folder: a second
+        # one there (the filters' library) answered "Not a ParaView Plugin".
+        plugin = os.environ.get("MUSCLEDEFORMATION_PLUGIN")
+        if not plugin:
+            self.skipTest("MUSCLEDEFORMATION_PLUGIN is not set")
+        folder = os.path.dirname(plugin)
+        libraries = sorted(name for name in os.listdir(folder) if ".so" in name or name.endswith(".dll"))
+        self.assertEqual(libraries, ["MuscleDeformation.so"])
+
     def test_proxies_have_the_names_users_rely_on(self):
         for name in ("MusculoskeletalPhantom", "ActionLineMatching", "BoneInterpolation", "HullDecimation",
                      "MuscleDeformation"):
