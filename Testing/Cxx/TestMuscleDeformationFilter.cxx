@@ -65,6 +65,26 @@ struct AbortPast
   }
 };
 
+/// Aborts `f` once its progress passes `threshold`: the run must stop there without an error and
+/// leave an empty output, and the next run must compute afresh.
+void ExpectAbortStopsCleanly(vtkAlgorithm* f, double threshold)
+{
+  AbortPast stop(threshold);
+  const unsigned long observer = f->AddObserver(vtkCommand::ProgressEvent, stop.command);
+  {
+    CapturedMessages messages;
+    f->Update();
+    EXPECT_FALSE(messages.Contains("ERROR")) << messages.Text();
+  }
+  EXPECT_LE(stop.eventsAfterAbort, 1); // at most the executive's own final report
+  EXPECT_EQ(vtkCompositeDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
+  f->RemoveObserver(observer);
+  f->SetAbortExecute(0);
+  f->Modified();
+  f->Update();
+  EXPECT_GT(vtkCompositeDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
+}
+
 struct PhantomPipeline
 {
   vtkNew<vtkMusculoskeletalPhantom> phantom;
@@ -132,21 +152,7 @@ TEST(MuscleDeformationFilter, AbortStopsTheRunWithAnEmptyOutputAndTheNextRunWork
   PhantomPipeline pipeline;
   vtkNew<vtkMuscleDeformation> f;
   pipeline.Connect(f);
-  AbortPast stop(0.35); // past the hulls: the pass then reports progress about 40 times
-  const unsigned long observer = f->AddObserver(vtkCommand::ProgressEvent, stop.command);
-  {
-    CapturedMessages messages;
-    f->Update();
-    EXPECT_FALSE(messages.Contains("ERROR")) << messages.Text();
-  }
-  EXPECT_LE(stop.eventsAfterAbort, 1); // at most the executive's own final report
-  EXPECT_EQ(vtkCompositeDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
-
-  f->RemoveObserver(observer);
-  f->SetAbortExecute(0);
-  f->Modified();
-  f->Update();
-  EXPECT_GT(vtkCompositeDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
+  ExpectAbortStopsCleanly(f, 0.35); // past the hulls: the pass then reports progress ~40 times
 }
 
 TEST(MuscleDeformationFilter, AbortStopsTheWholeMethodToo)
@@ -160,18 +166,5 @@ TEST(MuscleDeformationFilter, AbortStopsTheWholeMethodToo)
   }
   f->SetNumberOfSteps(3);
   f->SetHullTargetNumberOfPoints(100);
-  AbortPast stop(0.4); // in the second step
-  const unsigned long observer = f->AddObserver(vtkCommand::ProgressEvent, stop.command);
-  {
-    CapturedMessages messages;
-    f->Update();
-    EXPECT_FALSE(messages.Contains("ERROR")) << messages.Text();
-  }
-  EXPECT_LE(stop.eventsAfterAbort, 1);
-  EXPECT_EQ(vtkCompositeDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
-  f->RemoveObserver(observer);
-  f->SetAbortExecute(0);
-  f->Modified();
-  f->Update();
-  EXPECT_GT(vtkCompositeDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
+  ExpectAbortStopsCleanly(f, 0.4); // in the second step
 }
