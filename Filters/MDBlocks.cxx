@@ -409,6 +409,33 @@ vtkSmartPointer<vtkPolyData> ToPolyData(const TriangleMesh& mesh)
   return polyData;
 }
 
+vtkSmartPointer<vtkPolyData> ToPolyLines(const std::vector<Points>& lines)
+{
+  Eigen::Index total = 0;
+  for (const Points& line : lines)
+  {
+    total += line.rows();
+  }
+  Points all(total, 3);
+  vtkNew<vtkCellArray> cells;
+  vtkIdType next = 0;
+  for (const Points& line : lines)
+  {
+    const auto n = static_cast<vtkIdType>(line.rows());
+    all.middleRows(next, n) = line;
+    cells->InsertNextCell(n);
+    for (vtkIdType k = 0; k < n; ++k)
+    {
+      cells->InsertCellPoint(next + k);
+    }
+    next += n;
+  }
+  auto output = vtkSmartPointer<vtkPolyData>::New();
+  output->SetPoints(ToVtkPoints(all));
+  output->SetLines(cells);
+  return output;
+}
+
 std::vector<Points> ToPolylines(vtkPolyData* polyData, const Points* values)
 {
   std::vector<Points> lines;

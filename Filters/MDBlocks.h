@@ -94,6 +94,8 @@ vtkIdType ReadTriangles(vtkPolyData* input, TriangleMesh& mesh);
 /// The polylines of a polydata, each as its point coordinates, or as the rows
 /// of `values` (one per point of the polydata, e.g. a point array) when given.
 std::vector<Points> ToPolylines(vtkPolyData* polyData, const Points* values = nullptr);
+/// A polydata with one polyline cell per entry of `lines`, their points in order.
+vtkSmartPointer<vtkPolyData> ToPolyLines(const std::vector<Points>& lines);
 /// The meshes of every block of every connection of a repeatable input port
 /// (such as Obstacles), named by block name or label. Fails, with a message,
 /// on a block without triangles or with non-finite coordinates.

@@ -29,36 +29,23 @@ struct LineBuilder
 
   vtkSmartPointer<vtkPolyData> Build(vtkPolyData* source) const
   {
-    vtkIdType total = 0;
-    for (const auto& line : this->lines)
-    {
-      total += line.rows();
-    }
-    md::Points all(total, 3);
+    auto output = mdvtk::ToPolyLines(this->lines);
+    const vtkIdType total = output->GetNumberOfPoints();
     auto arcLength = vtkSmartPointer<vtkDoubleArray>::New();
     arcLength->SetName("ArcLength");
     arcLength->SetNumberOfValues(total);
     auto insertedFlag = vtkSmartPointer<vtkUnsignedCharArray>::New();
     insertedFlag->SetName("Inserted");
     insertedFlag->SetNumberOfValues(total);
-    vtkNew<vtkCellArray> cells;
     vtkIdType next = 0;
     for (size_t l = 0; l < this->lines.size(); ++l)
     {
-      const vtkIdType n = this->lines[l].rows();
-      all.middleRows(next, n) = this->lines[l];
-      cells->InsertNextCell(n);
-      for (vtkIdType k = 0; k < n; ++k)
+      for (vtkIdType k = 0; k < static_cast<vtkIdType>(this->lines[l].rows()); ++k, ++next)
       {
-        cells->InsertCellPoint(next + k);
-        arcLength->SetValue(next + k, this->parameters[l][k]);
-        insertedFlag->SetValue(next + k, this->inserted[l][k] ? 1 : 0);
+        arcLength->SetValue(next, this->parameters[l][k]);
+        insertedFlag->SetValue(next, this->inserted[l][k] ? 1 : 0);
       }
-      next += n;
     }
-    auto output = vtkSmartPointer<vtkPolyData>::New();
-    output->SetPoints(mdvtk::ToVtkPoints(all));
-    output->SetLines(cells);
     output->GetPointData()->AddArray(arcLength);
     output->GetPointData()->AddArray(insertedFlag);
     // Line cell data carries over: line l of the output is line l of the source,

@@ -2,6 +2,7 @@
 
 #include "ActionLineMatching.h"
 #include "InterpolatedDeformation.h"
+#include "LocalFrame.h"
 #include "MDBlocks.h"
 
 #include <vtkAlgorithmOutput.h>
@@ -26,6 +27,13 @@ struct vtkInterpolatedMuscleDeformation::Cache
   vtkMTimeType filterTime = 0;
   std::vector<size_t> blockOf; // block of each muscle
   md::InterpolationResult result;
+  // What outputs 1 and 2 show at each step: the bones and matched action lines moved as the
+  // method moved them (the same interpolators, in the same local frame).
+  md::LocalFrame frame;
+  std::vector<md::PoseInterpolator> boneMotions;
+  std::vector<size_t> boneLeaf;                          // BonesRest leaf of each bone
+  std::vector<std::vector<md::PoseInterpolator>> lineMotions; // per muscle
+  std::vector<size_t> lineLeaf;                          // ActionLinesRest leaf of each muscle
 };
 
 namespace
@@ -34,7 +42,7 @@ const char* const PortNames[] = { "Input", "BonesRest", "BonesCurrent", "ActionL
 
 /// The bones in both poses, paired.
 bool ReadBones(vtkObject* reporter, vtkDataObject* rest, vtkDataObject* current, std::vector<md::BoneMotion>& bones,
-  std::string& error)
+  std::string& error, std::vector<size_t>* leafOfBone = nullptr)
 {
   std::vector<mdvtk::Leaf> restLeaves, currentLeaves;
   std::vector<size_t> partner;
@@ -75,6 +83,10 @@ bool ReadBones(vtkObject* reporter, vtkDataObject* rest, vtkDataObject* current,
       return false;
     }
     bones.push_back(std::move(bone));
+    if (leafOfBone)
+    {
+      leafOfBone->push_back(b);
+    }
   }
   return true;
 }
@@ -84,6 +96,31 @@ vtkInterpolatedMuscleDeformation::vtkInterpolatedMuscleDeformation()
   : Computed(std::make_unique<Cache>())
 {
   this->SetNumberOfInputPorts(5);
+  this->SetNumberOfOutputPorts(3);
+}
+
+int vtkInterpolatedMuscleDeformation::RequestDataObject(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  // Each output has the type of the input it follows: muscles, bones, action lines.
+  const int followed[3] = { 0, 1, 3 };
+  for (int port = 0; port < 3; ++port)
+  {
+    vtkDataObject* input = vtkDataObject::GetData(inputVector[followed[port]], 0);
+    if (!input)
+    {
+      continue;
+    }
+    vtkInformation* info = outputVector->GetInformationObject(port);
+    vtkDataObject* output = vtkDataObject::GetData(info);
+    if (!output || !output->IsA(input->GetClassName()))
+    {
+      vtkSmartPointer<vtkDataObject> made;
+      made.TakeReference(input->NewInstance());
+      info->Set(vtkDataObject::DATA_OBJECT(), made);
+    }
+  }
+  return 1;
 }
 
 vtkInterpolatedMuscleDeformation::~vtkInterpolatedMuscleDeformation() = default;
@@ -131,15 +168,18 @@ int vtkInterpolatedMuscleDeformation::RequestInformation(
     }
   }
   this->ResolvedNumberOfSteps = steps;
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
   std::vector<double> times(static_cast<size_t>(steps) + 1);
   for (int j = 0; j <= steps; ++j)
   {
     times[j] = j;
   }
-  outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), steps + 1);
   const double range[2] = { 0.0, static_cast<double>(steps) };
-  outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+  for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
+  {
+    vtkInformation* outInfo = outputVector->GetInformationObject(port);
+    outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), steps + 1);
+    outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+  }
   return 1;
 }
 
@@ -159,7 +199,7 @@ int vtkInterpolatedMuscleDeformation::RequestUpdateExtent(
 }
 
 int vtkInterpolatedMuscleDeformation::RequestData(
-  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   vtkDataObject* input = vtkDataObject::GetData(inputVector[0], 0);
   vtkDataObject* inputs[5];
@@ -190,7 +230,7 @@ int vtkInterpolatedMuscleDeformation::RequestData(
       !mdvtk::CollectLeaves(inputs[4], PortNames[4], currentLines, error) ||
       !mdvtk::PairLeaves(this, muscles, PortNames[0], restLines, PortNames[3], restLinesOf, error) ||
       !mdvtk::PairLeaves(this, restLines, PortNames[3], currentLines, PortNames[4], currentLinesOf, error) ||
-      !ReadBones(this, inputs[1], inputs[2], bones, error))
+      !ReadBones(this, inputs[1], inputs[2], bones, error, &cache.boneLeaf))
     {
       vtkErrorMacro(<< error);
       return 0;
@@ -274,6 +314,13 @@ int vtkInterpolatedMuscleDeformation::RequestData(
         vtkErrorMacro(<< "an action line of " << restLeaf.label << " or " << currentLeaf.label << ": " << e.what());
         return 0;
       }
+      cache.lineMotions.emplace_back();
+      for (const md::MatchedLine& line : motion.lines)
+      {
+        cache.lineMotions.back().emplace_back(
+          line.rest, line.current, static_cast<md::InterpolationMode>(this->BoneInterpolationMode));
+      }
+      cache.lineLeaf.push_back(restLinesOf[b]);
       motions.push_back(std::move(motion));
       cache.blockOf.push_back(b);
     }
@@ -295,6 +342,12 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     {
       cache.result = md::DeformByInterpolation(motions, bones, parameters, mdvtk::ProgressOrCancel(this));
       md::ResultToWorld(frame, cache.result);
+      cache.frame = frame;
+      for (const md::BoneMotion& bone : bones)
+      {
+        cache.boneMotions.emplace_back(
+          bone.rest.points, bone.current, static_cast<md::InterpolationMode>(this->BoneInterpolationMode));
+      }
       for (size_t m = 0; m < cache.blockOf.size(); ++m)
       {
         for (size_t j = 0; j < cache.result.points.size(); ++j)
@@ -328,7 +381,12 @@ int vtkInterpolatedMuscleDeformation::RequestData(
 
   const md::InterpolationResult& r = cache.result;
   const int steps = r.numberOfSteps;
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  // The time asked for on the port whose request this is: all three outputs show that step.
+  int port = request->Has(vtkDemandDrivenPipeline::FROM_OUTPUT_PORT())
+    ? request->Get(vtkDemandDrivenPipeline::FROM_OUTPUT_PORT())
+    : 0;
+  port = port < 0 || port >= this->GetNumberOfOutputPorts() ? 0 : port;
+  vtkInformation* outInfo = outputVector->GetInformationObject(port);
   int step = steps;
   if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
   {
@@ -386,9 +444,44 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     output->SetFieldData(fieldData);
     outputs[b] = output;
   }
-  vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
-  mdvtk::AssignLeaves(input, output, outputs);
-  output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), static_cast<double>(step));
+  mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), outputs);
+
+  // Outputs 1 and 2: the bones and the matched action lines at the same step, as the method
+  // moved them, so that the muscles are never shown against bones of another step.
+  std::vector<mdvtk::Leaf> boneLeaves, lineLeaves;
+  if (!mdvtk::CollectLeaves(inputs[1], PortNames[1], boneLeaves, error) ||
+    !mdvtk::CollectLeaves(inputs[3], PortNames[3], lineLeaves, error))
+  {
+    vtkErrorMacro(<< error);
+    return 0;
+  }
+  std::vector<vtkSmartPointer<vtkPolyData>> boneOutputs(boneLeaves.size());
+  for (size_t k = 0; k < cache.boneMotions.size(); ++k)
+  {
+    md::Points points = cache.boneMotions[k].AtStep(step, steps);
+    cache.frame.ToWorld(points);
+    auto bone = vtkSmartPointer<vtkPolyData>::New();
+    bone->ShallowCopy(boneLeaves[cache.boneLeaf[k]].data);
+    bone->SetPoints(mdvtk::ToVtkPoints(points));
+    boneOutputs[cache.boneLeaf[k]] = bone;
+  }
+  mdvtk::AssignLeaves(inputs[1], vtkDataObject::GetData(outputVector, 1), boneOutputs);
+  std::vector<vtkSmartPointer<vtkPolyData>> lineOutputs(lineLeaves.size());
+  for (size_t m = 0; m < cache.lineMotions.size(); ++m)
+  {
+    std::vector<md::Points> lines;
+    for (const md::PoseInterpolator& line : cache.lineMotions[m])
+    {
+      lines.push_back(line.AtStep(step, steps));
+      cache.frame.ToWorld(lines.back());
+    }
+    lineOutputs[cache.lineLeaf[m]] = mdvtk::ToPolyLines(lines);
+  }
+  mdvtk::AssignLeaves(inputs[3], vtkDataObject::GetData(outputVector, 2), lineOutputs);
+  for (int p = 0; p < this->GetNumberOfOutputPorts(); ++p)
+  {
+    vtkDataObject::GetData(outputVector, p)->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), static_cast<double>(step));
+  }
   this->UpdateProgress(1.0);
   return 1;
 }

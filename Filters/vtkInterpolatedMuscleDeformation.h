@@ -22,7 +22,11 @@
  * in both poses, one block per muscle (by name, else by order), polylines
  * paired by order inside a block and matched as ActionLineMatching does.
  *
- * Output: the muscles at the requested time step j (0 = rest pose, N =
+ * Outputs 1 (Bones) and 2 (ActionLines): the bones and the matched action
+ * lines at the same step, as the method moved them, in the structure of
+ * BonesRest and ActionLinesRest.
+ *
+ * Output 0: the muscles at the requested time step j (0 = rest pose, N =
  * current pose; every step is computed once and kept), point arrays
  * Displacement (from the rest pose) and StaticShift (step j's static
  * resolution), and field data per muscle: VolumeChangePercent,
@@ -113,6 +117,7 @@ protected:
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestDataObject(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   int NumberOfSteps = 4;

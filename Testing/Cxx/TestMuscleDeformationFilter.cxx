@@ -5,6 +5,7 @@
 #include "FilterTestUtilities.h"
 
 #include "vtkActionLineMatching.h"
+#include "vtkBoneInterpolation.h"
 #include "vtkInterpolatedMuscleDeformation.h"
 #include "vtkMuscleDeformation.h"
 #include "vtkMusculoskeletalPhantom.h"
@@ -13,6 +14,7 @@
 #include <vtkCommand.h>
 #include <vtkDataArray.h>
 #include <vtkFieldData.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
 
 #include <gtest/gtest.h>
 
@@ -167,4 +169,50 @@ TEST(MuscleDeformationFilter, AbortStopsTheWholeMethodToo)
   f->SetNumberOfSteps(3);
   f->SetHullTargetNumberOfPoints(100);
   ExpectAbortStopsCleanly(f, 0.4); // in the second step
+}
+
+TEST(InterpolatedMuscleDeformationFilter, OutputsTheBonesAndActionLinesOfTheSameStep)
+{
+  // Seeing the bones at a step took a separate BoneInterpolation kept at the same N by hand;
+  // with another N the femur appeared to cut through the muscle. Outputs 1 and 2 now show the
+  // bones and the action lines of the step the muscles are at.
+  PhantomPipeline pipeline;
+  vtkNew<vtkInterpolatedMuscleDeformation> f;
+  f->SetInputConnection(0, pipeline.phantom->GetOutputPort(vtkMusculoskeletalPhantom::MUSCLES));
+  for (int port = 1; port < 5; ++port)
+  {
+    f->SetInputConnection(port, pipeline.phantom->GetOutputPort(port));
+  }
+  f->SetNumberOfSteps(2);
+  f->SetHullTargetNumberOfPoints(100);
+  vtkNew<vtkBoneInterpolation> bones;
+  bones->SetInputConnection(0, pipeline.phantom->GetOutputPort(vtkMusculoskeletalPhantom::BONES_REST));
+  bones->SetInputConnection(1, pipeline.phantom->GetOutputPort(vtkMusculoskeletalPhantom::BONES_CURRENT));
+  bones->SetNumberOfSteps(2);
+  for (int step = 0; step <= 2; ++step)
+  {
+    SCOPED_TRACE(step);
+    f->UpdateInformation();
+    for (int port = 0; port < 3; ++port)
+    {
+      f->GetOutputInformation(port)->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(), step);
+      f->Update(port);
+    }
+    bones->UpdateTimeStep(step);
+    EXPECT_LT(LargestDifference(f->GetOutputDataObject(1), bones->GetOutputDataObject(0)), 1e-9);
+    auto* lines = vtkMultiBlockDataSet::SafeDownCast(f->GetOutputDataObject(2));
+    ASSERT_NE(lines, nullptr);
+    ASSERT_EQ(lines->GetNumberOfBlocks(), 3u);
+    EXPECT_GT(vtkPolyData::SafeDownCast(lines->GetBlock(0))->GetNumberOfLines(), 0);
+    for (int port = 0; port < 3; ++port)
+    {
+      EXPECT_EQ(f->GetOutputDataObject(port)->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()), step);
+    }
+  }
+  // At the last step: the bones in the current pose and the lines at their current positions.
+  EXPECT_EQ(LargestDifference(
+              f->GetOutputDataObject(1), pipeline.phantom->GetOutputDataObject(vtkMusculoskeletalPhantom::BONES_CURRENT)),
+    0.0);
+  pipeline.matching->Update();
+  EXPECT_LT(LargestDifference(f->GetOutputDataObject(2), pipeline.matching->GetOutputDataObject(1)), 1e-9);
 }
