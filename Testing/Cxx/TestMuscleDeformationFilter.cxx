@@ -104,6 +104,15 @@ struct PhantomPipeline
     f->AddInputConnection(2, this->phantom->GetOutputPort(vtkMusculoskeletalPhantom::BONES_CURRENT));
     f->SetHullTargetNumberOfPoints(100);
   }
+  /// The phantom's five outputs into the whole method, as they are (raw action lines).
+  void Connect(vtkInterpolatedMuscleDeformation* f)
+  {
+    for (int port = 0; port < 5; ++port)
+    {
+      f->SetInputConnection(port, this->phantom->GetOutputPort(port));
+    }
+    f->SetHullTargetNumberOfPoints(100);
+  }
 };
 }
 
@@ -161,13 +170,8 @@ TEST(MuscleDeformationFilter, AbortStopsTheWholeMethodToo)
 {
   PhantomPipeline pipeline;
   vtkNew<vtkInterpolatedMuscleDeformation> f;
-  f->SetInputConnection(0, pipeline.phantom->GetOutputPort(vtkMusculoskeletalPhantom::MUSCLES));
-  for (int port = 1; port < 5; ++port)
-  {
-    f->SetInputConnection(port, pipeline.phantom->GetOutputPort(port));
-  }
+  pipeline.Connect(f);
   f->SetNumberOfSteps(3);
-  f->SetHullTargetNumberOfPoints(100);
   ExpectAbortStopsCleanly(f, 0.4); // in the second step
 }
 
@@ -178,13 +182,8 @@ TEST(InterpolatedMuscleDeformationFilter, OutputsTheBonesAndActionLinesOfTheSame
   // bones and the action lines of the step the muscles are at.
   PhantomPipeline pipeline;
   vtkNew<vtkInterpolatedMuscleDeformation> f;
-  f->SetInputConnection(0, pipeline.phantom->GetOutputPort(vtkMusculoskeletalPhantom::MUSCLES));
-  for (int port = 1; port < 5; ++port)
-  {
-    f->SetInputConnection(port, pipeline.phantom->GetOutputPort(port));
-  }
+  pipeline.Connect(f);
   f->SetNumberOfSteps(2);
-  f->SetHullTargetNumberOfPoints(100);
   vtkNew<vtkBoneInterpolation> bones;
   bones->SetInputConnection(0, pipeline.phantom->GetOutputPort(vtkMusculoskeletalPhantom::BONES_REST));
   bones->SetInputConnection(1, pipeline.phantom->GetOutputPort(vtkMusculoskeletalPhantom::BONES_CURRENT));
