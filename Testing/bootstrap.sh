@@ -13,7 +13,7 @@ MD_DATA_DIR=${MUSCLEDEFORMATION_DATA_DIR:-$MD_SOURCE_DIR/../shared/data}
 # libqt5svg5: the GUI's toolbar icons are SVG; without it they show blank.
 MD_PACKAGES=(
   cmake g++ make
-  paraview-dev python3-paraview
+  paraview paraview-dev python3-paraview
   libeigen3-dev libgtest-dev
   xvfb xauth libgl1-mesa-dri
   qtbase5-dev qttools5-dev qtxmlpatterns5-dev-tools

@@ -1,5 +1,6 @@
 """Shared set-up of the pvpython tests: paths, the plugin, captured VTK messages, skipping."""
 import os
+import shutil
 import sys
 import unittest
 
@@ -37,6 +38,21 @@ def block(data, name):
         if data.GetMetaData(index).Get(data.NAME()) == name:
             return data.GetBlock(index)
     raise KeyError(name)
+
+
+def assert_matches_baseline(test, fresh, name, output):
+    """Compares the image `fresh` with Testing/Baseline/`name` (vtkTesting, threshold 10), or
+    makes it the baseline when MUSCLEDEFORMATION_UPDATE_BASELINES=1."""
+    from vtkmodules.vtkTestingRendering import vtkTesting
+    baseline = os.path.join(BASELINE_DIR, name)
+    if os.environ.get("MUSCLEDEFORMATION_UPDATE_BASELINES") == "1":
+        shutil.copyfile(fresh, baseline)
+    test.assertTrue(os.path.isfile(baseline), "no baseline %s" % baseline)
+    testing = vtkTesting()
+    for argument in ("-V", os.path.abspath(baseline), "-T", os.path.abspath(output)):
+        testing.AddArgument(argument)
+    test.assertEqual(testing.RegressionTest(os.path.abspath(fresh), 10.0), vtkTesting.PASSED,
+                     "%s differs from its baseline; see %s" % (name, output))
 
 
 def load_plugin():

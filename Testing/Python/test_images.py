@@ -3,17 +3,14 @@
 Set MUSCLEDEFORMATION_UPDATE_BASELINES=1 to write new baselines after a deliberate change.
 """
 import os
-import shutil
 import unittest
 
 import mdtesting
 import mdexamples
 import phantom_interpolation
 from paraview import simple
-from vtkmodules.vtkTestingRendering import vtkTesting
 
 mdtesting.load_plugin()
-THRESHOLD = 10.0
 SIZE = (600, 600)
 
 
@@ -30,15 +27,7 @@ class Images(unittest.TestCase):
 
     def compare(self, name, time=None):
         fresh = mdexamples.screenshot(self.view, os.path.join(self.output, name), time=time)
-        baseline = os.path.join(mdtesting.BASELINE_DIR, name)
-        if os.environ.get("MUSCLEDEFORMATION_UPDATE_BASELINES") == "1":
-            shutil.copyfile(fresh, baseline)
-        self.assertTrue(os.path.isfile(baseline), "no baseline %s" % baseline)
-        testing = vtkTesting()
-        for argument in ("-V", os.path.abspath(baseline), "-T", os.path.abspath(self.output)):
-            testing.AddArgument(argument)
-        self.assertEqual(testing.RegressionTest(os.path.abspath(fresh), THRESHOLD), vtkTesting.PASSED,
-                         "%s differs from its baseline; see %s" % (name, self.output))
+        mdtesting.assert_matches_baseline(self, fresh, name, self.output)
 
     def test_rest_pose(self):
         mdexamples.show_pose(self.view, self.pipeline, "rest")
