@@ -62,6 +62,13 @@ class ServerManagerXML(unittest.TestCase):
         libraries = sorted(name for name in os.listdir(folder) if ".so" in name or name.endswith(".dll"))
         self.assertEqual(libraries, ["MuscleDeformation.so"])
 
+    def test_hulls_are_shown_as_a_wireframe_around_their_muscle(self):
+        folder = os.path.join(mdtesting.SOURCE_DIR, "ServerManagerXML")
+        root = ElementTree.parse(os.path.join(folder, "MuscleDeformation.xml")).getroot()
+        hints = root.find("./ProxyGroup/SourceProxy[@name='HullDecimation']/Hints")
+        self.assertEqual(hints.find("Representation").get("type"), "Wireframe")
+        self.assertEqual(hints.find("Visibility").get("replace_input"), "0")
+
     def test_proxies_have_the_names_users_rely_on(self):
         for name in ("MusculoskeletalPhantom", "ActionLineMatching", "BoneInterpolation", "HullDecimation",
                      "MuscleDeformation"):
