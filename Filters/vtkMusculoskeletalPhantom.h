@@ -59,7 +59,7 @@ protected:
 
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  double Flexion = 60.0;
+  double Flexion = 30.0;
   double Scale = 1.0;
   int Resolution = 24;
 

@@ -72,6 +72,7 @@ TEST(MusculoskeletalPhantom, OutputsNamedBlocksOnFivePorts)
 TEST(ActionLineMatching, PairsBlocksByNameAndCarriesTheCurrentPosition)
 {
   vtkNew<vtkMusculoskeletalPhantom> phantom;
+  phantom->SetFlexion(60);
   phantom->Update();
   auto* linesRest = vtkMultiBlockDataSet::SafeDownCast(phantom->GetOutputDataObject(3));
   auto* linesCurrent = vtkMultiBlockDataSet::SafeDownCast(phantom->GetOutputDataObject(4));
@@ -188,6 +189,7 @@ TEST(ActionLineMatching, BadInputGivesAClearErrorAndNoOutput)
 TEST(BoneInterpolation, AdvertisesOneTimeStepPerStepAndDeliversEach)
 {
   vtkNew<vtkMusculoskeletalPhantom> phantom;
+  phantom->SetFlexion(60);
   vtkNew<vtkBoneInterpolation> interpolation;
   interpolation->SetInputConnection(0, phantom->GetOutputPort(1));
   interpolation->SetInputConnection(1, phantom->GetOutputPort(2));
@@ -254,6 +256,7 @@ TEST(BoneInterpolation, AutomaticStepsFollowTheLargestDisplacement)
 TEST(BoneInterpolation, InterpolatesMatchedActionLinesThroughCurrentPosition)
 {
   vtkNew<vtkMusculoskeletalPhantom> phantom;
+  phantom->SetFlexion(60);
   vtkNew<vtkActionLineMatching> matching;
   matching->SetInputConnection(0, phantom->GetOutputPort(3));
   matching->SetInputConnection(1, phantom->GetOutputPort(4));
@@ -287,6 +290,7 @@ TEST(BoneInterpolation, RigidModeWarnsAboutANonRigidMotion)
 TEST(BoneInterpolation, BadInputGivesAClearErrorAndNoOutput)
 {
   vtkNew<vtkMusculoskeletalPhantom> phantom;
+  phantom->SetFlexion(60);
   phantom->Update();
   vtkSmartPointer<vtkPolyData> femur = Block(phantom->GetOutputDataObject(1), 1);
   vtkSmartPointer<vtkPolyData> pelvis = Block(phantom->GetOutputDataObject(1), 0);

@@ -71,6 +71,7 @@ struct Phantom
   Phantom()
   {
     this->source->SetResolution(12);
+    this->source->SetFlexion(60); // the femur sweeps into the rectus femoris
     this->source->Update();
     this->matching->SetInputConnection(this->source->GetOutputPort(3));
     this->matching->SetCurrentPoseConnection(this->source->GetOutputPort(4));

@@ -66,7 +66,7 @@ class ServerManagerXML(unittest.TestCase):
         folder = os.path.join(mdtesting.SOURCE_DIR, "ServerManagerXML")
         root = ElementTree.parse(os.path.join(folder, "MuscleDeformation.xml")).getroot()
         hints = root.find("./ProxyGroup/SourceProxy[@name='HullDecimation']/Hints")
-        self.assertEqual(hints.find("Representation").get("type"), "Wireframe")
+        self.assertEqual(hints.find("RepresentationType").get("type"), "Wireframe")
         self.assertEqual(hints.find("Visibility").get("replace_input"), "0")
 
     def test_proxies_have_the_names_users_rely_on(self):
