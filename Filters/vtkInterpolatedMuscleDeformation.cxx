@@ -14,6 +14,8 @@
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
+#include <vtkStringArray.h>
+#include <vtkTable.h>
 
 #include <algorithm>
 #include <cmath>
@@ -96,13 +98,28 @@ vtkInterpolatedMuscleDeformation::vtkInterpolatedMuscleDeformation()
   : Computed(std::make_unique<Cache>())
 {
   this->SetNumberOfInputPorts(5);
-  this->SetNumberOfOutputPorts(3);
+  this->SetNumberOfOutputPorts(4);
+}
+
+int vtkInterpolatedMuscleDeformation::FillOutputPortInformation(int port, vtkInformation* info)
+{
+  if (port == 3)
+  {
+    info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkTable");
+    return 1;
+  }
+  return this->Superclass::FillOutputPortInformation(port, info);
 }
 
 int vtkInterpolatedMuscleDeformation::RequestDataObject(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  // Each output has the type of the input it follows: muscles, bones, action lines.
+  // Each output has the type of the input it follows: muscles, bones, action lines; then the table.
+  if (!vtkTable::GetData(outputVector, 3))
+  {
+    vtkNew<vtkTable> table;
+    outputVector->GetInformationObject(3)->Set(vtkDataObject::DATA_OBJECT(), table);
+  }
   const int followed[3] = { 0, 1, 3 };
   for (int port = 0; port < 3; ++port)
   {
@@ -394,6 +411,8 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     step = static_cast<int>(std::lround(std::clamp(time, 0.0, static_cast<double>(steps))));
   }
   std::vector<vtkSmartPointer<vtkPolyData>> outputs(muscles.size());
+  std::vector<std::string> names;                                  // Measures rows
+  std::vector<std::pair<std::string, std::vector<double>>> columns; // Measures columns
   for (size_t m = 0; m < cache.blockOf.size(); ++m)
   {
     const size_t b = cache.blockOf[m];
@@ -424,27 +443,58 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     }
     vtkNew<vtkFieldData> fieldData;
     fieldData->DeepCopy(muscles[b].data->GetFieldData());
-    mdvtk::AddFieldValue(fieldData, "VolumeChangePercent", s.volumeChangePercent);
-    mdvtk::AddFieldValue(fieldData, "NewPenetrationCount", s.newPenetrationCount);
-    mdvtk::AddFieldValue(fieldData, "MaxNewPenetrationDepth", s.maxNewPenetrationDepth);
-    mdvtk::AddFieldValue(fieldData, "NewBonePenetrationCount", s.newBonePenetrationCount);
-    mdvtk::AddFieldValue(fieldData, "MaxNewBonePenetrationDepth", s.maxNewBonePenetrationDepth);
-    mdvtk::AddFieldValue(fieldData, "MaxStaticShift", s.maxStaticShift);
-    mdvtk::AddFieldValue(fieldData, "StepStaticShift", s.stepStaticShift);
-    mdvtk::AddFieldValue(fieldData, "SharpEdgeCount", s.sharpEdgeCount);
-    mdvtk::AddFieldValue(fieldData, "FlippedTriangleCount", s.flippedTriangleCount);
-    mdvtk::AddFieldValue(fieldData, "NumberOfIterations", s.iterations);
-    mdvtk::AddFieldValue(fieldData, "Converged", s.converged ? 1 : 0);
-    mdvtk::AddFieldValue(fieldData, "PointsFrozenInObstacles", s.pointsFrozenInObstacles);
-    mdvtk::AddFieldValue(fieldData, "InterpolationStep", step);
-    mdvtk::AddFieldValue(fieldData, "NumberOfSteps", steps);
-    mdvtk::AddFieldValue(fieldData, "HullSeconds", hullSeconds);
-    mdvtk::AddFieldValue(fieldData, "StepSeconds", r.stepSeconds[step]);
-    mdvtk::AddFieldValue(fieldData, "ElapsedSeconds", r.totalSeconds);
+    // Each measure goes to the muscle's field data and to its row of the Measures table.
+    names.push_back(muscles[b].name.empty() ? muscles[b].label : muscles[b].name);
+    size_t measureIndex = 0;
+    auto measure = [&](const char* name, auto value) {
+      mdvtk::AddFieldValue(fieldData, name, value);
+      if (m == 0)
+      {
+        columns.emplace_back(name, std::vector<double>());
+      }
+      columns[measureIndex++].second.push_back(static_cast<double>(value));
+    };
+    measure("VolumeChangePercent", s.volumeChangePercent);
+    measure("NewPenetrationCount", s.newPenetrationCount);
+    measure("MaxNewPenetrationDepth", s.maxNewPenetrationDepth);
+    measure("NewBonePenetrationCount", s.newBonePenetrationCount);
+    measure("MaxNewBonePenetrationDepth", s.maxNewBonePenetrationDepth);
+    measure("MaxStaticShift", s.maxStaticShift);
+    measure("StepStaticShift", s.stepStaticShift);
+    measure("SharpEdgeCount", s.sharpEdgeCount);
+    measure("FlippedTriangleCount", s.flippedTriangleCount);
+    measure("NumberOfIterations", s.iterations);
+    measure("Converged", s.converged ? 1 : 0);
+    measure("PointsFrozenInObstacles", s.pointsFrozenInObstacles);
+    measure("InterpolationStep", step);
+    measure("NumberOfSteps", steps);
+    measure("HullSeconds", hullSeconds);
+    measure("StepSeconds", r.stepSeconds[step]);
+    measure("ElapsedSeconds", r.totalSeconds);
     output->SetFieldData(fieldData);
     outputs[b] = output;
   }
   mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), outputs);
+
+  // Output 3: the same measures as a table, one row per muscle, for a spreadsheet view.
+  vtkTable* table = vtkTable::GetData(outputVector, 3);
+  vtkNew<vtkStringArray> muscleColumn;
+  muscleColumn->SetName("Muscle");
+  for (const std::string& name : names)
+  {
+    muscleColumn->InsertNextValue(name);
+  }
+  table->AddColumn(muscleColumn);
+  for (const auto& [name, values] : columns)
+  {
+    vtkNew<vtkDoubleArray> column;
+    column->SetName(name.c_str());
+    for (double value : values)
+    {
+      column->InsertNextValue(value);
+    }
+    table->AddColumn(column);
+  }
 
   // Outputs 1 and 2: the bones and the matched action lines at the same step, as the method
   // moved them, so that the muscles are never shown against bones of another step.

@@ -24,7 +24,8 @@
  *
  * Outputs 1 (Bones) and 2 (ActionLines): the bones and the matched action
  * lines at the same step, as the method moved them, in the structure of
- * BonesRest and ActionLinesRest.
+ * BonesRest and ActionLinesRest. Output 3 (Measures): a table of the
+ * muscles' field data below, one row per muscle (column Muscle: its name).
  *
  * Output 0: the muscles at the requested time step j (0 = rest pose, N =
  * current pose; every step is computed once and kept), point arrays
@@ -118,6 +119,7 @@ protected:
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestDataObject(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int FillOutputPortInformation(int port, vtkInformation* info) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   int NumberOfSteps = 4;

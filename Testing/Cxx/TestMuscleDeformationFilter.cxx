@@ -15,6 +15,8 @@
 #include <vtkDataArray.h>
 #include <vtkFieldData.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
+#include <vtkTable.h>
+#include <vtkVariant.h>
 
 #include <gtest/gtest.h>
 
@@ -214,4 +216,20 @@ TEST(InterpolatedMuscleDeformationFilter, OutputsTheBonesAndActionLinesOfTheSame
     0.0);
   pipeline.matching->Update();
   EXPECT_LT(LargestDifference(f->GetOutputDataObject(2), pipeline.matching->GetOutputDataObject(1)), 1e-9);
+
+  // Output 3: the per-muscle measures of the step as a table, the same as the field data.
+  auto* table = vtkTable::SafeDownCast(f->GetOutputDataObject(3));
+  ASSERT_NE(table, nullptr);
+  auto* muscles = vtkMultiBlockDataSet::SafeDownCast(f->GetOutputDataObject(0));
+  ASSERT_EQ(table->GetNumberOfRows(), static_cast<vtkIdType>(muscles->GetNumberOfBlocks()));
+  for (unsigned int b = 0; b < muscles->GetNumberOfBlocks(); ++b)
+  {
+    EXPECT_EQ(table->GetValueByName(b, "Muscle").ToString(), BlockName(muscles, b));
+    for (const char* name : { "VolumeChangePercent", "MaxStaticShift", "FlippedTriangleCount", "InterpolationStep" })
+    {
+      EXPECT_EQ(table->GetValueByName(b, name).ToDouble(),
+        vtkPolyData::SafeDownCast(muscles->GetBlock(b))->GetFieldData()->GetArray(name)->GetTuple1(0))
+        << name;
+    }
+  }
 }
