@@ -1,13 +1,14 @@
 """Seconds of MuscleDeformation through pvpython, as a user meets them, at three muscle sizes.
 
-    pvpython Testing/Benchmarks/benchmark_filter_scaling.py [data folder]
+    pvpython Testing/Benchmarks/benchmark_filter_scaling.py [data folder] [levels, e.g. 2 or 0,1,2]
 
 The VHF gluteus maximus (24,220 points) and the same surface subdivided at its edges' midpoints
 once (96,874) and twice (387,490), as BenchmarkScaling does in the core. Its action line: the
 centroids of five slices along its long axis; the current pose turns it by 10 degrees about its
 first point, then by 12 (a second pose, as when a user moves a slider). For each size it prints
 the seconds of the first run (the hull and mean value coordinates built), of the second pose (both
-kept) and of HullDecimation alone. Asserts nothing.
+kept) and of HullDecimation alone; give levels to measure only some sizes (e.g. 2: the 387k
+surface alone, for its peak memory under /usr/bin/time -v). Asserts nothing.
 """
 import math
 import os
@@ -65,13 +66,14 @@ def action_line(muscle, degrees):
     return line
 
 
+levels = [int(level) for level in sys.argv[2].split(",")] if len(sys.argv) > 2 else [0, 1, 2]
 reader = vtkSTLReader()
 reader.SetFileName(path)
 reader.Update()
 muscle = vtkPolyData()
 muscle.DeepCopy(reader.GetOutput())
 print("points    first run s   second pose s   HullDecimation s   (hull + coordinates kept on the second pose)")
-for level in range(3):
+for level in range(max(levels) + 1):
     if level:
         subdivide = vtkLinearSubdivisionFilter()
         subdivide.SetInputData(muscle)
@@ -79,10 +81,18 @@ for level in range(3):
         subdivide.Update()
         muscle = vtkPolyData()
         muscle.DeepCopy(subdivide.GetOutput())
+    if level not in levels:
+        continue
     source = simple.TrivialProducer()
     source.GetClientSideObject().SetOutput(muscle)
     lines = simple.TrivialProducer()
     lines.GetClientSideObject().SetOutput(action_line(muscle, 10))
+    # HullDecimation first, and gone before the deformation: each filter's peak memory alone.
+    hull = simple.HullDecimation(Input=source)
+    start = time.perf_counter()
+    hull.UpdatePipeline()
+    hull_seconds = time.perf_counter() - start
+    simple.Delete(hull)
     deformation = simple.MuscleDeformation(Input=source, ActionLines=lines)
     start = time.perf_counter()
     deformation.UpdatePipeline()
@@ -92,10 +102,6 @@ for level in range(3):
     start = time.perf_counter()
     deformation.UpdatePipeline()
     second = time.perf_counter() - start
-    hull = simple.HullDecimation(Input=source)
-    start = time.perf_counter()
-    hull.UpdatePipeline()
-    hull_seconds = time.perf_counter() - start
     print("%7d   %10.2f   %12.2f   %14.2f" % (muscle.GetNumberOfPoints(), first, second, hull_seconds))
-    for proxy in (hull, deformation, lines, source):
+    for proxy in (deformation, lines, source):
         simple.Delete(proxy)
