@@ -10,12 +10,13 @@
 namespace md
 {
 /// local = (world - origin) / unit. The unit is the power of two at or above the largest extent
-/// of the data the frame is made around; the origin is the multiple of 16 units nearest the data's
-/// centre, or 0 while that is within 8 units of it. So data within a few times its own size of the coordinates' origin keeps origin 0 and
-/// is only divided by a power of two, which is exact: its results are bit for bit those computed
-/// in its own coordinates. Data far away (a scan 1e12 from the origin) is moved near it by a
-/// shift that is itself exact (a multiple of a power of two at least as coarse as the data's own
-/// rounding), and data in metres, millimetres or light years gets the same local numbers.
+/// of the data the frame is made around; the origin is the multiple of 16 units nearest the
+/// data's centre, or 0 while that is within 8 units of it. So data within a few times its own
+/// size of the coordinates' origin keeps origin 0 and is only divided by a power of two, which is
+/// exact: its results are bit for bit those computed in its own coordinates. Data far away (a
+/// scan 1e12 from the origin) is moved near it by a shift that is itself exact (a multiple of a
+/// power of two at least as coarse as the data's own rounding), and data in metres or in
+/// millimetres gets local numbers of the same size, equal to rounding.
 struct LocalFrame
 {
   Eigen::RowVector3d origin = Eigen::RowVector3d::Zero();
