@@ -241,7 +241,8 @@ bool PairLeaves(vtkObject* reporter, const std::vector<Leaf>& a, const std::stri
   {
     shared += !leaf.name.empty() && indexOfName.count(leaf.name) ? 1 : 0;
   }
-  if (uniquelyNamed(a) && uniquelyNamed(b) && (shared > 0 || a.size() != b.size()))
+  const bool aNamed = uniquelyNamed(a), bNamed = uniquelyNamed(b);
+  if (aNamed && bNamed && (shared > 0 || a.size() != b.size()))
   {
     // Names that pair some blocks but not all are a mistake (a block left out or renamed), not
     // a reason to fall back to the order, which would pair the wrong muscles.
@@ -275,7 +276,7 @@ bool PairLeaves(vtkObject* reporter, const std::vector<Leaf>& a, const std::stri
   }
   // Named blocks that share no name (the GUI names the blocks of Group Datasets after its
   // inputs: 'femur_r.vtk' against 'Transform1') pair by order; say which with which.
-  if (reporter && a.size() > 1 && shared == 0 && (uniquelyNamed(a) || uniquelyNamed(b)))
+  if (reporter && a.size() > 1 && shared == 0 && (aNamed || bNamed))
   {
     std::string pairs;
     for (size_t i = 0; i < a.size() && i < 4; ++i)
@@ -299,6 +300,26 @@ std::function<void(double)> ProgressOrCancel(vtkAlgorithm* filter, double offset
       throw md::Cancelled();
     }
   };
+}
+
+bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::function<void()>& work, int& result)
+{
+  try
+  {
+    work();
+    return true;
+  }
+  catch (const md::InputError& e)
+  {
+    vtkErrorWithObjectMacro(filter, << context << e.what());
+    result = 0;
+  }
+  catch (const md::Cancelled&)
+  {
+    filter->CheckAbort(); // sets AbortOutput: the executive empties the outputs
+    result = 1;
+  }
+  return false;
 }
 
 std::function<bool()> AbortRequested(vtkAlgorithm* filter)
@@ -386,13 +407,19 @@ Points ToPoints(vtkPoints* points)
 
 vtkSmartPointer<vtkPoints> ToVtkPoints(const Points& points)
 {
-  vtkNew<vtkDoubleArray> array;
-  array->SetNumberOfComponents(3);
-  array->SetNumberOfTuples(points.rows());
-  std::copy(points.data(), points.data() + points.size(), array->GetPointer(0));
   auto out = vtkSmartPointer<vtkPoints>::New();
-  out->SetData(array);
+  out->SetData(ToVtkArray(nullptr, points));
   return out;
+}
+
+vtkSmartPointer<vtkDoubleArray> ToVtkArray(const char* name, const Points& values)
+{
+  auto array = vtkSmartPointer<vtkDoubleArray>::New();
+  array->SetName(name);
+  array->SetNumberOfComponents(3);
+  array->SetNumberOfTuples(values.rows());
+  std::copy(values.data(), values.data() + values.size(), array->GetPointer(0));
+  return array;
 }
 
 vtkSmartPointer<vtkPolyData> ToPolyData(const TriangleMesh& mesh)

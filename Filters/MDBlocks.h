@@ -14,6 +14,7 @@
 
 class vtkAlgorithm;
 class vtkDataArray;
+class vtkDoubleArray;
 class vtkDataObject;
 class vtkFieldData;
 class vtkInformation;
@@ -70,6 +71,12 @@ void CopyTimeSteps(vtkInformation* from, vtkInformation* to);
 /// progress and throws md::Cancelled when the user has asked the filter to stop (ParaView's
 /// abort). Call only from the filter's own thread.
 std::function<void(double)> ProgressOrCancel(vtkAlgorithm* filter, double offset = 0.0, double share = 1.0);
+/// Runs `work` (calls into the core) and turns the core's exceptions into what a filter reports:
+/// md::InputError becomes an error (`context` + its message) and RequestData's result 0;
+/// md::Cancelled (the user stopped the run) notes the abort, so that the executive empties the
+/// outputs, and the result 1. Returns true when `work` completed; otherwise `result` is what
+/// RequestData returns.
+bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::function<void()>& work, int& result);
 /// Whether the user has asked `filter` to stop; safe to ask from worker threads (it only reads
 /// the flag), for md::HullParameters::cancelled.
 std::function<bool()> AbortRequested(vtkAlgorithm* filter);
@@ -87,6 +94,8 @@ Points ToPoints(vtkPoints* points);
 /// The tuples of a 3-component array (such as CurrentPosition) in double precision.
 Points ToPoints(vtkDataArray* array);
 vtkSmartPointer<vtkPoints> ToVtkPoints(const Points& points);
+/// A 3-component point array named `name` holding the rows of `values` (displacements, shifts).
+vtkSmartPointer<vtkDoubleArray> ToVtkArray(const char* name, const Points& values);
 vtkSmartPointer<vtkPolyData> ToPolyData(const TriangleMesh& mesh);
 /// The polygons of `input` as triangles (polygons and strips triangulated),
 /// with all of its points. Returns the number of cells that were not triangles.

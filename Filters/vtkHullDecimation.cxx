@@ -68,19 +68,10 @@ int vtkHullDecimation::RequestData(
     md::TriangleMesh muscle;
     const vtkIdType converted = mdvtk::ReadTriangles(leaf.data, muscle);
     md::MuscleHull built;
-    try
+    int result = 1;
+    if (!mdvtk::CallCore(this, leaf.label + ": ", [&] { built = md::BuildMuscleHull(muscle, parameters); }, result))
     {
-      built = md::BuildMuscleHull(muscle, parameters);
-    }
-    catch (const md::InputError& e)
-    {
-      vtkErrorMacro(<< leaf.label << ": " << e.what());
-      return 0;
-    }
-    catch (const md::Cancelled&)
-    {
-      this->CheckAbort();
-      return 1;
+      return result;
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const md::RepairReport& report = built.report;

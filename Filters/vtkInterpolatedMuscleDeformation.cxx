@@ -174,14 +174,10 @@ int vtkInterpolatedMuscleDeformation::RequestInformation(
     md::InterpolationParameters parameters;
     parameters.numberOfSteps = 0;
     parameters.maximumStepDisplacement = this->MaximumStepDisplacement; // bones in world units here
-    try
+    int result = 1;
+    if (!mdvtk::CallCore(this, "", [&] { steps = md::ResolveNumberOfSteps(bones, parameters); }, result))
     {
-      steps = md::ResolveNumberOfSteps(bones, parameters);
-    }
-    catch (const md::InputError& e)
-    {
-      vtkErrorMacro(<< e.what());
-      return 0;
+      return result;
     }
   }
   this->ResolvedNumberOfSteps = steps;
@@ -254,25 +250,6 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     }
     // Everything in the muscles' local frame from here on, the matching of the action lines
     // too: the same answer wherever the data sits and whatever its units.
-    std::vector<md::Points> worldMuscles;
-    for (const mdvtk::Leaf& leaf : muscles)
-    {
-      if (leaf.data)
-      {
-        worldMuscles.push_back(mdvtk::ToPoints(leaf.data->GetPoints()));
-      }
-    }
-    std::vector<const md::Points*> muscleParts;
-    for (const md::Points& points : worldMuscles)
-    {
-      muscleParts.push_back(&points);
-    }
-    const md::LocalFrame frame = md::LocalFrame::Around(muscleParts);
-    for (md::BoneMotion& bone : bones)
-    {
-      frame.ToLocal(bone.rest.points);
-      frame.ToLocal(bone.current);
-    }
     std::vector<md::MuscleMotion> motions;
     for (size_t b = 0; b < muscles.size(); ++b)
     {
@@ -289,6 +266,30 @@ int vtkInterpolatedMuscleDeformation::RequestData(
         vtkErrorMacro(<< leaf.label << " has no surface (no polygons); a muscle must be a closed triangle surface");
         return 0;
       }
+      motions.push_back(std::move(motion));
+      cache.blockOf.push_back(b);
+    }
+    std::vector<md::Points> worldMuscles; // the rest pose as given: step 0 shows it exactly
+    std::vector<const md::Points*> restPoints;
+    for (const md::MuscleMotion& motion : motions)
+    {
+      worldMuscles.push_back(motion.muscle.points);
+    }
+    for (const md::Points& points : worldMuscles)
+    {
+      restPoints.push_back(&points);
+    }
+    const md::LocalFrame frame = md::LocalFrame::Around(restPoints);
+    for (md::BoneMotion& bone : bones)
+    {
+      frame.ToLocal(bone.rest.points);
+      frame.ToLocal(bone.current);
+    }
+    for (size_t m = 0; m < motions.size(); ++m)
+    {
+      md::MuscleMotion& motion = motions[m];
+      const size_t b = cache.blockOf[m];
+      const mdvtk::Leaf& leaf = muscles[b];
       frame.ToLocal(motion.muscle.points);
       const mdvtk::Leaf& restLeaf = restLines[restLinesOf[b]];
       const mdvtk::Leaf& currentLeaf = currentLines[currentLinesOf[restLinesOf[b]]];
@@ -314,22 +315,20 @@ int vtkInterpolatedMuscleDeformation::RequestData(
                       << " has " << current.size() << ": the lines of a muscle pair by order");
         return 0;
       }
-      try
+      int result = 1;
+      if (!mdvtk::CallCore(this, "an action line of " + restLeaf.label + " or " + currentLeaf.label + ": ", [&] {
+            for (size_t l = 0; l < rest.size(); ++l)
+            {
+              const md::MatchedActionLines matched = md::MatchActionLines(rest[l], current[l], this->MatchingTolerance);
+              motion.lines.push_back({ matched.rest, matched.current });
+            }
+            for (const std::string& note : md::LimitActionLinePoints(motion.lines))
+            {
+              vtkWarningMacro(<< restLeaf.label << ": " << note);
+            }
+          }, result))
       {
-        for (size_t l = 0; l < rest.size(); ++l)
-        {
-          const md::MatchedActionLines matched = md::MatchActionLines(rest[l], current[l], this->MatchingTolerance);
-          motion.lines.push_back({ matched.rest, matched.current });
-        }
-        for (const std::string& note : md::LimitActionLinePoints(motion.lines))
-        {
-          vtkWarningMacro(<< restLeaf.label << ": " << note);
-        }
-      }
-      catch (const md::InputError& e)
-      {
-        vtkErrorMacro(<< "an action line of " << restLeaf.label << " or " << currentLeaf.label << ": " << e.what());
-        return 0;
+        return result;
       }
       cache.lineMotions.emplace_back();
       for (const md::MatchedLine& line : motion.lines)
@@ -338,8 +337,6 @@ int vtkInterpolatedMuscleDeformation::RequestData(
           line.rest, line.current, static_cast<md::InterpolationMode>(this->BoneInterpolationMode));
       }
       cache.lineLeaf.push_back(restLinesOf[b]);
-      motions.push_back(std::move(motion));
-      cache.blockOf.push_back(b);
     }
 
     md::InterpolationParameters parameters;
@@ -355,38 +352,20 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     parameters.deformation.contactWeight = this->BoneContactWeight;
     parameters.hull.targetNumberOfPoints = this->HullTargetNumberOfPoints;
     parameters.hull.cancelled = mdvtk::AbortRequested(this);
-    try
+    int result = 1;
+    if (!mdvtk::CallCore(this, "", [&] {
+          cache.result = md::DeformByInterpolation(motions, bones, parameters, mdvtk::ProgressOrCancel(this));
+        }, result))
     {
-      cache.result = md::DeformByInterpolation(motions, bones, parameters, mdvtk::ProgressOrCancel(this));
-      md::ResultToWorld(frame, cache.result);
-      cache.frame = frame;
-      for (const md::BoneMotion& bone : bones)
-      {
-        cache.boneMotions.emplace_back(
-          bone.rest.points, bone.current, static_cast<md::InterpolationMode>(this->BoneInterpolationMode));
-      }
-      for (size_t m = 0; m < cache.blockOf.size(); ++m)
-      {
-        for (size_t j = 0; j < cache.result.points.size(); ++j)
-        {
-          if (j == 0 || cache.result.zeroMotion)
-          {
-            cache.result.points[j][m] = worldMuscles[m]; // the input itself, not its round trip
-          }
-        }
-      }
-    }
-    catch (const md::InputError& e)
-    {
-      vtkErrorMacro(<< e.what());
       cache = Cache{};
-      return 0;
+      return result;
     }
-    catch (const md::Cancelled&)
+    md::ResultToWorld(frame, restPoints, cache.result);
+    cache.frame = frame;
+    for (const md::BoneMotion& bone : bones)
     {
-      this->CheckAbort(); // stopped by the user: the executive empties the output
-      cache = Cache{};
-      return 1;
+      cache.boneMotions.emplace_back(
+        bone.rest.points, bone.current, static_cast<md::InterpolationMode>(this->BoneInterpolationMode));
     }
     for (const std::string& warning : cache.result.warnings)
     {
@@ -422,20 +401,10 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     auto output = vtkSmartPointer<vtkPolyData>::New();
     output->ShallowCopy(muscles[b].data);
     output->SetPoints(mdvtk::ToVtkPoints(points));
-    auto addVectors = [&](const char* name, const md::Points& values) {
-      vtkNew<vtkDoubleArray> array;
-      array->SetName(name);
-      array->SetNumberOfComponents(3);
-      array->SetNumberOfTuples(points.rows());
-      for (Eigen::Index i = 0; i < points.rows(); ++i)
-      {
-        const Eigen::RowVector3d v = values.rows() ? Eigen::RowVector3d(values.row(i)) : Eigen::RowVector3d::Zero();
-        array->SetTuple(i, v.data());
-      }
-      output->GetPointData()->AddArray(array);
-    };
-    addVectors("Displacement", points - rest);
-    addVectors("StaticShift", s.staticShift);
+    output->GetPointData()->AddArray(mdvtk::ToVtkArray("Displacement", points - rest));
+    // No static move at step 0: zeros.
+    output->GetPointData()->AddArray(mdvtk::ToVtkArray(
+      "StaticShift", s.staticShift.rows() ? s.staticShift : md::Points(md::Points::Zero(points.rows(), 3))));
     double hullSeconds = r.restHullSeconds[m];
     for (int j = 1; j <= step; ++j)
     {

@@ -177,32 +177,30 @@ int vtkIntersectionResolve::RequestData(
   };
   md::StaticResolveResult resolved;
   std::vector<md::Penetration> left;
-  try
+  int result = 1;
+  if (!mdvtk::CallCore(this, "", [&] {
+        trees = md::BuildObstacles(obstacleNames, obstacles);
+        this->UpdateProgress(0.2);
+        if (restGiven)
+        {
+          restTrees = restObstacles.empty() ? trees : md::BuildObstacles(restObstacleNames, restObstacles);
+          existing = md::FindOverlaps(deformableRest, fixedOf(restTrees));
+        }
+        this->UpdateProgress(0.4);
+        md::StaticResolveParameters parameters;
+        parameters.deformableShare = this->DeformableShare;
+        const std::vector<md::FixedObstacle> fixed = fixedOf(trees);
+        resolved = md::ResolveStaticIntersections(deformable, fixed, restGiven ? &existing : nullptr, parameters);
+        this->UpdateProgress(0.8);
+        std::vector<md::TriangleMesh> after = deformable;
+        for (size_t k = 0; k < after.size(); ++k)
+        {
+          after[k].points = resolved.points[k];
+        }
+        left = md::MeasureNewPenetration(after, fixed, restGiven ? &existing : nullptr);
+      }, result))
   {
-    trees = md::BuildObstacles(obstacleNames, obstacles);
-    this->UpdateProgress(0.2);
-    if (restGiven)
-    {
-      restTrees = restObstacles.empty() ? trees : md::BuildObstacles(restObstacleNames, restObstacles);
-      existing = md::FindOverlaps(deformableRest, fixedOf(restTrees));
-    }
-    this->UpdateProgress(0.4);
-    md::StaticResolveParameters parameters;
-    parameters.deformableShare = this->DeformableShare;
-    const std::vector<md::FixedObstacle> fixed = fixedOf(trees);
-    resolved = md::ResolveStaticIntersections(deformable, fixed, restGiven ? &existing : nullptr, parameters);
-    this->UpdateProgress(0.8);
-    std::vector<md::TriangleMesh> after = deformable;
-    for (size_t k = 0; k < after.size(); ++k)
-    {
-      after[k].points = resolved.points[k];
-    }
-    left = md::MeasureNewPenetration(after, fixed, restGiven ? &existing : nullptr);
-  }
-  catch (const md::InputError& e)
-  {
-    vtkErrorMacro(<< e.what());
-    return 0;
+    return result;
   }
 
   std::vector<vtkSmartPointer<vtkPolyData>> outputs(leaves.size());
@@ -216,12 +214,7 @@ int vtkIntersectionResolve::RequestData(
     auto output = vtkSmartPointer<vtkPolyData>::New();
     output->ShallowCopy(leaves[b].data);
     output->SetPoints(mdvtk::ToVtkPoints(points));
-    vtkNew<vtkDoubleArray> shift;
-    shift->SetName("StaticShift");
-    shift->SetNumberOfComponents(3);
-    shift->SetNumberOfTuples(shifts.rows());
-    std::copy(shifts.data(), shifts.data() + shifts.size(), shift->GetPointer(0));
-    output->GetPointData()->AddArray(shift);
+    output->GetPointData()->AddArray(mdvtk::ToVtkArray("StaticShift", shifts));
     // Field data describes this output only: the upstream measures (a deformation's volume
     // change, iterations, ...) no longer hold once points have moved.
     vtkNew<vtkFieldData> fieldData;

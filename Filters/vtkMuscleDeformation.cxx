@@ -281,25 +281,18 @@ int vtkMuscleDeformation::RequestData(
         md::HullParameters parameters;
         parameters.targetNumberOfPoints = this->HullTargetNumberOfPoints;
         parameters.cancelled = mdvtk::AbortRequested(this);
-        try
+        int result = 1;
+        if (!mdvtk::CallCore(this, leaf.label + ": ", [&] {
+              const md::MuscleHull built = md::BuildMuscleHull(surfaces[b], parameters);
+              ++this->HullBuildCount;
+              entry.hull = built.result.hull;
+              if (built.report.Changed())
+              {
+                entry.repairs = built.report.Describe();
+              }
+            }, result))
         {
-          const md::MuscleHull built = md::BuildMuscleHull(surfaces[b], parameters);
-          ++this->HullBuildCount;
-          entry.hull = built.result.hull;
-          if (built.report.Changed())
-          {
-            entry.repairs = built.report.Describe();
-          }
-        }
-        catch (const md::InputError& e)
-        {
-          vtkErrorMacro(<< leaf.label << ": " << e.what());
-          return 0;
-        }
-        catch (const md::Cancelled&)
-        {
-          this->CheckAbort();
-          return 1;
+          return result;
         }
       }
       entry.weights = md::MeanValueCoordinates(entry.hull, surfaces[b].points);
@@ -327,21 +320,15 @@ int vtkMuscleDeformation::RequestData(
   parameters.preserveVolume = this->PreserveVolume;
   parameters.dynamicIntersections = this->DynamicIntersections;
   std::vector<md::DeformationResult> results;
-  try
+  int result = 1;
+  if (!mdvtk::CallCore(this, "", [&] {
+        const std::vector<md::Obstacle> obstacles = this->DynamicIntersections
+          ? md::BuildObstacles(obstacleNames, obstacleMeshes)
+          : std::vector<md::Obstacle>{};
+        results = md::DeformMuscles(toDeform, obstacles, parameters, mdvtk::ProgressOrCancel(this, 0.3, 0.7));
+      }, result))
   {
-    const std::vector<md::Obstacle> obstacles = this->DynamicIntersections
-      ? md::BuildObstacles(obstacleNames, obstacleMeshes)
-      : std::vector<md::Obstacle>{};
-    results = md::DeformMuscles(toDeform, obstacles, parameters, mdvtk::ProgressOrCancel(this, 0.3, 0.7));
-  }
-  catch (const md::InputError& e)
-  {
-    vtkErrorMacro(<< e.what());
-    return 0;
-  }
-  catch (const md::Cancelled&)
-  {
-    return 1; // stopped by the user: the executive empties the output
+    return result;
   }
   const double seconds = SecondsSince(start);
 
@@ -361,12 +348,7 @@ int vtkMuscleDeformation::RequestData(
     auto output = vtkSmartPointer<vtkPolyData>::New();
     output->ShallowCopy(muscles[b].data);
     output->SetPoints(mdvtk::ToVtkPoints(points));
-    vtkNew<vtkDoubleArray> displacementArray;
-    displacementArray->SetName("Displacement");
-    displacementArray->SetNumberOfComponents(3);
-    displacementArray->SetNumberOfTuples(displacement.rows());
-    std::copy(displacement.data(), displacement.data() + displacement.size(), displacementArray->GetPointer(0));
-    output->GetPointData()->AddArray(displacementArray);
+    output->GetPointData()->AddArray(mdvtk::ToVtkArray("Displacement", displacement));
     vtkNew<vtkFieldData> fieldData;
     fieldData->DeepCopy(muscles[b].data->GetFieldData());
     mdvtk::AddFieldValue(fieldData, "VolumeChangePercent", r.volumeChangePercent);

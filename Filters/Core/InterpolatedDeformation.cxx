@@ -493,12 +493,12 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
   const std::function<void(double)>& progress)
 {
   // Everything in the muscles' local frame, lengths given in data units with it.
-  std::vector<const Points*> muscleParts;
+  std::vector<const Points*> restPoints;
   for (const MuscleMotion& m : muscles)
   {
-    muscleParts.push_back(&m.muscle.points);
+    restPoints.push_back(&m.muscle.points);
   }
-  const LocalFrame frame = LocalFrame::Around(muscleParts);
+  const LocalFrame frame = LocalFrame::Around(restPoints);
   std::vector<MuscleMotion> localMuscles = muscles;
   for (MuscleMotion& m : localMuscles)
   {
@@ -520,27 +520,24 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
   local.deformation.convergenceTolerance = frame.LengthToLocal(parameters.deformation.convergenceTolerance);
 
   InterpolationResult result = DeformInLocalFrame(localMuscles, localBones, local, progress);
-  ResultToWorld(frame, result);
-  for (size_t m = 0; m < muscles.size(); ++m)
-  {
-    for (size_t j = 0; j < result.points.size(); ++j)
-    {
-      if (j == 0 || result.zeroMotion)
-      {
-        result.points[j][m] = muscles[m].muscle.points; // the input itself, not its round trip
-      }
-    }
-  }
+  ResultToWorld(frame, restPoints, result);
   return result;
 }
 
-void ResultToWorld(const LocalFrame& frame, InterpolationResult& result)
+void ResultToWorld(const LocalFrame& frame, const std::vector<const Points*>& restPoints, InterpolationResult& result)
 {
   for (size_t j = 0; j < result.points.size(); ++j)
   {
     for (size_t m = 0; m < result.points[j].size(); ++m)
     {
-      frame.ToWorld(result.points[j][m]);
+      if (j == 0 || result.zeroMotion)
+      {
+        result.points[j][m] = *restPoints[m]; // the input itself, not its round trip
+      }
+      else
+      {
+        frame.ToWorld(result.points[j][m]);
+      }
       MuscleStepMeasures& s = result.measures[j][m];
       s.maxNewPenetrationDepth = frame.LengthToWorld(s.maxNewPenetrationDepth);
       s.maxNewBonePenetrationDepth = frame.LengthToWorld(s.maxNewBonePenetrationDepth);

@@ -144,6 +144,7 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
   const std::function<void(double)>& progress = {});
 
 /// Points and lengths of a result computed in `frame` (for callers that bring their input into
-/// the frame themselves, e.g. to match action lines there) back in world coordinates.
-void ResultToWorld(const LocalFrame& frame, InterpolationResult& result);
+/// the frame themselves, e.g. to match action lines there) back in world coordinates. Step 0 (and
+/// every step of a zero motion) becomes `restPoints[m]`, the input itself, not its round trip.
+void ResultToWorld(const LocalFrame& frame, const std::vector<const Points*>& restPoints, InterpolationResult& result);
 }

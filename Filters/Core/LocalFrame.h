@@ -36,6 +36,5 @@ struct LocalFrame
   double LengthToLocal(double length) const { return length / this->unit; }
   double LengthToWorld(double length) const { return length * this->unit; }
   double VolumeToWorld(double volume) const { return volume * this->unit * this->unit * this->unit; }
-  bool IsIdentity() const { return this->unit == 1.0 && this->origin.isZero(0.0); }
 };
 }

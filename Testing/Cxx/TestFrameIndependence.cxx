@@ -84,7 +84,6 @@ vtkSmartPointer<vtkDataObject> Placed(vtkDataObject* data, const Placement* p)
     };
     if (out->GetPoints())
     {
-      out->GetPoints()->SetDataTypeToDouble();
       vtkNew<vtkPoints> points;
       points->SetDataTypeToDouble();
       points->DeepCopy(in->GetPoints());
