@@ -3,6 +3,8 @@
 #include <vtkStreamingDemandDrivenPipeline.h>
 
 #include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkUnsignedCharArray.h>
 #include <vtkCellArrayIterator.h>
 #include <vtkCompositeDataSet.h>
 #include <vtkDataObjectTreeIterator.h>
@@ -23,6 +25,7 @@
 #include <vtkTriangleFilter.h>
 
 #include <map>
+#include <sstream>
 #include <optional>
 #include <set>
 
@@ -353,8 +356,80 @@ void CopyTimeSteps(vtkInformation* from, vtkInformation* to)
   }
 }
 
-void AssignLeaves(
-  vtkDataObject* input, vtkDataObject* output, const std::vector<vtkSmartPointer<vtkPolyData>>& results)
+namespace
+{
+void MarkRole(vtkPolyData* leaf, Role role, size_t index)
+{
+  vtkCellData* cells = leaf->GetCellData();
+  const int value = role == Role::Muscle ? static_cast<int>(Role::Muscle) + static_cast<int>(index % MuscleShades)
+                                         : static_cast<int>(role);
+  auto array = vtkSmartPointer<vtkUnsignedCharArray>::New();
+  array->SetName(RoleArrayName);
+  array->SetNumberOfTuples(leaf->GetNumberOfCells());
+  array->Fill(value);
+  cells->AddArray(array);
+  if (!cells->GetScalars() && !leaf->GetPointData()->GetScalars())
+  {
+    cells->SetActiveScalars(RoleArrayName);
+  }
+}
+}
+
+void MarkRoles(vtkDataObject* data, Role role)
+{
+  if (role == Role::AsGiven)
+  {
+    return;
+  }
+  if (auto* polyData = vtkPolyData::SafeDownCast(data))
+  {
+    MarkRole(polyData, role, 0);
+  }
+  else if (auto* tree = vtkMultiBlockDataSet::SafeDownCast(data))
+  {
+    size_t index = 0;
+    ForEachLeaf(tree, [&](vtkDataObjectTreeIterator* it) {
+      if (auto* leaf = vtkPolyData::SafeDownCast(it->GetCurrentDataObject()))
+      {
+        MarkRole(leaf, role, index);
+      }
+      ++index;
+    });
+  }
+}
+
+std::string DefaultDisplaySettings()
+{
+  // Muscle shades that tell neighbours apart and still read as muscle; bone ivory; action
+  // lines a blue that stands out against both.
+  const double muscles[MuscleShades][3] = { { 0.78, 0.24, 0.22 }, { 0.91, 0.55, 0.47 }, { 0.60, 0.13, 0.16 },
+    { 0.85, 0.42, 0.27 }, { 0.84, 0.35, 0.46 }, { 0.68, 0.31, 0.22 }, { 0.95, 0.67, 0.60 }, { 0.72, 0.18, 0.32 } };
+  const double bone[3] = { 0.89, 0.85, 0.76 };
+  const double line[3] = { 0.10, 0.35, 0.85 };
+  const double hull[3] = { 0.20, 0.62, 0.50 };
+  std::ostringstream annotations, colours;
+  auto add = [&](int value, const std::string& text, const double* rgb) {
+    annotations << (annotations.tellp() > 0 ? ", " : "") << '"' << value << "\", \"" << text << '"';
+    colours << (colours.tellp() > 0 ? ", " : "") << rgb[0] << ", " << rgb[1] << ", " << rgb[2];
+  };
+  add(static_cast<int>(Role::Bone), "Bone", bone);
+  for (int k = 0; k < MuscleShades; ++k)
+  {
+    add(static_cast<int>(Role::Muscle) + k, "Muscle " + std::to_string(k + 1), muscles[k]);
+  }
+  add(static_cast<int>(Role::ActionLine), "Action line", line);
+  add(static_cast<int>(Role::Hull), "Hull", hull);
+  std::ostringstream json;
+  json << "{ \"array_lookup_tables\": { \"" << RoleArrayName << "\": { \"PVLookupTable\": { "
+       << "\"IndexedLookup\": 1, \"AnnotationsInitialized\": 1, "
+       << "\"Annotations\": [" << annotations.str() << "], \"IndexedColors\": [" << colours.str() << "] } } }, "
+       << "\"representations\": { \"" << ActionLinesRepresentation << "\": { "
+       << "\"LineWidth\": 4, \"RenderLinesAsTubes\": 1 } } }";
+  return json.str();
+}
+
+void AssignLeaves(vtkDataObject* input, vtkDataObject* output,
+  const std::vector<vtkSmartPointer<vtkPolyData>>& results, Role role)
 {
   if (auto* polyData = vtkPolyData::SafeDownCast(output))
   {
@@ -362,6 +437,7 @@ void AssignLeaves(
     {
       polyData->ShallowCopy(results.front());
     }
+    MarkRoles(output, role);
     return;
   }
   auto* inTree = vtkMultiBlockDataSet::SafeDownCast(input);
@@ -379,6 +455,7 @@ void AssignLeaves(
     }
     ++index;
   });
+  MarkRoles(output, role);
 }
 
 Points ToPoints(vtkDataArray* array)

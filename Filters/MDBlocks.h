@@ -52,11 +52,39 @@ bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vect
 bool PairLeaves(vtkObject* reporter, const std::vector<Leaf>& a, const std::string& nameA,
   const std::vector<Leaf>& b, const std::string& nameB, std::vector<size_t>& partner, std::string& error);
 
+/// What a piece of the model is. The filters write it as cell array "Role" on their outputs (the
+/// active scalars, unless the data brings its own), and the plugin registers a categorical colour
+/// map for that array (RoleColourSettings): ParaView then shows bones in bone colour, muscles in
+/// muscle shades and action lines in blue without any setting, in the GUI and in pvpython.
+enum class Role : unsigned char
+{
+  Bone = 0,
+  Muscle = 1, ///< the muscles take the values 1 ... MuscleShades in turn, by block
+  ActionLine = 9,
+  Hull = 10,
+  AsGiven = 255, ///< keep the input's Role, add none (filters that move whatever they are given)
+};
+constexpr int MuscleShades = 8;
+constexpr const char* RoleArrayName = "Role";
+
+/// Writes `role` as the cell array Role of every polydata leaf of `data` (in leaf order: muscle
+/// k gets shade k modulo MuscleShades), the active cell scalars unless the leaf has other active
+/// scalars. Role::AsGiven leaves `data` as it is.
+void MarkRoles(vtkDataObject* data, Role role);
+
+/// The representation proxy (ServerManagerXML) the filters ask for to show action lines.
+constexpr const char* ActionLinesRepresentation = "MuscleDeformationActionLinesRepresentation";
+
+/// The plugin's display defaults as vtkSMSettings JSON, for the plugin to register when it loads:
+/// the colour map of array Role (categories with names) and tubes for ActionLinesRepresentation.
+std::string DefaultDisplaySettings();
+
 /// Puts one result per leaf of `input` into `output`, which is of the same
 /// type as `input` (see vtkPassInputTypeAlgorithm): for a multiblock input the
-/// output gets the input's structure and block names.
+/// output gets the input's structure and block names. The results then get `role` (MarkRoles);
+/// they must be the filter's own objects, not the input's.
 void AssignLeaves(vtkDataObject* input, vtkDataObject* output,
-  const std::vector<vtkSmartPointer<vtkPolyData>>& results);
+  const std::vector<vtkSmartPointer<vtkPolyData>>& results, Role role);
 
 /// Adds a one-value array to field data (a double, or an int for counts).
 void AddFieldValue(vtkFieldData* fieldData, const char* name, double value);

@@ -180,9 +180,11 @@ int vtkActionLineGrouping::RequestData(
     }
   };
   build(paths, false, vtkMultiBlockDataSet::GetData(outputVector, 0));
+  mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, 0), mdvtk::Role::ActionLine);
   if (haveCurrent)
   {
     build(current, true, vtkMultiBlockDataSet::GetData(outputVector, 1));
+    mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, 1), mdvtk::Role::ActionLine);
   }
   return 1;
 }

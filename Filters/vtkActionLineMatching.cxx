@@ -173,8 +173,8 @@ int vtkActionLineMatching::RequestData(
     currentResults[partner[b]] = currentOut;
   }
 
-  mdvtk::AssignLeaves(restInput, vtkDataObject::GetData(outputVector, 0), restResults);
-  mdvtk::AssignLeaves(currentInput, vtkDataObject::GetData(outputVector, 1), currentResults);
+  mdvtk::AssignLeaves(restInput, vtkDataObject::GetData(outputVector, 0), restResults, mdvtk::Role::ActionLine);
+  mdvtk::AssignLeaves(currentInput, vtkDataObject::GetData(outputVector, 1), currentResults, mdvtk::Role::ActionLine);
   return 1;
 }
 

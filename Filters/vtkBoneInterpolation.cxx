@@ -5,6 +5,7 @@
 
 #include <vtkAlgorithmOutput.h>
 #include <vtkCellArray.h>
+#include <vtkCellData.h>
 #include <vtkDataArray.h>
 #include <vtkFieldData.h>
 #include <vtkIdTypeArray.h>
@@ -287,7 +288,21 @@ int vtkBoneInterpolation::RequestData(
     results[b] = output;
   }
   vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
-  mdvtk::AssignLeaves(restInput, output, results);
+  // What it moves keeps its role; unmarked input is bones, or action lines when it has no faces.
+  mdvtk::Role role = mdvtk::Role::Bone;
+  for (const Pose& pose : poses)
+  {
+    if (pose.restData && pose.restData->GetCellData()->GetArray(mdvtk::RoleArrayName))
+    {
+      role = mdvtk::Role::AsGiven;
+      break;
+    }
+    if (pose.restData && pose.restData->GetNumberOfPolys() == 0 && pose.restData->GetNumberOfLines() > 0)
+    {
+      role = mdvtk::Role::ActionLine;
+    }
+  }
+  mdvtk::AssignLeaves(restInput, output, results, role);
   output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), static_cast<double>(step));
   return 1;
 }

@@ -117,7 +117,7 @@ int vtkHullDecimation::RequestData(
     }
     results[b] = output;
   }
-  mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), results);
+  mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), results, mdvtk::Role::Hull);
   return 1;
 }
 

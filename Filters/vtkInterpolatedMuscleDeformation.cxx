@@ -96,9 +96,15 @@ bool ReadBones(vtkObject* reporter, vtkDataObject* rest, vtkDataObject* current,
 
 vtkInterpolatedMuscleDeformation::vtkInterpolatedMuscleDeformation()
   : Computed(std::make_unique<Cache>())
+  , KeptRest(std::make_unique<md::RestMappingCache>())
 {
   this->SetNumberOfInputPorts(5);
   this->SetNumberOfOutputPorts(4);
+}
+
+int vtkInterpolatedMuscleDeformation::GetHullBuildCount() const
+{
+  return this->KeptRest->hullBuildCount;
 }
 
 int vtkInterpolatedMuscleDeformation::FillOutputPortInformation(int port, vtkInformation* info)
@@ -354,7 +360,8 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     parameters.hull.cancelled = mdvtk::AbortRequested(this);
     int result = 1;
     if (!mdvtk::CallCore(this, "", [&] {
-          cache.result = md::DeformByInterpolation(motions, bones, parameters, mdvtk::ProgressOrCancel(this));
+          cache.result = md::DeformByInterpolation(
+            motions, bones, parameters, mdvtk::ProgressOrCancel(this), this->KeptRest.get());
         }, result))
     {
       cache = Cache{};
@@ -389,6 +396,17 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     const double time = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
     step = static_cast<int>(std::lround(std::clamp(time, 0.0, static_cast<double>(steps))));
   }
+  // Time j is step j of N: after N changes the same time is another point of the motion. Said,
+  // not silent, when the view stays on the time it showed before the change.
+  if (this->ShownNumberOfSteps > 0 && steps != this->ShownNumberOfSteps && step == this->ShownStep && step != 0)
+  {
+    vtkWarningMacro(<< "NumberOfSteps is now " << steps << ": time " << step << " shows step " << step << " of "
+                    << steps << " (" << 100.0 * step / steps << " % of the motion), where it showed step " << step
+                    << " of " << this->ShownNumberOfSteps << " (" << 100.0 * step / this->ShownNumberOfSteps
+                    << " %); time " << steps << " is the current pose");
+  }
+  this->ShownNumberOfSteps = steps;
+  this->ShownStep = step;
   std::vector<vtkSmartPointer<vtkPolyData>> outputs(muscles.size());
   std::vector<std::string> names;                                  // Measures rows
   std::vector<std::pair<std::string, std::vector<double>>> columns; // Measures columns
@@ -443,7 +461,7 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     output->SetFieldData(fieldData);
     outputs[b] = output;
   }
-  mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), outputs);
+  mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), outputs, mdvtk::Role::Muscle);
 
   // Output 3: the same measures as a table, one row per muscle, for a spreadsheet view.
   vtkTable* table = vtkTable::GetData(outputVector, 3);
@@ -484,7 +502,7 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     bone->SetPoints(mdvtk::ToVtkPoints(points));
     boneOutputs[cache.boneLeaf[k]] = bone;
   }
-  mdvtk::AssignLeaves(inputs[1], vtkDataObject::GetData(outputVector, 1), boneOutputs);
+  mdvtk::AssignLeaves(inputs[1], vtkDataObject::GetData(outputVector, 1), boneOutputs, mdvtk::Role::Bone);
   std::vector<vtkSmartPointer<vtkPolyData>> lineOutputs(lineLeaves.size());
   for (size_t m = 0; m < cache.lineMotions.size(); ++m)
   {
@@ -496,7 +514,7 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     }
     lineOutputs[cache.lineLeaf[m]] = mdvtk::ToPolyLines(lines);
   }
-  mdvtk::AssignLeaves(inputs[3], vtkDataObject::GetData(outputVector, 2), lineOutputs);
+  mdvtk::AssignLeaves(inputs[3], vtkDataObject::GetData(outputVector, 2), lineOutputs, mdvtk::Role::ActionLine);
   for (int p = 0; p < this->GetNumberOfOutputPorts(); ++p)
   {
     vtkDataObject::GetData(outputVector, p)->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), static_cast<double>(step));
@@ -521,4 +539,5 @@ void vtkInterpolatedMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "BoneContactWeight: " << this->BoneContactWeight << "\n";
   os << indent << "RefitRegularisation: " << this->RefitRegularisation << "\n";
   os << indent << "ResolvedNumberOfSteps: " << this->ResolvedNumberOfSteps << "\n";
+  os << indent << "HullBuildCount: " << this->GetHullBuildCount() << "\n";
 }

@@ -45,6 +45,11 @@
 
 #include <memory>
 
+namespace md
+{
+struct RestMappingCache;
+}
+
 class MUSCLEDEFORMATIONFILTERS_EXPORT vtkInterpolatedMuscleDeformation : public vtkPassInputTypeAlgorithm
 {
 public:
@@ -112,6 +117,13 @@ public:
   /// N as resolved by the last RequestInformation.
   vtkGetMacro(ResolvedNumberOfSteps, int);
 
+  /// Rest-pose hulls built so far. A muscle's rest-pose hull and its mean value coordinates depend
+  /// on its rest-pose surface and HullTargetNumberOfPoints only, so they are kept: another number
+  /// of steps, other bones or action lines, or another deformation setting reuses them; a changed
+  /// muscle or hull size rebuilds that muscle's. (HullMode Rebuild's hulls of later steps are
+  /// built anew on every run and not counted.)
+  int GetHullBuildCount() const;
+
 protected:
   vtkInterpolatedMuscleDeformation();
   ~vtkInterpolatedMuscleDeformation() override;
@@ -135,10 +147,13 @@ protected:
   int HullTargetNumberOfPoints = 250;
   double RefitRegularisation = 1e-3;
   int ResolvedNumberOfSteps = 4;
+  int ShownNumberOfSteps = 0; // N and step of the last output, to say when N changes under a time
+  int ShownStep = 0;
 
 private:
   vtkInterpolatedMuscleDeformation(const vtkInterpolatedMuscleDeformation&) = delete;
   void operator=(const vtkInterpolatedMuscleDeformation&) = delete;
   struct Cache;
   std::unique_ptr<Cache> Computed;
+  std::unique_ptr<md::RestMappingCache> KeptRest;
 };

@@ -232,7 +232,7 @@ int vtkIntersectionResolve::RequestData(
     output->SetFieldData(fieldData);
     outputs[b] = output;
   }
-  mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), outputs);
+  mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), outputs, mdvtk::Role::Muscle);
   this->UpdateProgress(1.0);
   return 1;
 }

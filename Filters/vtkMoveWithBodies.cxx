@@ -141,7 +141,7 @@ int vtkMoveWithBodies::RequestData(
     vtkErrorMacro(<< "BodyOfSurface: " << e.what());
     return 0;
   }
-  mdvtk::AssignLeaves(input, output, results);
+  mdvtk::AssignLeaves(input, output, results, mdvtk::Role::AsGiven); // moves whatever it is given
   return 1;
 }
 

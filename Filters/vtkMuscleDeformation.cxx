@@ -81,14 +81,9 @@ struct KeptMuscle
   bool Holds(const md::TriangleMesh& muscle, const md::LocalFrame& now, bool given, const md::TriangleMesh* givenHull,
     int targetNumberOfPoints) const
   {
-    return this->weights.size() > 0 && this->hullGiven == given && Same(this->surface, muscle) &&
+    return this->weights.size() > 0 && this->hullGiven == given && md::SameMesh(this->surface, muscle) &&
       this->frame.origin == now.origin && this->frame.unit == now.unit &&
-      (given ? Same(this->hull, *givenHull) : this->target == targetNumberOfPoints);
-  }
-  static bool Same(const md::TriangleMesh& a, const md::TriangleMesh& b)
-  {
-    return a.points.rows() == b.points.rows() && a.triangles.rows() == b.triangles.rows() &&
-      a.points == b.points && a.triangles == b.triangles;
+      (given ? md::SameMesh(this->hull, *givenHull) : this->target == targetNumberOfPoints);
   }
 };
 }
@@ -366,7 +361,7 @@ int vtkMuscleDeformation::RequestData(
     output->SetFieldData(fieldData);
     outputs[b] = output;
   }
-  mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), outputs);
+  mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), outputs, mdvtk::Role::Muscle);
   this->UpdateProgress(1.0);
   return 1;
 }

@@ -95,6 +95,15 @@ int vtkMusculoskeletalPhantom::RequestData(
     AddBlock(output(BONES_CURRENT), bone.name,
       mdvtk::ToPolyData(md::TriangleMesh{ bone.currentPoints, bone.rest.triangles }));
   }
+  mdvtk::MarkRoles(output(MUSCLES), mdvtk::Role::Muscle);
+  for (int port : { BONES_REST, BONES_CURRENT })
+  {
+    mdvtk::MarkRoles(output(port), mdvtk::Role::Bone);
+  }
+  for (int port : { ACTION_LINES_REST, ACTION_LINES_CURRENT })
+  {
+    mdvtk::MarkRoles(output(port), mdvtk::Role::ActionLine);
+  }
   return 1;
 }
 

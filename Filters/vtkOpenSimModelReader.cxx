@@ -465,6 +465,14 @@ int vtkOpenSimModelReader::RequestData(
   bodies(in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, BODIES_REST));
   paths(q, poses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS));
   paths(in.rest, in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS_REST));
+  for (int port : { BODIES, BODIES_REST })
+  {
+    mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, port), mdvtk::Role::Bone);
+  }
+  for (int port : { MUSCLE_PATHS, MUSCLE_PATHS_REST })
+  {
+    mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, port), mdvtk::Role::ActionLine);
+  }
 
   vtkMultiBlockDataSet* wraps = vtkMultiBlockDataSet::GetData(outputVector, WRAP_OBJECTS);
   for (size_t w = 0; w < model.wrapObjects.size(); ++w)

@@ -25,14 +25,22 @@ double SecondsSince(Clock::time_point start)
 
 /// The hulls of the muscles with their points at `points[m]` (the muscles'
 /// triangles), built in parallel, the largest muscle first so that the cores
-/// finish together. A hull that cannot be built is left empty and its muscle
+/// finish together; with `wanted`, only those of the muscles it marks (the others are left
+/// empty). A hull that cannot be built is left empty and its muscle
 /// gets the message in `errors`; `seconds` receives each build's time.
 std::vector<TriangleMesh> BuildHulls(const std::vector<MuscleMotion>& muscles, const std::vector<const Points*>& points,
-  const HullParameters& parameters, std::vector<std::string>& errors, std::vector<double>& seconds)
+  const HullParameters& parameters, std::vector<std::string>& errors, std::vector<double>& seconds,
+  const std::vector<char>* wanted = nullptr)
 {
   const size_t count = muscles.size();
-  std::vector<size_t> order(count);
-  std::iota(order.begin(), order.end(), 0);
+  std::vector<size_t> order;
+  for (size_t m = 0; m < count; ++m)
+  {
+    if (!wanted || (*wanted)[m])
+    {
+      order.push_back(m);
+    }
+  }
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
     return muscles[a].muscle.triangles.rows() > muscles[b].muscle.triangles.rows();
   });
@@ -41,7 +49,7 @@ std::vector<TriangleMesh> BuildHulls(const std::vector<MuscleMotion>& muscles, c
   seconds.assign(count, 0.0);
   std::vector<char> cancelled(count, 0); // no exception may leave a parallel region
 #pragma omp parallel for schedule(dynamic, 1)
-  for (int k = 0; k < static_cast<int>(count); ++k)
+  for (int k = 0; k < static_cast<int>(order.size()); ++k)
   {
     const size_t m = order[k];
     const auto start = Clock::now();
@@ -203,7 +211,7 @@ namespace
 /// DeformByInterpolation on input already in its local frame.
 InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters,
-  const std::function<void(double)>& progress)
+  const std::function<void(double)>& progress, RestMappingCache* kept)
 {
   const auto start = Clock::now();
   auto report = [&](double fraction) {
@@ -267,15 +275,43 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
     }
   }
 
-  // The rest-pose hulls (the muscles in parallel) and mappings (each in parallel inside).
+  // The rest-pose hulls (the muscles in parallel) and mappings (each in parallel inside), or
+  // those an earlier run left in `kept` where they still hold.
+  RestMappingCache scratch;
+  RestMappingCache& rest = kept ? *kept : scratch;
+  rest.muscles.resize(count);
   std::vector<const Points*> restPointers(count);
+  std::vector<char> build(count, 0);
   for (size_t m = 0; m < count; ++m)
   {
+    const RestMappingCache::Entry& entry = rest.muscles[m];
     restPointers[m] = &muscles[m].muscle.points;
+    build[m] = entry.weights.size() == 0 || !SameMesh(entry.surface, muscles[m].muscle) ||
+      !entry.hull.SameHullAs(parameters.hull);
   }
   std::vector<std::string> errors;
-  std::vector<TriangleMesh> hulls = BuildHulls(muscles, restPointers, parameters.hull, errors, result.restHullSeconds);
-  std::vector<WeightMatrix> weights(count);
+  std::vector<TriangleMesh> built =
+    BuildHulls(muscles, restPointers, parameters.hull, errors, result.restHullSeconds, &build);
+  for (size_t m = 0; m < count; ++m)
+  {
+    RestMappingCache::Entry& entry = rest.muscles[m];
+    if (build[m])
+    {
+      entry = RestMappingCache::Entry{};
+    }
+    if (build[m] && errors[m].empty())
+    {
+      const auto mappingStart = Clock::now();
+      entry.surface = muscles[m].muscle;
+      entry.hull = parameters.hull;
+      entry.hull.cancelled = nullptr;
+      entry.restHull = std::move(built[m]);
+      entry.weights = MeanValueCoordinates(entry.restHull, muscles[m].muscle.points);
+      ++rest.hullBuildCount;
+      result.restHullSeconds[m] += SecondsSince(mappingStart);
+    }
+    report(0.15 * (m + 1) / count);
+  }
   for (const std::string& error : errors)
   {
     if (!error.empty())
@@ -283,21 +319,26 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       throw InputError(error);
     }
   }
+  // Rebuild replaces hulls and weights; Refit moves only the hull's points.
+  std::vector<TriangleMesh> hulls(count);
+  std::vector<const WeightMatrix*> weights(count);
+  std::vector<WeightMatrix> rebuiltWeights(count);
   std::vector<std::unique_ptr<HullRefitter>> refitters(count);
   std::vector<Points> details(count);
   std::vector<double> restVolumes(count);
   for (size_t m = 0; m < count; ++m)
   {
     const auto mappingStart = Clock::now();
-    weights[m] = MeanValueCoordinates(hulls[m], muscles[m].muscle.points);
-    details[m] = muscles[m].muscle.points - weights[m] * hulls[m].points;
+    hulls[m] = rest.muscles[m].restHull;
+    weights[m] = &rest.muscles[m].weights;
+    details[m] = muscles[m].muscle.points - *weights[m] * hulls[m].points;
     if (parameters.hullMode == HullMode::Refit)
     {
-      refitters[m] = std::make_unique<HullRefitter>(weights[m], hulls[m], parameters.refitRegularisation);
+      refitters[m] = std::make_unique<HullRefitter>(*weights[m], hulls[m], parameters.refitRegularisation);
     }
     restVolumes[m] = EnclosedVolume(muscles[m].muscle.points, muscles[m].muscle.triangles);
     result.restHullSeconds[m] += SecondsSince(mappingStart);
-    report(0.2 * (m + 1) / count);
+    report(0.15 + 0.05 * (m + 1) / count);
   }
 
   // The bones' hierarchies, built once in the rest pose and refitted to the
@@ -372,8 +413,9 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
         if (failures[m].empty())
         {
           hulls[m] = std::move(rebuilt[m]);
-          weights[m] = MeanValueCoordinates(hulls[m], current[m].points);
-          details[m] = current[m].points - weights[m] * hulls[m].points;
+          rebuiltWeights[m] = MeanValueCoordinates(hulls[m], current[m].points);
+          weights[m] = &rebuiltWeights[m];
+          details[m] = current[m].points - *weights[m] * hulls[m].points;
         }
         else
         {
@@ -390,7 +432,7 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       d.name = muscles[m].name;
       d.muscle = &current[m];
       d.hull = &hulls[m];
-      d.weights = &weights[m];
+      d.weights = weights[m];
       d.detail = &details[m];
       d.targetVolume = restVolumes[m];
       d.reference = &muscles[m].muscle.points; // folds an earlier step left are undone too
@@ -444,7 +486,7 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       hulls[m].points = parameters.hullMode == HullMode::Refit
         ? refitters[m]->Fit(next[m].points, deformed[m].hullPoints)
         : deformed[m].hullPoints;
-      details[m] = next[m].points - weights[m] * hulls[m].points;
+      details[m] = next[m].points - *weights[m] * hulls[m].points;
       RelaxDetail(muscles[m].muscle.triangles, parameters.detailRelaxation, details[m]);
       measures[m].hullSeconds += SecondsSince(hullStart);
     }
@@ -490,7 +532,7 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
 
 InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscles,
   const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters,
-  const std::function<void(double)>& progress)
+  const std::function<void(double)>& progress, RestMappingCache* kept)
 {
   // Everything in the muscles' local frame, lengths given in data units with it.
   std::vector<const Points*> restPoints;
@@ -519,7 +561,7 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
   local.maximumStepDisplacement = frame.LengthToLocal(parameters.maximumStepDisplacement);
   local.deformation.convergenceTolerance = frame.LengthToLocal(parameters.deformation.convergenceTolerance);
 
-  InterpolationResult result = DeformInLocalFrame(localMuscles, localBones, local, progress);
+  InterpolationResult result = DeformInLocalFrame(localMuscles, localBones, local, progress, kept);
   ResultToWorld(frame, restPoints, result);
   return result;
 }

@@ -132,16 +132,35 @@ struct InterpolationResult
   std::vector<std::string> warnings;
 };
 
+/// The rest-pose hull of every muscle and the mean value coordinates of its points in it, kept
+/// between runs of DeformByInterpolation by a caller that runs the method again (another number
+/// of steps, other weights or tolerances): they depend on the rest-pose surface and the hull
+/// parameters alone, and the hull is most of a first run's time. A muscle whose surface or hull
+/// parameters changed gets a new hull; the entries follow the order of the muscles.
+struct RestMappingCache
+{
+  struct Entry
+  {
+    TriangleMesh surface;    ///< the rest pose it was made from (in the method's local frame)
+    HullParameters hull;     ///< and the hull parameters
+    TriangleMesh restHull;
+    WeightMatrix weights;
+  };
+  std::vector<Entry> muscles;
+  int hullBuildCount = 0; ///< rest-pose hulls built so far (not counting HullMode::Rebuild's)
+};
+
 /// Number of steps: `parameters.numberOfSteps`, or when 0 enough steps that no
 /// bone point moves more than `parameters.maximumStepDisplacement` in one.
 int ResolveNumberOfSteps(const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters);
 
 /// Runs the whole method, in the muscles' LocalFrame (lengths in `parameters` and in the result
 /// in the data's units). Throws InputError naming the muscle or bone for input it cannot use.
-/// `progress` (optional) receives fractions in [0, 1].
+/// `progress` (optional) receives fractions in [0, 1]. `kept` (optional) holds the rest-pose hulls
+/// and mappings of an earlier run, used where they still hold and updated.
 InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscles,
   const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters,
-  const std::function<void(double)>& progress = {});
+  const std::function<void(double)>& progress = {}, RestMappingCache* kept = nullptr);
 
 /// Points and lengths of a result computed in `frame` (for callers that bring their input into
 /// the frame themselves, e.g. to match action lines there) back in world coordinates. Step 0 (and

@@ -21,6 +21,13 @@ struct TriangleMesh
   Triangles triangles;
 };
 
+/// True when both meshes have the same points and triangles, bit for bit.
+inline bool SameMesh(const TriangleMesh& a, const TriangleMesh& b)
+{
+  return a.points.rows() == b.points.rows() && a.triangles.rows() == b.triangles.rows() && a.points == b.points &&
+    a.triangles == b.triangles;
+}
+
 /// Thrown when input data cannot be used; the message says what is wrong so
 /// that the VTK adapters can report it together with the name of the input.
 class InputError : public std::runtime_error

@@ -327,9 +327,10 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
     }
     if (!anchored.empty())
     {
-      s.result.warnings.push_back("part of muscle '" + m.name + "' (" + std::to_string(anchored.size()) +
-        " hull points) is a separate piece that no action line passes through: it follows its nearest "
-        "action-line segment");
+      s.result.warnings.push_back("part of muscle '" + m.name + "' lies apart from the rest, and no action line " +
+        "passes through it (" + std::to_string(anchored.size()) + " of the " + std::to_string(hull.points.rows()) +
+        " points of its coarse hull): it moves with the nearest action-line segment; give that part an " +
+        "action line of its own if it should move otherwise");
     }
   }
 

@@ -23,6 +23,14 @@ struct HullParameters
   /// Asked every few hundred collapses; when it returns true the build throws Cancelled. May be
   /// called from worker threads.
   std::function<bool()> cancelled;
+
+  /// True when `other` builds the same hull (everything but `cancelled` equal).
+  bool SameHullAs(const HullParameters& other) const
+  {
+    return targetNumberOfPoints == other.targetNumberOfPoints && minimumAngleDegrees == other.minimumAngleDegrees &&
+      maximumNormalDeviationDegrees == other.maximumNormalDeviationDegrees &&
+      maximumFoldAngleDegrees == other.maximumFoldAngleDegrees;
+  }
 };
 
 struct HullResult

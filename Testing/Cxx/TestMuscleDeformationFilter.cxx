@@ -158,6 +158,116 @@ TEST(MuscleDeformationFilter, HullsAreKeptAcrossPosesAndSettingsThatDoNotTouchTh
   EXPECT_NE(vtkPolyData::SafeDownCast(vtkMultiBlockDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetBlock(1)), nullptr);
 }
 
+TEST(InterpolatedMuscleDeformationFilter, RestHullsAreKeptAcrossSettingsThatDoNotTouchThem)
+{
+  // Every property change recomputed everything, hulls included; the rest-pose hulls and
+  // mappings depend on the rest-pose muscles and the hull size only.
+  PhantomPipeline pipeline;
+  vtkNew<vtkInterpolatedMuscleDeformation> f;
+  pipeline.Connect(f);
+  f->SetNumberOfSteps(2);
+  f->Update();
+  ASSERT_EQ(f->GetHullBuildCount(), 3); // one per muscle
+
+  // Other steps, weights, a new current pose and the other hull mode: the same rest hulls.
+  f->SetNumberOfSteps(3);
+  f->Update();
+  f->SetBoneContactWeight(0.25);
+  f->SetConvergenceTolerance(0.005);
+  f->Update();
+  pipeline.phantom->SetFlexion(20); // moves the current pose only
+  f->Update();
+  f->SetHullMode(vtkInterpolatedMuscleDeformation::REBUILD);
+  f->Update();
+  f->SetHullMode(vtkInterpolatedMuscleDeformation::REFIT);
+  f->Update();
+  EXPECT_EQ(f->GetHullBuildCount(), 3);
+
+  // Kept hulls give exactly what a new filter builds for itself, at every step.
+  vtkNew<vtkInterpolatedMuscleDeformation> fresh;
+  pipeline.Connect(fresh);
+  fresh->SetNumberOfSteps(3);
+  fresh->SetBoneContactWeight(0.25);
+  fresh->SetConvergenceTolerance(0.005);
+  for (double step : { 1.0, 3.0 })
+  {
+    f->UpdateTimeStep(step);
+    fresh->UpdateTimeStep(step);
+    EXPECT_EQ(LargestDifference(f->GetOutputDataObject(0), fresh->GetOutputDataObject(0)), 0.0) << "step " << step;
+  }
+
+  // Another hull size rebuilds every hull.
+  f->SetHullTargetNumberOfPoints(90);
+  f->Update();
+  EXPECT_EQ(f->GetHullBuildCount(), 6);
+}
+
+/// Every progress value `f` reports in one update, in order.
+std::vector<double> ProgressOfOneUpdate(vtkAlgorithm* f)
+{
+  std::vector<double> seen;
+  vtkNew<vtkCallbackCommand> record;
+  record->SetClientData(&seen);
+  record->SetCallback([](vtkObject*, unsigned long, void* clientData, void* callData) {
+    static_cast<std::vector<double>*>(clientData)->push_back(*static_cast<double*>(callData));
+  });
+  const unsigned long observer = f->AddObserver(vtkCommand::ProgressEvent, record);
+  f->Modified();
+  f->Update();
+  f->RemoveObserver(observer);
+  return seen;
+}
+
+TEST(MuscleDeformationFilter, ProgressNeverGoesBackWithinARun)
+{
+  // The GUI's progress bar once jumped from 89 % back to 6 % within a filter's run.
+  PhantomPipeline pipeline;
+  vtkNew<vtkMuscleDeformation> pass;
+  pipeline.Connect(pass);
+  vtkNew<vtkInterpolatedMuscleDeformation> method;
+  pipeline.Connect(method);
+  method->SetNumberOfSteps(2);
+  method->SetHullMode(vtkInterpolatedMuscleDeformation::REBUILD); // hulls inside the steps too
+  for (vtkAlgorithm* f : { static_cast<vtkAlgorithm*>(pass), static_cast<vtkAlgorithm*>(method) })
+  {
+    const std::vector<double> seen = ProgressOfOneUpdate(f);
+    ASSERT_GT(seen.size(), 10u) << f->GetClassName();
+    for (size_t i = 1; i < seen.size(); ++i)
+    {
+      // The executive reports 0 when a run starts (RequestData of an output's time step).
+      if (seen[i] != 0.0)
+      {
+        EXPECT_GE(seen[i], seen[i - 1]) << f->GetClassName() << ", report " << i;
+      }
+    }
+    EXPECT_EQ(seen.back(), 1.0) << f->GetClassName();
+  }
+}
+
+TEST(InterpolatedMuscleDeformationFilter, SaysSoWhenANewNumberOfStepsChangesWhatTheTimeShows)
+{
+  // Time j is step j of N. The view stayed on time 2 after N went from 4 to 8, now a quarter of
+  // the motion instead of half, and nothing said so.
+  PhantomPipeline pipeline;
+  vtkNew<vtkInterpolatedMuscleDeformation> f;
+  pipeline.Connect(f);
+  f->SetNumberOfSteps(4);
+  f->UpdateTimeStep(2);
+  f->SetNumberOfSteps(8);
+  {
+    CapturedMessages messages;
+    f->UpdateTimeStep(2);
+    EXPECT_TRUE(messages.Contains("time 2 shows step 2 of 8 (25 % of the motion), where it showed step 2 of 4 (50 %)"))
+      << messages.Text();
+  }
+  {
+    CapturedMessages messages; // a new time, or the same N: nothing to say
+    f->UpdateTimeStep(4);
+    f->UpdateTimeStep(2);
+    EXPECT_FALSE(messages.Contains("NumberOfSteps is now")) << messages.Text();
+  }
+}
+
 TEST(MuscleDeformationFilter, AbortStopsTheRunWithAnEmptyOutputAndTheNextRunWorks)
 {
   // ParaView's cancel sets the filter's AbortExecute; here an observer does it once the

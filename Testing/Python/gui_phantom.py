@@ -23,12 +23,13 @@ def run():
         ActionLinesCurrent=simple.OutputPort(phantom, 4), NumberOfSteps=4)
     view = simple.GetActiveViewOrCreate("RenderView")
     view.OrientationAxesVisibility = 0
-    muscles = simple.Show(simple.OutputPort(method, 0), view)
-    bones = simple.Show(simple.OutputPort(method, 1), view)
-    for representation in (muscles, bones):
-        representation.ColorArrayName = ["POINTS", ""]
-    muscles.DiffuseColor = [0.8, 0.25, 0.2]
-    bones.DiffuseColor = [0.9, 0.88, 0.8]
+    # The plugin's default display, nothing set here: coloured by role (array Role, the plugin's
+    # categorical colour map), action lines as tubes.
+    shown = [simple.Show(simple.OutputPort(method, port), view) for port in (0, 1, 2)]
+    report["coloured_by_role"] = int(all(r.ColorArrayName[1] == "Role" and r.LookupTable is not None and
+                                         r.LookupTable.InterpretValuesAsCategories == 1 for r in shown))
+    report["action_lines_as_tubes"] = int(shown[2].RenderLinesAsTubes == 1 and shown[2].LineWidth > 1)
+    report["surfaces_not_tubes"] = int(shown[0].RenderLinesAsTubes == 0)
     scene = simple.GetAnimationScene()
     scene.UpdateAnimationUsingDataTimeSteps()
     times = list(method.TimestepValues)

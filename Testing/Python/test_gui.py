@@ -33,7 +33,8 @@ class Gui(unittest.TestCase):
         self.assertEqual(run.returncode, 0, run.stdout.decode(errors="replace")[-3000:])
         with open(os.path.join(output, "report.txt")) as f:
             report = dict(line.split() for line in f if line.strip())
-        self.assertEqual(report, {"plugin_loaded": "1", "time_steps": "5", "points_every_step": "1",
+        self.assertEqual(report, {"plugin_loaded": "1", "coloured_by_role": "1", "action_lines_as_tubes": "1",
+                                  "surfaces_not_tubes": "1", "time_steps": "5", "points_every_step": "1",
                                   "last_step": "4"})
         mdtesting.assert_matches_baseline(self, os.path.join(output, "GuiPhantomInterpolated.png"),
                                           "GuiPhantomInterpolated.png", output)
