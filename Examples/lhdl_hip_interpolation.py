@@ -13,7 +13,7 @@ femur) and by the one-pass method (one step, the same static resolution). Writes
 lhdl_current.png, lhdl_hulls.png, lhdl_step_<j>.png (bones and action lines),
 lhdl_method_step_<j>.png (the muscles at every step of the method), lhdl_one_pass_resolved.png,
 lhdl_deformed_one_pass.png (MuscleDeformation alone), the meshes as .vtp and figures.json (every
-measure of METHOD.md per muscle and step), and prints the comparison. Exits with code 77 (skipped)
+measure of docs/DESIGN.md per muscle and step), and prints the comparison. Exits with code 77 (skipped)
 when the data is absent.
 """
 import argparse

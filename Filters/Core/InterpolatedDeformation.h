@@ -1,4 +1,4 @@
-// The interpolation method (Hajkova & Kohout sec. 4.3; METHOD.md section 6):
+// The interpolation method (Hajkova & Kohout sec. 4.3; docs/DESIGN.md section 6):
 // the motion split into N steps, bones and matched action lines interpolated
 // at every step, each step deformed from the previous result (all muscles
 // together, obstacles for each other) and then statically resolved.
@@ -98,7 +98,7 @@ struct InterpolationParameters
   HullParameters hull;
 };
 
-/// The measures of one muscle after step j (METHOD.md, "Measures of quality").
+/// The measures of one muscle after step j (docs/DESIGN.md, "Measures").
 struct MuscleStepMeasures
 {
   double volumeChangePercent = 0;         ///< against the rest pose

@@ -1,5 +1,5 @@
 // One rest-pose -> current-pose pass of the muscle deformation (Kellnhofer &
-// Kohout, after Huang et al. 2006; METHOD.md sections 4 and 5 "Dynamic"):
+// Kohout, after Huang et al. 2006; docs/DESIGN.md section 4):
 // least squares on the hull points, shape rows (cotangent Laplacian with
 // rotated Laplacian coordinates) and action-line rows, the volume held by
 // corrected Gauss-Newton steps, the full mesh following by mean value

@@ -1,5 +1,5 @@
-// Static intersection resolution (Hajkova & Kohout sec. 3.1; METHOD.md
-// section 5 "Static"), once after a deformation, on the full meshes: the
+// Static intersection resolution (Hajkova & Kohout sec. 3.1; docs/DESIGN.md
+// section 5), once after a deformation, on the full meshes: the
 // vertices of deformable meshes (muscles) that lie inside an obstacle (a bone,
 // or another of the deformable meshes) go out to the obstacle's surface.
 #pragma once

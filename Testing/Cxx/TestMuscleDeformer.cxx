@@ -89,7 +89,7 @@ TEST(MuscleDeformer, RigidMotionsOfTheActionLinesMoveTheMuscleRigidly)
   md::RigidTransform shift;
   shift.translation = Eigen::Vector3d(40, -25, 10);
   // A rotation only approximately: the action lines give each segment's
-  // direction, not its twist about itself (METHOD.md section 4).
+  // direction, not its twist about itself (docs/DESIGN.md, section 4).
   const md::RigidTransform turn =
     md::RigidTransform::AboutPoint(Eigen::Vector3d(0.3, 1, 0.2), 50 * M_PI / 180, Eigen::Vector3d(10, -20, 5));
   for (const auto& [motion, tolerance] : { std::make_pair(shift, 1e-6), std::make_pair(turn, 0.02) })

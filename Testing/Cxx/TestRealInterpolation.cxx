@@ -2,7 +2,7 @@
 // (frame 35), four muscles together, obstacles iliac bone, sacrum and femur:
 // the one-pass method, the interpolation with the hull refitted (N = 4) and
 // with the hull rebuilt before every step (the paper), judged by the measures
-// of METHOD.md. Skipped when ../shared/data is absent.
+// of docs/DESIGN.md. Skipped when ../shared/data is absent.
 #include "InterpolatedDeformation.h"
 #include "RealData.h"
 #include "ProgressiveHull.h"

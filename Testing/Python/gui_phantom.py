@@ -23,9 +23,27 @@ def run():
         ActionLinesCurrent=simple.OutputPort(phantom, 4), NumberOfSteps=4)
     view = simple.GetActiveViewOrCreate("RenderView")
     view.OrientationAxesVisibility = 0
+    # What Apply shows: the GUI shows every output port in its preferred view, as here (the
+    # controller pqApplyBehavior uses), then hides the filter's inputs.
+    controller = servermanager.vtkSMParaViewPipelineControllerWithRendering()
+
+    def apply_shows(source):
+        views = {}
+        for port in range(source.GetNumberOfOutputPorts()):
+            shown_in = controller.ShowInPreferredView(source.SMProxy, port, view.SMProxy)
+            views[port] = shown_in.GetXMLName() if shown_in else "none"
+        return views
+
+    phantom_views = apply_shows(phantom)
+    report["phantom_shows"] = ",".join(str(p) for p, v in sorted(phantom_views.items()) if v == "RenderView")
+    for port in range(5):
+        simple.Hide(simple.OutputPort(phantom, port), view)
+    method_views = apply_shows(method)
+    report["method_shows"] = ",".join("%d:%s" % (p, v) for p, v in sorted(method_views.items()))
+    simple.SetActiveView(view)
     # The plugin's default display, nothing set here: coloured by role (array Role, the plugin's
     # categorical colour map), action lines as tubes.
-    shown = [simple.Show(simple.OutputPort(method, port), view) for port in (0, 1, 2)]
+    shown = [simple.GetDisplayProperties(simple.OutputPort(method, port), view) for port in (0, 1, 2)]
     report["coloured_by_role"] = int(all(r.ColorArrayName[1] == "Role" and r.LookupTable is not None and
                                          r.LookupTable.InterpretValuesAsCategories == 1 for r in shown))
     report["action_lines_as_tubes"] = int(shown[2].RenderLinesAsTubes == 1 and shown[2].LineWidth > 1)

@@ -33,7 +33,11 @@ class Gui(unittest.TestCase):
         self.assertEqual(run.returncode, 0, run.stdout.decode(errors="replace")[-3000:])
         with open(os.path.join(output, "report.txt")) as f:
             report = dict(line.split() for line in f if line.strip())
-        self.assertEqual(report, {"plugin_loaded": "1", "coloured_by_role": "1", "action_lines_as_tubes": "1",
+        # The phantom shows its rest pose (muscles, bones, action lines), the method its muscles,
+        # bones and action lines with the measures in a spreadsheet.
+        self.assertEqual(report, {"plugin_loaded": "1", "phantom_shows": "0,1,3",
+                                  "method_shows": "0:RenderView,1:RenderView,2:RenderView,3:SpreadSheetView",
+                                  "coloured_by_role": "1", "action_lines_as_tubes": "1",
                                   "surfaces_not_tubes": "1", "time_steps": "5", "points_every_step": "1",
                                   "last_step": "4"})
         mdtesting.assert_matches_baseline(self, os.path.join(output, "GuiPhantomInterpolated.png"),

@@ -37,7 +37,7 @@ class LhdlExample(unittest.TestCase):
             self.assertLessEqual(abs(deformed["VolumeChangePercent"]), 0.05, name)
             self.assertEqual(deformed["FlippedTriangleCount"], 0, name)
             self.assertEqual(deformed["Converged"], 1, name)
-        # The whole method in 4 steps against the one-pass method (METHOD.md measures).
+        # The whole method in 4 steps against the one-pass method (docs/DESIGN.md, "Measures").
         method = figures["interpolation_method"]
         self.assertEqual(method["number_of_steps"], 4)
         final, one_pass = method["steps"][-1]["muscles"], figures["one_pass_method"]

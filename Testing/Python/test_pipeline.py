@@ -62,6 +62,15 @@ class ServerManagerXML(unittest.TestCase):
         libraries = sorted(name for name in os.listdir(folder) if ".so" in name or name.endswith(".dll"))
         self.assertEqual(libraries, ["MuscleDeformation.so"])
 
+    def test_the_set_up_installs_the_svg_support_the_guis_icons_need(self):
+        # Debian's ParaView showed blank toolbar icons until libqt5svg5 was installed by hand.
+        with open(os.path.join(mdtesting.SOURCE_DIR, "Testing", "bootstrap.sh")) as f:
+            text = f.read()
+        start = text.index("MD_PACKAGES=(")
+        packages = text[start:text.index(")", start)].split()
+        self.assertIn("libqt5svg5", packages)
+        self.assertIn("paraview", packages)
+
     def test_hulls_are_shown_as_a_wireframe_around_their_muscle(self):
         folder = os.path.join(mdtesting.SOURCE_DIR, "ServerManagerXML")
         root = ElementTree.parse(os.path.join(folder, "MuscleDeformation.xml")).getroot()
