@@ -317,10 +317,25 @@ bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::funct
     vtkErrorWithObjectMacro(filter, << context << e.what());
     result = 0;
   }
+  catch (const md::ComputationError& e)
+  {
+    vtkErrorWithObjectMacro(filter, << context << e.what());
+    result = 0;
+  }
   catch (const md::Cancelled&)
   {
     filter->CheckAbort(); // sets AbortOutput: the executive empties the outputs
     result = 1;
+  }
+  catch (const std::bad_alloc&)
+  {
+    vtkErrorWithObjectMacro(filter, << context << "out of memory; try fewer hull points or a coarser surface");
+    result = 0;
+  }
+  catch (const std::exception& e)
+  {
+    vtkErrorWithObjectMacro(filter, << context << "unexpected failure: " << e.what());
+    result = 0;
   }
   return false;
 }

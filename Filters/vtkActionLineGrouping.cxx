@@ -101,15 +101,13 @@ int vtkActionLineGrouping::RequestData(
     pathNames.push_back(paths[p].name.empty() ? "path " + std::to_string(p) : paths[p].name);
   }
   md::osim::PathGrouping grouping;
-  try
+  int result = 1;
+  if (!mdvtk::CallCore(this, "PathsOfMuscle: ", [&] {
+        grouping = md::osim::GroupPaths(meshes, muscleNames, lines, pathNames,
+          md::osim::ParseAssignments(this->PathsOfMuscle ? this->PathsOfMuscle : ""));
+      }, result))
   {
-    grouping = md::osim::GroupPaths(
-      meshes, muscleNames, lines, pathNames, md::osim::ParseAssignments(this->PathsOfMuscle ? this->PathsOfMuscle : ""));
-  }
-  catch (const md::InputError& e)
-  {
-    vtkErrorMacro(<< "PathsOfMuscle: " << e.what());
-    return 0;
+    return result;
   }
   std::ostringstream decision, unassigned;
   for (size_t p = 0; p < paths.size(); ++p)

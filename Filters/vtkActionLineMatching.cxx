@@ -138,15 +138,11 @@ int vtkActionLineMatching::RequestData(
     for (size_t l = 0; l < restLines.size(); ++l)
     {
       md::MatchedActionLines matched;
-      try
+      int result = 1;
+      if (!mdvtk::CallCore(this, "polyline " + std::to_string(l) + " of " + rest.label + " / " + current.label + ": ",
+            [&] { matched = md::MatchActionLines(restLines[l], currentLines[l], this->Tolerance); }, result))
       {
-        matched = md::MatchActionLines(restLines[l], currentLines[l], this->Tolerance);
-      }
-      catch (const md::InputError& e)
-      {
-        vtkErrorMacro(<< "polyline " << l << " of " << rest.label << " / " << current.label << ": "
-                      << e.what());
-        return 0;
+        return result;
       }
       restBuilder.lines.push_back(matched.rest);
       restBuilder.parameters.push_back(matched.restParameters);

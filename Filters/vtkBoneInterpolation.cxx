@@ -175,14 +175,11 @@ int vtkBoneInterpolation::RequestInformation(
     {
       largest = std::max(largest, md::MaximumDisplacement(pose.rest, pose.current));
     }
-    try
+    int result = 1;
+    if (!mdvtk::CallCore(this, "", [&] { steps = md::AutomaticNumberOfSteps(largest, this->MaximumStepDisplacement); },
+          result))
     {
-      steps = md::AutomaticNumberOfSteps(largest, this->MaximumStepDisplacement);
-    }
-    catch (const md::InputError& e)
-    {
-      vtkErrorMacro(<< e.what());
-      return 0;
+      return result;
     }
   }
   this->ResolvedNumberOfSteps = steps;
@@ -251,35 +248,33 @@ int vtkBoneInterpolation::RequestData(
     output->ShallowCopy(pose.restData);
     output->GetFieldData()->DeepCopy(pose.restData->GetFieldData());
     vtkFieldData* fieldData = output->GetFieldData();
-    try
+    int result = 1;
+    if (!mdvtk::CallCore(this, pose.label + ": ", [&] {
+          const md::PoseInterpolator interpolator(pose.rest, pose.current, mode);
+          positions = interpolator.AtStep(step, steps);
+          if (interpolator.Fit())
+          {
+            const md::RigidFit& fit = *interpolator.Fit();
+            mdvtk::AddFieldValue(fieldData, "RigidFitRMSResidual", fit.rmsResidual);
+            mdvtk::AddFieldValue(fieldData, "RigidFitMaxResidual", fit.maxResidual);
+            mdvtk::AddFieldValue(fieldData, "RotationAngleDegrees", vtkMath::DegreesFromRadians(interpolator.RotationAngle()));
+            double bounds[6];
+            pose.restData->GetBounds(bounds);
+            const double diagonal = std::sqrt(vtkMath::Distance2BetweenPoints(
+              std::array<double, 3>{ bounds[0], bounds[2], bounds[4] }.data(),
+              std::array<double, 3>{ bounds[1], bounds[3], bounds[5] }.data()));
+            if (fit.maxResidual > 1e-3 * diagonal)
+            {
+              vtkWarningMacro(<< "the motion of " << pose.label << " is not rigid: the best rigid fit "
+                              << "misses the current pose by up to " << fit.maxResidual << " ("
+                              << 100.0 * fit.maxResidual / diagonal
+                              << " % of its size); Rigid mode blends that residual in linearly, "
+                                 "Linear mode may suit this motion better");
+            }
+          }
+        }, result))
     {
-      const md::PoseInterpolator interpolator(pose.rest, pose.current, mode);
-      positions = interpolator.AtStep(step, steps);
-      if (interpolator.Fit())
-      {
-        const md::RigidFit& fit = *interpolator.Fit();
-        mdvtk::AddFieldValue(fieldData, "RigidFitRMSResidual", fit.rmsResidual);
-        mdvtk::AddFieldValue(fieldData, "RigidFitMaxResidual", fit.maxResidual);
-        mdvtk::AddFieldValue(fieldData, "RotationAngleDegrees", vtkMath::DegreesFromRadians(interpolator.RotationAngle()));
-        double bounds[6];
-        pose.restData->GetBounds(bounds);
-        const double diagonal = std::sqrt(vtkMath::Distance2BetweenPoints(
-          std::array<double, 3>{ bounds[0], bounds[2], bounds[4] }.data(),
-          std::array<double, 3>{ bounds[1], bounds[3], bounds[5] }.data()));
-        if (fit.maxResidual > 1e-3 * diagonal)
-        {
-          vtkWarningMacro(<< "the motion of " << pose.label << " is not rigid: the best rigid fit "
-                          << "misses the current pose by up to " << fit.maxResidual << " ("
-                          << 100.0 * fit.maxResidual / diagonal
-                          << " % of its size); Rigid mode blends that residual in linearly, "
-                             "Linear mode may suit this motion better");
-        }
-      }
-    }
-    catch (const md::InputError& e)
-    {
-      vtkErrorMacro(<< pose.label << ": " << e.what());
-      return 0;
+      return result;
     }
     output->SetPoints(mdvtk::ToVtkPoints(positions));
     mdvtk::AddFieldValue(fieldData, "InterpolationStep", step);

@@ -97,49 +97,47 @@ int vtkMoveWithBodies::RequestData(
     motions.push_back(t);
   }
   std::vector<vtkSmartPointer<vtkPolyData>> results(leaves.size());
-  try
+  std::vector<std::pair<std::string, std::vector<std::string>>> assignments;
+  int result = 1;
+  if (!mdvtk::CallCore(this, "BodyOfSurface: ",
+        [&] { assignments = md::osim::ParseAssignments(this->BodyOfSurface ? this->BodyOfSurface : ""); }, result))
   {
-    const auto assignments = md::osim::ParseAssignments(this->BodyOfSurface ? this->BodyOfSurface : "");
-    for (size_t i = 0; i < leaves.size(); ++i)
-    {
-      if (!leaves[i].data)
-      {
-        continue;
-      }
-      const std::string name = leaves[i].name.empty() ? "Input" : leaves[i].name;
-      const int body = md::osim::BodyOfSurface(name, bodyNames, assignments);
-      if (body < 0)
-      {
-        std::string list;
-        for (const std::string& b : bodyNames)
-        {
-          list += (list.empty() ? "" : ", ") + b;
-        }
-        vtkErrorMacro(<< leaves[i].label << ": no body of the model is named after '" << name
-                      << "'; say which body it moves with in BodyOfSurface (e.g. " << md::osim::WithoutExtension(name)
-                      << "=pelvis). The bodies: " << list);
-        return 0;
-      }
-      auto moved = vtkSmartPointer<vtkPolyData>::New();
-      moved->ShallowCopy(leaves[i].data);
-      if (leaves[i].data->GetPoints())
-      {
-        moved->SetPoints(mdvtk::ToVtkPoints(motions[body].Apply(mdvtk::ToPoints(leaves[i].data->GetPoints()))));
-      }
-      vtkNew<vtkFieldData> fieldData;
-      fieldData->ShallowCopy(leaves[i].data->GetFieldData());
-      vtkNew<vtkStringArray> bodyArray;
-      bodyArray->SetName("Body");
-      bodyArray->InsertNextValue(bodyNames[body]);
-      fieldData->AddArray(bodyArray);
-      moved->SetFieldData(fieldData);
-      results[i] = moved;
-    }
+    return result;
   }
-  catch (const md::InputError& e)
+  for (size_t i = 0; i < leaves.size(); ++i)
   {
-    vtkErrorMacro(<< "BodyOfSurface: " << e.what());
-    return 0;
+    if (!leaves[i].data)
+    {
+      continue;
+    }
+    const std::string name = leaves[i].name.empty() ? "Input" : leaves[i].name;
+    const int body = md::osim::BodyOfSurface(name, bodyNames, assignments);
+    if (body < 0)
+    {
+      std::string list;
+      for (const std::string& b : bodyNames)
+      {
+        list += (list.empty() ? "" : ", ") + b;
+      }
+      vtkErrorMacro(<< leaves[i].label << ": no body of the model is named after '" << name
+                    << "'; say which body it moves with in BodyOfSurface (e.g. " << md::osim::WithoutExtension(name)
+                    << "=pelvis). The bodies: " << list);
+      return 0;
+    }
+    auto moved = vtkSmartPointer<vtkPolyData>::New();
+    moved->ShallowCopy(leaves[i].data);
+    if (leaves[i].data->GetPoints())
+    {
+      moved->SetPoints(mdvtk::ToVtkPoints(motions[body].Apply(mdvtk::ToPoints(leaves[i].data->GetPoints()))));
+    }
+    vtkNew<vtkFieldData> fieldData;
+    fieldData->ShallowCopy(leaves[i].data->GetFieldData());
+    vtkNew<vtkStringArray> bodyArray;
+    bodyArray->SetName("Body");
+    bodyArray->InsertNextValue(bodyNames[body]);
+    fieldData->AddArray(bodyArray);
+    moved->SetFieldData(fieldData);
+    results[i] = moved;
   }
   mdvtk::AssignLeaves(input, output, results, mdvtk::Role::AsGiven); // moves whatever it is given
   return 1;

@@ -70,14 +70,10 @@ int vtkMusculoskeletalPhantom::RequestData(
   parameters.scale = this->Scale;
   parameters.resolution = this->Resolution;
   md::Phantom phantom;
-  try
+  int result = 1;
+  if (!mdvtk::CallCore(this, "", [&] { phantom = md::BuildPhantom(parameters); }, result))
   {
-    phantom = md::BuildPhantom(parameters);
-  }
-  catch (const md::InputError& e)
-  {
-    vtkErrorMacro(<< e.what());
-    return 0;
+    return result;
   }
   auto output = [&](int port) { return vtkMultiBlockDataSet::GetData(outputVector, port); };
 

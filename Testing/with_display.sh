@@ -8,39 +8,30 @@ if [ -n "${DISPLAY:-}" ]; then
   exec "$@"
 fi
 command -v Xvfb >/dev/null || { echo "with_display.sh: Xvfb is not installed (Debian package xvfb)" >&2; exit 1; }
-# True when an X client can open the display (libX11 comes with ParaView).
-can_connect() {
-  /usr/bin/python3 -c "import ctypes, sys
-x = ctypes.cdll.LoadLibrary('libX11.so.6')
-x.XOpenDisplay.restype = ctypes.c_void_p
-d = x.XOpenDisplay(b':$1')
-sys.exit(0 if d else 1)" 2>/dev/null
-}
 
-for number in $(seq 110 199); do
-  # A lock or a socket left by a server that is just stopping: not free.
-  [ -e "/tmp/.X${number}-lock" ] || [ -e "/tmp/.X11-unix/X${number}" ] && continue
-  Xvfb ":${number}" -screen 0 1280x1024x24 -nolisten tcp >/dev/null 2>&1 &
-  server=$!
-  # Ready when a client can connect; gone when another run took the number first.
-  ready=0
-  for _ in $(seq 1 200); do
-    kill -0 "$server" 2>/dev/null || break
-    if can_connect "$number"; then
-      ready=1
-      break
-    fi
-    sleep 0.05
-  done
-  if [ "$ready" = 1 ]; then
-    DISPLAY=":${number}" "$@"
-    status=$?
-    kill "$server" 2>/dev/null
-    wait "$server" 2>/dev/null
-    exit "$status"
-  fi
+# Xvfb picks a free display number itself (-displayfd) and writes it once it accepts clients.
+# Choosing the number here raced when two runs started together (ctest --parallel): both took
+# the same number, the second server gave up, and its command lost the display when the first
+# run ended ("bad X server connection").
+number_file=$(mktemp)
+Xvfb -displayfd 3 -screen 0 1280x1024x24 -nolisten tcp 3>"$number_file" >/dev/null 2>&1 &
+server=$!
+number=""
+for _ in $(seq 1 400); do
+  number=$(tr -dc '0-9' <"$number_file")
+  [ -n "$number" ] && break
+  kill -0 "$server" 2>/dev/null || break
+  sleep 0.05
+done
+rm -f "$number_file"
+if [ -z "$number" ]; then
   kill "$server" 2>/dev/null
   wait "$server" 2>/dev/null
-done
-echo "with_display.sh: no X display could be started" >&2
-exit 1
+  echo "with_display.sh: no X display could be started" >&2
+  exit 1
+fi
+DISPLAY=":${number}" "$@"
+status=$?
+kill "$server" 2>/dev/null
+wait "$server" 2>/dev/null
+exit "$status"

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <memory>
 #include <numeric>
 #include <set>
@@ -48,6 +49,7 @@ std::vector<TriangleMesh> BuildHulls(const std::vector<MuscleMotion>& muscles, c
   errors.assign(count, std::string());
   seconds.assign(count, 0.0);
   std::vector<char> cancelled(count, 0); // no exception may leave a parallel region
+  std::vector<std::exception_ptr> failed(count);
 #pragma omp parallel for schedule(dynamic, 1)
   for (int k = 0; k < static_cast<int>(order.size()); ++k)
   {
@@ -65,11 +67,22 @@ std::vector<TriangleMesh> BuildHulls(const std::vector<MuscleMotion>& muscles, c
     {
       cancelled[m] = 1;
     }
+    catch (...)
+    {
+      failed[m] = std::current_exception(); // out of memory, say: thrown again below
+    }
     seconds[m] = SecondsSince(start);
   }
   if (std::count(cancelled.begin(), cancelled.end(), 1) > 0)
   {
     throw Cancelled();
+  }
+  for (const std::exception_ptr& failure : failed)
+  {
+    if (failure)
+    {
+      std::rethrow_exception(failure);
+    }
   }
   return hulls;
 }

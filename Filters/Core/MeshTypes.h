@@ -36,6 +36,14 @@ public:
   using std::runtime_error::runtime_error;
 };
 
+/// Thrown when a computation cannot finish on input of a sound form (a deformation that
+/// diverges): not the input's fault as such, but no result is handed on.
+class ComputationError : public std::runtime_error
+{
+public:
+  using std::runtime_error::runtime_error;
+};
+
 /// Thrown through the core by a progress or cancel callback when the user stops a computation
 /// (ParaView's abort): the core unwinds, nothing half-done is handed on.
 class Cancelled : public std::runtime_error

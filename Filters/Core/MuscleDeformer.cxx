@@ -12,6 +12,7 @@
 #include <sstream>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <numeric>
 
@@ -411,7 +412,7 @@ void RunCoarsePhase(MuscleState& s, const DeformationParameters& parameters)
     ++s.result.coarseIterations;
     if (!next.allFinite())
     {
-      throw InputError("the deformation of muscle '" + s.input->name + "' diverged on its hull");
+      throw ComputationError("the deformation of muscle '" + s.input->name + "' diverged on its hull");
     }
     if (change < parameters.convergenceTolerance)
     {
@@ -1075,6 +1076,7 @@ std::vector<Obstacle> BuildObstacles(const std::vector<std::string>& names, cons
 {
   std::vector<Obstacle> obstacles(meshes.size());
   std::string error;
+  std::vector<std::exception_ptr> failed(meshes.size()); // no exception may leave a parallel region
 #pragma omp parallel for schedule(dynamic, 1)
   for (size_t b = 0; b < meshes.size(); ++b)
   {
@@ -1087,10 +1089,21 @@ std::vector<Obstacle> BuildObstacles(const std::vector<std::string>& names, cons
 #pragma omp critical
       error = "obstacle '" + names[b] + "': " + e.what();
     }
+    catch (...)
+    {
+      failed[b] = std::current_exception();
+    }
   }
   if (!error.empty())
   {
     throw InputError(error);
+  }
+  for (const std::exception_ptr& failure : failed)
+  {
+    if (failure)
+    {
+      std::rethrow_exception(failure);
+    }
   }
   return obstacles;
 }
@@ -1151,7 +1164,7 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
     // hull point far off that hardly weighs on the muscle is no harm.)
     if (Growth(s) > maximumGrowth)
     {
-      throw InputError("the deformation of muscle '" + s.input->name + "' diverged on its hull: the muscle spans " +
+      throw ComputationError("the deformation of muscle '" + s.input->name + "' diverged on its hull: the muscle spans " +
         std::to_string(Growth(s)) + " times its starting size after " +
         std::to_string(s.result.coarseIterations) + " iterations");
     }
@@ -1262,7 +1275,7 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
       }
       if (!next.allFinite())
       {
-        throw InputError("the deformation of muscle '" + s.input->name + "' diverged on its full mesh");
+        throw ComputationError("the deformation of muscle '" + s.input->name + "' diverged on its full mesh");
       }
       const Points change = next - s.hull;
       const double largest = change.cwiseAbs().maxCoeff();
@@ -1368,7 +1381,7 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
       if (!s.fellBack && ((parameters.preserveVolume && std::abs(r.volumeChangePercent) > 10.0) ||
         Growth(s) > maximumGrowth))
       {
-        throw InputError("the deformation of muscle '" + s.input->name + "' diverged: after " +
+        throw ComputationError("the deformation of muscle '" + s.input->name + "' diverged: after " +
           std::to_string(parameters.maximumIterations) + " iterations its volume is off by " +
           std::to_string(r.volumeChangePercent) + " % and it spans " +
           std::to_string(Growth(s)) + " times its starting size");

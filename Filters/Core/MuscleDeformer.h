@@ -72,8 +72,8 @@ struct DeformationParameters
 struct MuscleToDeform
 {
   std::string name;           ///< for messages
-  const TriangleMesh* muscle; ///< full mesh in the rest pose (any point order; unused points follow too)
-  const TriangleMesh* hull;   ///< rest-pose hull enclosing the muscle (BuildProgressiveHull)
+  const TriangleMesh* muscle = nullptr; ///< full mesh in the rest pose (any point order; unused points follow too)
+  const TriangleMesh* hull = nullptr;   ///< rest-pose hull enclosing the muscle (BuildProgressiveHull)
   std::vector<MatchedLine> lines;
   /// Mean value coordinates of the muscle's points in the hull (one row per
   /// point), when already known: they depend on the rest pose only, so
@@ -153,7 +153,8 @@ std::vector<Obstacle> BuildObstacles(const std::vector<std::string>& names, cons
 /// Throws InputError naming the muscle for input that cannot give a sound
 /// result: an action line that does not pass through the hull, a muscle
 /// entirely inside an obstacle before it moves, no or unmatched action lines,
-/// non-finite coordinates, a least-squares system nothing fixes. The caller
+/// non-finite coordinates, a least-squares system nothing fixes; ComputationError
+/// when a muscle's deformation diverges. The caller
 /// checks that a hull it was given encloses its muscle. `progress`
 /// (optional) receives fractions in [0, 1].
 std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& muscles,

@@ -2,6 +2,7 @@
 // point arrays shorter than the points. Each must be refused with a message naming the input and
 // the block, never read past an array's end (these crashed ParaView before).
 #include "FilterTestUtilities.h"
+#include "MDBlocks.h"
 #include "MeshChecks.h"
 
 #include "vtkActionLineGrouping.h"
@@ -380,4 +381,35 @@ TEST(MalformedInput, IntersectionResolveWithoutObstaclesSaysSo)
   f->Update();
   EXPECT_TRUE(messages.Contains("no Obstacles are connected")) << messages.Text();
   EXPECT_FALSE(messages.Contains("ERROR")) << messages.Text();
+}
+
+TEST(MalformedInput, EveryFailureOfTheCoreBecomesAnErrorMessageNotACrash)
+{
+  // Only InputError was caught: a diverged computation was reported as bad input, and out of
+  // memory escaped RequestData. The one guard every filter calls the core through now tells
+  // them apart and catches everything.
+  vtkNew<vtkMuscleDeformation> filter;
+  struct Case
+  {
+    std::function<void()> failure;
+    const char* message;
+    int result;
+  };
+  const std::vector<Case> cases = {
+    { [] { throw md::InputError("no action line"); }, "muscle 'A': no action line", 0 },
+    { [] { throw md::ComputationError("diverged"); }, "muscle 'A': diverged", 0 },
+    { [] { throw std::bad_alloc(); }, "muscle 'A': out of memory", 0 },
+    { [] { throw std::runtime_error("odd"); }, "muscle 'A': unexpected failure: odd", 0 },
+  };
+  for (const Case& c : cases)
+  {
+    CapturedMessages messages;
+    int result = 1;
+    EXPECT_FALSE(mdvtk::CallCore(filter, "muscle 'A': ", c.failure, result));
+    EXPECT_EQ(result, c.result);
+    EXPECT_TRUE(messages.Contains(c.message)) << messages.Text();
+  }
+  int result = 1;
+  EXPECT_TRUE(mdvtk::CallCore(filter, "", [] {}, result));
+  EXPECT_EQ(result, 1);
 }
