@@ -108,7 +108,7 @@ public:
   vtkSetClampMacro(BoneContactWeight, double, 0.0, 100.0);
   vtkGetMacro(BoneContactWeight, double);
   /// Points of each muscle's hull. Default 250.
-  vtkSetClampMacro(HullTargetNumberOfPoints, int, 8, 1000000);
+  vtkSetClampMacro(HullTargetNumberOfPoints, int, 4, 1000000);
   vtkGetMacro(HullTargetNumberOfPoints, int);
   /// Shape regularisation of the Refit least squares (relative). Default 1e-3.
   vtkSetClampMacro(RefitRegularisation, double, 1e-9, 1e3);

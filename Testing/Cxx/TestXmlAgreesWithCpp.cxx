@@ -1,0 +1,132 @@
+// The defaults a user sees in ParaView (ServerManagerXML) and the ones a C++ or VTK user gets
+// (the filters' constructors) are written twice: this test holds them to each other, through
+// each filter's PrintSelf. (HullTargetNumberOfPoints once had a minimum of 4 in one and 8 in the
+// other.)
+#include "vtkActionLineGrouping.h"
+#include "vtkActionLineMatching.h"
+#include "vtkBoneInterpolation.h"
+#include "vtkHullDecimation.h"
+#include "vtkInterpolatedMuscleDeformation.h"
+#include "vtkIntersectionResolve.h"
+#include "vtkMoveWithBodies.h"
+#include "vtkMuscleDeformation.h"
+#include "vtkMusculoskeletalPhantom.h"
+#include "vtkOpenSimModelReader.h"
+
+#include <vtkSmartPointer.h>
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+
+namespace
+{
+template <typename T>
+vtkSmartPointer<vtkObject> Make()
+{
+  return vtkSmartPointer<T>::New();
+}
+
+const std::map<std::string, std::function<vtkSmartPointer<vtkObject>()>> Classes = {
+  { "vtkActionLineGrouping", Make<vtkActionLineGrouping> },
+  { "vtkActionLineMatching", Make<vtkActionLineMatching> },
+  { "vtkBoneInterpolation", Make<vtkBoneInterpolation> },
+  { "vtkHullDecimation", Make<vtkHullDecimation> },
+  { "vtkInterpolatedMuscleDeformation", Make<vtkInterpolatedMuscleDeformation> },
+  { "vtkIntersectionResolve", Make<vtkIntersectionResolve> },
+  { "vtkMoveWithBodies", Make<vtkMoveWithBodies> },
+  { "vtkMuscleDeformation", Make<vtkMuscleDeformation> },
+  { "vtkMusculoskeletalPhantom", Make<vtkMusculoskeletalPhantom> },
+  { "vtkOpenSimModelReader", Make<vtkOpenSimModelReader> },
+};
+
+std::map<std::string, std::string> Attributes(const std::string& tag)
+{
+  std::map<std::string, std::string> attributes;
+  static const std::regex attribute(R"re((\w+)="([^"]*)")re");
+  for (std::sregex_iterator it(tag.begin(), tag.end(), attribute), end; it != end; ++it)
+  {
+    attributes[(*it)[1]] = (*it)[2];
+  }
+  return attributes;
+}
+
+/// The value PrintSelf gives for `name` ("  Name: value"), or "" when it prints none.
+std::string Printed(vtkObject* object, const std::string& name)
+{
+  std::ostringstream out;
+  object->Print(out);
+  std::istringstream lines(out.str());
+  std::string line;
+  const std::string key = name + ": ";
+  while (std::getline(lines, line))
+  {
+    const size_t start = line.find_first_not_of(' ');
+    if (start != std::string::npos && line.compare(start, key.size(), key) == 0)
+    {
+      return line.substr(start + key.size());
+    }
+  }
+  return "";
+}
+}
+
+TEST(ServerManagerXml, EveryNumericDefaultIsTheConstructorsDefault)
+{
+  int compared = 0;
+  for (const char* file : { "MuscleDeformation.xml", "OpenSimModelReader.xml", "OpenSimAttachment.xml" })
+  {
+    std::ifstream in(std::string(MUSCLEDEFORMATION_SOURCE_DIR) + "/ServerManagerXML/" + file);
+    ASSERT_TRUE(in) << file;
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    static const std::regex proxy(R"re(<SourceProxy([^>]*)>([\s\S]*?)</SourceProxy>)re");
+    static const std::regex property(R"re(<(Int|Double)VectorProperty([^>]*[^/])>([\s\S]*?)</\1VectorProperty>)re");
+    static const std::regex entry(R"re(<Entry([^>]*)/>)re");
+    for (std::sregex_iterator p(text.begin(), text.end(), proxy), end; p != end; ++p)
+    {
+      const std::string className = Attributes((*p)[1])["class"];
+      ASSERT_EQ(Classes.count(className), 1u) << className << " is in the XML but not in this test";
+      vtkSmartPointer<vtkObject> object = Classes.at(className)();
+      const std::string body = (*p)[2];
+      for (std::sregex_iterator q(body.begin(), body.end(), property); q != end; ++q)
+      {
+        std::map<std::string, std::string> a = Attributes((*q)[2]);
+        if (a["information_only"] == "1" || a["number_of_elements"] != "1" || a["default_values"].empty() ||
+          a["command"] != "Set" + a["name"])
+        {
+          continue;
+        }
+        const std::string printed = Printed(object, a["name"]);
+        ASSERT_FALSE(printed.empty()) << className << "::PrintSelf does not print " << a["name"];
+        char* rest = nullptr;
+        double value = std::strtod(printed.c_str(), &rest);
+        if (!rest || *rest != '\0')
+        {
+          // An enumeration may print its entry's text: the XML's Entry says its value.
+          const std::string elements = (*q)[3];
+          bool found = false;
+          for (std::sregex_iterator e(elements.begin(), elements.end(), entry); e != end && !found; ++e)
+          {
+            std::map<std::string, std::string> item = Attributes((*e)[1]);
+            if (item["text"] == printed)
+            {
+              value = std::stod(item["value"]);
+              found = true;
+            }
+          }
+          ASSERT_TRUE(found) << className << "." << a["name"] << " prints '" << printed << "', no number or entry";
+        }
+        EXPECT_DOUBLE_EQ(value, std::stod(a["default_values"]))
+          << className << "." << a["name"] << ": XML default " << a["default_values"] << ", C++ " << printed;
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GE(compared, 39); // every numeric property the XML had when this was written: the parsing works
+}
