@@ -312,12 +312,7 @@ bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::funct
     work();
     return true;
   }
-  catch (const md::InputError& e)
-  {
-    vtkErrorWithObjectMacro(filter, << context << e.what());
-    result = 0;
-  }
-  catch (const md::ComputationError& e)
+  catch (const md::Error& e) // InputError or ComputationError: the message says which
   {
     vtkErrorWithObjectMacro(filter, << context << e.what());
     result = 0;
@@ -441,6 +436,13 @@ std::string DefaultDisplaySettings()
        << "\"representations\": { \"" << ActionLinesRepresentation << "\": { "
        << "\"LineWidth\": 4, \"RenderLinesAsTubes\": 1 } } }";
   return json.str();
+}
+
+void AddBlock(vtkMultiBlockDataSet* tree, const std::string& name, vtkDataObject* block)
+{
+  const unsigned int index = tree->GetNumberOfBlocks();
+  tree->SetBlock(index, block);
+  tree->GetMetaData(index)->Set(vtkCompositeDataSet::NAME(), name.c_str());
 }
 
 void AssignLeaves(vtkDataObject* input, vtkDataObject* output,

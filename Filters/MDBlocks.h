@@ -19,6 +19,7 @@ class vtkDataObject;
 class vtkFieldData;
 class vtkInformation;
 class vtkInformationVector;
+class vtkMultiBlockDataSet;
 class vtkObject;
 class vtkPoints;
 class vtkPolyData;
@@ -54,7 +55,7 @@ bool PairLeaves(vtkObject* reporter, const std::vector<Leaf>& a, const std::stri
 
 /// What a piece of the model is. The filters write it as cell array "Role" on their outputs (the
 /// active scalars, unless the data brings its own), and the plugin registers a categorical colour
-/// map for that array (RoleColourSettings): ParaView then shows bones in bone colour, muscles in
+/// map for that array (DefaultDisplaySettings): ParaView then shows bones in bone colour, muscles in
 /// muscle shades and action lines in blue without any setting, in the GUI and in pvpython.
 enum class Role : unsigned char
 {
@@ -85,6 +86,9 @@ std::string DefaultDisplaySettings();
 /// they must be the filter's own objects, not the input's.
 void AssignLeaves(vtkDataObject* input, vtkDataObject* output,
   const std::vector<vtkSmartPointer<vtkPolyData>>& results, Role role);
+
+/// Appends `block` to `tree` under the block name `name`.
+void AddBlock(vtkMultiBlockDataSet* tree, const std::string& name, vtkDataObject* block);
 
 /// Adds a one-value array to field data (a double, or an int for counts).
 void AddFieldValue(vtkFieldData* fieldData, const char* name, double value);

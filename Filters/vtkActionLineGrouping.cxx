@@ -172,9 +172,7 @@ int vtkActionLineGrouping::RequestData(
       block->ShallowCopy(append->GetOutput());
       block->GetFieldData()->AddArray(names);
       block->GetFieldData()->AddArray(shares);
-      const unsigned int index = output->GetNumberOfBlocks();
-      output->SetBlock(index, block);
-      output->GetMetaData(index)->Set(vtkCompositeDataSet::NAME(), muscleNames[m].c_str());
+      mdvtk::AddBlock(output, muscleNames[m], block);
     }
   };
   build(paths, false, vtkMultiBlockDataSet::GetData(outputVector, 0));

@@ -17,40 +17,16 @@ vtkStandardNewMacro(vtkMusculoskeletalPhantom);
 
 namespace
 {
-void AddBlock(vtkMultiBlockDataSet* tree, const std::string& name, vtkDataObject* block)
+/// The lines of one muscle as polylines, each named in cell array ActionLineName.
+vtkSmartPointer<vtkPolyData> Polylines(const std::vector<md::Points>& lines, const std::vector<std::string>& names)
 {
-  const unsigned int index = tree->GetNumberOfBlocks();
-  tree->SetBlock(index, block);
-  tree->GetMetaData(index)->Set(vtkCompositeDataSet::NAME(), name.c_str());
-}
-
-vtkSmartPointer<vtkPolyData> Polylines(
-  const std::vector<md::Points>& lines, const std::vector<std::string>& names)
-{
-  vtkIdType total = 0;
-  for (const md::Points& line : lines)
-  {
-    total += line.rows();
-  }
-  md::Points all(total, 3);
-  vtkNew<vtkCellArray> cells;
+  vtkSmartPointer<vtkPolyData> polyData = mdvtk::ToPolyLines(lines);
   vtkNew<vtkStringArray> lineNames;
   lineNames->SetName("ActionLineName");
-  vtkIdType next = 0;
-  for (size_t l = 0; l < lines.size(); ++l)
+  for (const std::string& name : names)
   {
-    all.middleRows(next, lines[l].rows()) = lines[l];
-    cells->InsertNextCell(static_cast<int>(lines[l].rows()));
-    for (vtkIdType k = 0; k < lines[l].rows(); ++k)
-    {
-      cells->InsertCellPoint(next + k);
-    }
-    next += lines[l].rows();
-    lineNames->InsertNextValue(names[l]);
+    lineNames->InsertNextValue(name);
   }
-  auto polyData = vtkSmartPointer<vtkPolyData>::New();
-  polyData->SetPoints(mdvtk::ToVtkPoints(all));
-  polyData->SetLines(cells);
   polyData->GetCellData()->AddArray(lineNames);
   return polyData;
 }
@@ -79,16 +55,16 @@ int vtkMusculoskeletalPhantom::RequestData(
 
   for (const md::PhantomMuscle& muscle : phantom.muscles)
   {
-    AddBlock(output(MUSCLES), muscle.name, mdvtk::ToPolyData(muscle.rest));
-    AddBlock(output(ACTION_LINES_REST), muscle.name,
+    mdvtk::AddBlock(output(MUSCLES), muscle.name, mdvtk::ToPolyData(muscle.rest));
+    mdvtk::AddBlock(output(ACTION_LINES_REST), muscle.name,
       Polylines(muscle.actionLinesRest, muscle.actionLineNames));
-    AddBlock(output(ACTION_LINES_CURRENT), muscle.name,
+    mdvtk::AddBlock(output(ACTION_LINES_CURRENT), muscle.name,
       Polylines(muscle.actionLinesCurrent, muscle.actionLineNames));
   }
   for (const md::PhantomBone& bone : phantom.bones)
   {
-    AddBlock(output(BONES_REST), bone.name, mdvtk::ToPolyData(bone.rest));
-    AddBlock(output(BONES_CURRENT), bone.name,
+    mdvtk::AddBlock(output(BONES_REST), bone.name, mdvtk::ToPolyData(bone.rest));
+    mdvtk::AddBlock(output(BONES_CURRENT), bone.name,
       mdvtk::ToPolyData(md::TriangleMesh{ bone.currentPoints, bone.rest.triangles }));
   }
   mdvtk::MarkRoles(output(MUSCLES), mdvtk::Role::Muscle);

@@ -86,13 +86,6 @@ vtkSmartPointer<vtkPolyData> ReadMeshFile(const std::string& path)
   return mesh;
 }
 
-void AddBlock(vtkMultiBlockDataSet* tree, const std::string& name, vtkDataObject* block)
-{
-  const unsigned int index = tree->GetNumberOfBlocks();
-  tree->SetBlock(index, block);
-  tree->GetMetaData(index)->Set(vtkCompositeDataSet::NAME(), name.c_str());
-}
-
 vtkSmartPointer<vtkStringArray> Strings(const char* name)
 {
   auto array = vtkSmartPointer<vtkStringArray>::New();
@@ -426,7 +419,7 @@ int vtkOpenSimModelReader::RequestData(
       }
       transform->InsertNextTuple(values);
       block->GetFieldData()->AddArray(transform);
-      AddBlock(tree, model.bodies[b].name, block);
+      mdvtk::AddBlock(tree, model.bodies[b].name, block);
     }
   };
   auto paths = [&](const std::vector<double>& coordinates, const std::vector<RigidTransform>& p,
@@ -457,7 +450,7 @@ int vtkOpenSimModelReader::RequestData(
       block->GetPointData()->AddArray(onBody);
       block->GetCellData()->AddArray(lineName);
       mdvtk::AddFieldValue(block->GetFieldData(), "PathLength", scale * osim::PolylineLength(g.points));
-      AddBlock(tree, path.name, block);
+      mdvtk::AddBlock(tree, path.name, block);
     }
   };
 
@@ -479,7 +472,7 @@ int vtkOpenSimModelReader::RequestData(
   {
     md::TriangleMesh mesh = in.wraps[w];
     mesh.points = toOutput(placed(poses, model.wrapObjects[w].body), mesh.points);
-    AddBlock(wraps, model.wrapObjects[w].name, mdvtk::ToPolyData(mesh));
+    mdvtk::AddBlock(wraps, model.wrapObjects[w].name, mdvtk::ToPolyData(mesh));
   }
 
   vtkTable* table = vtkTable::GetData(outputVector, BODY_TRANSFORMS);

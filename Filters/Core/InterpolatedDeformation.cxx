@@ -48,8 +48,7 @@ std::vector<TriangleMesh> BuildHulls(const std::vector<MuscleMotion>& muscles, c
   std::vector<TriangleMesh> hulls(count);
   errors.assign(count, std::string());
   seconds.assign(count, 0.0);
-  std::vector<char> cancelled(count, 0); // no exception may leave a parallel region
-  std::vector<std::exception_ptr> failed(count);
+  std::vector<std::exception_ptr> failed(count); // no exception may leave a parallel region
 #pragma omp parallel for schedule(dynamic, 1)
   for (int k = 0; k < static_cast<int>(order.size()); ++k)
   {
@@ -63,19 +62,11 @@ std::vector<TriangleMesh> BuildHulls(const std::vector<MuscleMotion>& muscles, c
     {
       errors[m] = "muscle '" + muscles[m].name + "': " + e.what();
     }
-    catch (const Cancelled&)
-    {
-      cancelled[m] = 1;
-    }
     catch (...)
     {
-      failed[m] = std::current_exception(); // out of memory, say: thrown again below
+      failed[m] = std::current_exception(); // Cancelled, or out of memory: thrown again below
     }
     seconds[m] = SecondsSince(start);
-  }
-  if (std::count(cancelled.begin(), cancelled.end(), 1) > 0)
-  {
-    throw Cancelled();
   }
   for (const std::exception_ptr& failure : failed)
   {

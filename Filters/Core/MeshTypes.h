@@ -28,20 +28,27 @@ inline bool SameMesh(const TriangleMesh& a, const TriangleMesh& b)
     a.triangles == b.triangles;
 }
 
-/// Thrown when input data cannot be used; the message says what is wrong so
-/// that the VTK adapters can report it together with the name of the input.
-class InputError : public std::runtime_error
+/// What the core throws when it hands on no result; the message says what went wrong so that
+/// the VTK adapters can report it together with the name of the input.
+class Error : public std::runtime_error
 {
 public:
   using std::runtime_error::runtime_error;
 };
 
-/// Thrown when a computation cannot finish on input of a sound form (a deformation that
-/// diverges): not the input's fault as such, but no result is handed on.
-class ComputationError : public std::runtime_error
+/// Thrown when input data cannot be used.
+class InputError : public Error
 {
 public:
-  using std::runtime_error::runtime_error;
+  using Error::Error;
+};
+
+/// Thrown when a computation cannot finish on input of a sound form (a deformation that
+/// diverges): not the input's fault as such, but no result is handed on.
+class ComputationError : public Error
+{
+public:
+  using Error::Error;
 };
 
 /// Thrown through the core by a progress or cancel callback when the user stops a computation
