@@ -18,6 +18,7 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkStringArray.h>
 #include <vtkAOSDataArrayTemplate.h>
 #include <vtkAbstractArray.h>
 #include <vtkAlgorithm.h>
@@ -305,8 +306,10 @@ std::function<void(double)> ProgressOrCancel(vtkAlgorithm* filter, double offset
   };
 }
 
-bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::function<void()>& work, int& result)
+bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::function<void()>& work, int& result,
+  std::string* reported)
 {
+  std::string message;
   try
   {
     work();
@@ -314,25 +317,51 @@ bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::funct
   }
   catch (const md::Error& e) // InputError or ComputationError: the message says which
   {
-    vtkErrorWithObjectMacro(filter, << context << e.what());
-    result = 0;
+    message = context + e.what();
   }
   catch (const md::Cancelled&)
   {
     filter->CheckAbort(); // sets AbortOutput: the executive empties the outputs
     result = 1;
+    if (reported)
+    {
+      reported->clear();
+    }
+    return false;
   }
   catch (const std::bad_alloc&)
   {
-    vtkErrorWithObjectMacro(filter, << context << "out of memory; try fewer hull points or a coarser surface");
-    result = 0;
+    message = context + "out of memory; try fewer hull points or a coarser surface";
   }
   catch (const std::exception& e)
   {
-    vtkErrorWithObjectMacro(filter, << context << "unexpected failure: " << e.what());
-    result = 0;
+    message = context + "unexpected failure: " + e.what();
+  }
+  vtkErrorWithObjectMacro(filter, << message);
+  result = 0;
+  if (reported)
+  {
+    *reported = message;
   }
   return false;
+}
+
+const char* const FailedArrayName = "DeformationFailed";
+const char* const FailureMessageArrayName = "FailureMessage";
+
+vtkSmartPointer<vtkPolyData> FailedMuscle(vtkPolyData* input, const std::string& message)
+{
+  auto output = vtkSmartPointer<vtkPolyData>::New();
+  if (input)
+  {
+    output->GetFieldData()->DeepCopy(input->GetFieldData());
+  }
+  AddFieldValue(output->GetFieldData(), FailedArrayName, 1);
+  vtkNew<vtkStringArray> why;
+  why->SetName(FailureMessageArrayName);
+  why->InsertNextValue(message);
+  output->GetFieldData()->AddArray(why);
+  return output;
 }
 
 std::function<bool()> AbortRequested(vtkAlgorithm* filter)

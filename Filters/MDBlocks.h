@@ -107,8 +107,19 @@ std::function<void(double)> ProgressOrCancel(vtkAlgorithm* filter, double offset
 /// md::InputError becomes an error (`context` + its message) and RequestData's result 0;
 /// md::Cancelled (the user stopped the run) notes the abort, so that the executive empties the
 /// outputs, and the result 1. Returns true when `work` completed; otherwise `result` is what
-/// RequestData returns.
-bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::function<void()>& work, int& result);
+/// RequestData returns, and `reported` (optional) receives the error reported (empty when the
+/// user stopped the run), for a filter that goes on with its other muscles.
+bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::function<void()>& work, int& result,
+  std::string* reported = nullptr);
+
+/// Field data of a muscle's output block that could not be processed: DeformationFailed 1, and
+/// why in FailureMessage. The other muscles of the input are processed and output as usual.
+extern const char* const FailedArrayName;
+extern const char* const FailureMessageArrayName;
+
+/// The output block of a muscle that could not be processed: no geometry (nothing silently
+/// wrong to show), the input block's field data, and DeformationFailed / FailureMessage.
+vtkSmartPointer<vtkPolyData> FailedMuscle(vtkPolyData* input, const std::string& message);
 /// Whether the user has asked `filter` to stop; safe to ask from worker threads (it only reads
 /// the flag), for md::HullParameters::cancelled.
 std::function<bool()> AbortRequested(vtkAlgorithm* filter);

@@ -47,6 +47,7 @@ int vtkHullDecimation::RequestData(
   parameters.cancelled = mdvtk::AbortRequested(this);
 
   std::vector<vtkSmartPointer<vtkPolyData>> results(leaves.size());
+  size_t muscleCount = 0, failedCount = 0;
   for (size_t b = 0; b < leaves.size(); ++b)
   {
     this->UpdateProgress(static_cast<double>(b) / leaves.size());
@@ -59,19 +60,32 @@ int vtkHullDecimation::RequestData(
     {
       continue;
     }
+    ++muscleCount;
     if (leaf.data->GetNumberOfPolys() + leaf.data->GetNumberOfStrips() == 0)
     {
-      vtkErrorMacro(<< leaf.label << " has no surface (no polygons); a muscle must be a closed triangle surface");
-      return 0;
+      const std::string message =
+        leaf.label + " has no surface (no polygons); a muscle must be a closed triangle surface";
+      vtkErrorMacro(<< message);
+      results[b] = mdvtk::FailedMuscle(leaf.data, message); // the other muscles go on
+      ++failedCount;
+      continue;
     }
     const auto start = std::chrono::steady_clock::now();
     md::TriangleMesh muscle;
     const vtkIdType converted = mdvtk::ReadTriangles(leaf.data, muscle);
     md::MuscleHull built;
     int result = 1;
-    if (!mdvtk::CallCore(this, leaf.label + ": ", [&] { built = md::BuildMuscleHull(muscle, parameters); }, result))
+    std::string failure;
+    if (!mdvtk::CallCore(
+          this, leaf.label + ": ", [&] { built = md::BuildMuscleHull(muscle, parameters); }, result, &failure))
     {
-      return result;
+      if (failure.empty())
+      {
+        return result; // stopped by the user
+      }
+      results[b] = mdvtk::FailedMuscle(leaf.data, failure); // the other muscles go on
+      ++failedCount;
+      continue;
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const md::RepairReport& report = built.report;
@@ -118,7 +132,7 @@ int vtkHullDecimation::RequestData(
     results[b] = output;
   }
   mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), results, mdvtk::Role::Hull);
-  return 1;
+  return muscleCount > 0 && failedCount == muscleCount ? 0 : 1; // each failure was reported
 }
 
 void vtkHullDecimation::PrintSelf(ostream& os, vtkIndent indent)

@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 vtkStandardNewMacro(vtkInterpolatedMuscleDeformation);
 
@@ -28,6 +29,7 @@ struct vtkInterpolatedMuscleDeformation::Cache
   vtkMTimeType inputsTime = 0;
   vtkMTimeType filterTime = 0;
   std::vector<size_t> blockOf; // block of each muscle
+  std::map<size_t, std::string> failedBlocks; // muscles that could not be deformed, and why
   md::InterpolationResult result;
   // What outputs 1 and 2 show at each step: the bones and matched action lines moved as the
   // method moved them (the same interpolators, in the same local frame).
@@ -254,6 +256,14 @@ int vtkInterpolatedMuscleDeformation::RequestData(
       vtkErrorMacro(<< error);
       return 0;
     }
+    // One muscle's fault is reported and that muscle left out; the others go on.
+    auto fail = [&](size_t block, const std::string& message, bool reported = false) {
+      if (!reported)
+      {
+        vtkErrorMacro(<< message);
+      }
+      cache.failedBlocks[block] = message;
+    };
     // Everything in the muscles' local frame from here on, the matching of the action lines
     // too: the same answer wherever the data sits and whatever its units.
     std::vector<md::MuscleMotion> motions;
@@ -269,17 +279,19 @@ int vtkInterpolatedMuscleDeformation::RequestData(
       mdvtk::ReadTriangles(leaf.data, motion.muscle);
       if (motion.muscle.triangles.rows() == 0)
       {
-        vtkErrorMacro(<< leaf.label << " has no surface (no polygons); a muscle must be a closed triangle surface");
-        return 0;
+        fail(b, leaf.label + " has no surface (no polygons); a muscle must be a closed triangle surface");
+        continue;
       }
       motions.push_back(std::move(motion));
       cache.blockOf.push_back(b);
     }
     std::vector<md::Points> worldMuscles; // the rest pose as given: step 0 shows it exactly
     std::vector<const md::Points*> restPoints;
-    for (const md::MuscleMotion& motion : motions)
+    std::map<size_t, size_t> blockIndex; // block -> its entry in worldMuscles
+    for (size_t m = 0; m < motions.size(); ++m)
     {
-      worldMuscles.push_back(motion.muscle.points);
+      worldMuscles.push_back(motions[m].muscle.points);
+      blockIndex[cache.blockOf[m]] = m;
     }
     for (const md::Points& points : worldMuscles)
     {
@@ -291,6 +303,8 @@ int vtkInterpolatedMuscleDeformation::RequestData(
       frame.ToLocal(bone.rest.points);
       frame.ToLocal(bone.current);
     }
+    std::vector<md::MuscleMotion> matched; // the muscles whose lines could be matched
+    std::vector<size_t> matchedBlocks;
     for (size_t m = 0; m < motions.size(); ++m)
     {
       md::MuscleMotion& motion = motions[m];
@@ -311,30 +325,36 @@ int vtkInterpolatedMuscleDeformation::RequestData(
       }
       if (rest.empty())
       {
-        vtkErrorMacro(<< restLeaf.label << " has no polylines: muscle " << leaf.label
-                      << " needs its action lines, or nothing says where it goes");
-        return 0;
+        fail(b, restLeaf.label + " has no polylines: muscle " + leaf.label +
+            " needs its action lines, or nothing says where it goes");
+        continue;
       }
       if (rest.size() != current.size())
       {
-        vtkErrorMacro(<< restLeaf.label << " has " << rest.size() << " action lines but " << currentLeaf.label
-                      << " has " << current.size() << ": the lines of a muscle pair by order");
-        return 0;
+        fail(b, restLeaf.label + " has " + std::to_string(rest.size()) + " action lines but " + currentLeaf.label +
+            " has " + std::to_string(current.size()) + ": the lines of a muscle pair by order");
+        continue;
       }
       int result = 1;
+      std::string failure;
       if (!mdvtk::CallCore(this, "an action line of " + restLeaf.label + " or " + currentLeaf.label + ": ", [&] {
             for (size_t l = 0; l < rest.size(); ++l)
             {
-              const md::MatchedActionLines matched = md::MatchActionLines(rest[l], current[l], this->MatchingTolerance);
-              motion.lines.push_back({ matched.rest, matched.current });
+              const md::MatchedActionLines pair = md::MatchActionLines(rest[l], current[l], this->MatchingTolerance);
+              motion.lines.push_back({ pair.rest, pair.current });
             }
             for (const std::string& note : md::LimitActionLinePoints(motion.lines))
             {
               vtkWarningMacro(<< restLeaf.label << ": " << note);
             }
-          }, result))
+          }, result, &failure))
       {
-        return result;
+        if (failure.empty())
+        {
+          return result; // stopped by the user
+        }
+        fail(b, failure, true);
+        continue;
       }
       cache.lineMotions.emplace_back();
       for (const md::MatchedLine& line : motion.lines)
@@ -343,6 +363,8 @@ int vtkInterpolatedMuscleDeformation::RequestData(
           line.rest, line.current, static_cast<md::InterpolationMode>(this->BoneInterpolationMode));
       }
       cache.lineLeaf.push_back(restLinesOf[b]);
+      matched.push_back(std::move(motion));
+      matchedBlocks.push_back(b);
     }
 
     md::InterpolationParameters parameters;
@@ -358,8 +380,19 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     parameters.deformation.contactWeight = this->BoneContactWeight;
     parameters.hull.targetNumberOfPoints = this->HullTargetNumberOfPoints;
     parameters.hull.cancelled = mdvtk::AbortRequested(this);
+    motions = std::move(matched);
+    cache.blockOf = std::move(matchedBlocks);
+    restPoints.clear();
+    for (size_t b : cache.blockOf)
+    {
+      restPoints.push_back(&worldMuscles[blockIndex.at(b)]);
+    }
     int result = 1;
     if (!mdvtk::CallCore(this, "", [&] {
+          if (motions.empty())
+          {
+            throw md::InputError("no muscle could be deformed (see the errors above)");
+          }
           cache.result = md::DeformByInterpolation(
             motions, bones, parameters, mdvtk::ProgressOrCancel(this), this->KeptRest.get());
         }, result))
@@ -368,6 +401,13 @@ int vtkInterpolatedMuscleDeformation::RequestData(
       return result;
     }
     md::ResultToWorld(frame, restPoints, cache.result);
+    for (size_t m = 0; m < motions.size(); ++m)
+    {
+      if (!cache.result.failures[m].empty())
+      {
+        fail(cache.blockOf[m], muscles[cache.blockOf[m]].label + ": " + cache.result.failures[m]);
+      }
+    }
     cache.frame = frame;
     for (const md::BoneMotion& bone : bones)
     {
@@ -410,9 +450,31 @@ int vtkInterpolatedMuscleDeformation::RequestData(
   std::vector<vtkSmartPointer<vtkPolyData>> outputs(muscles.size());
   std::vector<std::string> names;                                  // Measures rows
   std::vector<std::pair<std::string, std::vector<double>>> columns; // Measures columns
+  std::vector<size_t> failedRows;                                  // muscles not deformed: NaN
+  std::map<size_t, size_t> muscleOfBlock;
   for (size_t m = 0; m < cache.blockOf.size(); ++m)
   {
-    const size_t b = cache.blockOf[m];
+    if (r.failures[m].empty())
+    {
+      muscleOfBlock[cache.blockOf[m]] = m;
+    }
+  }
+  for (size_t b = 0; b < muscles.size(); ++b)
+  {
+    const auto failed = cache.failedBlocks.find(b);
+    const auto found = muscleOfBlock.find(b);
+    if (failed == cache.failedBlocks.end() && found == muscleOfBlock.end())
+    {
+      continue; // an empty block
+    }
+    names.push_back(muscles[b].name.empty() ? muscles[b].label : muscles[b].name);
+    if (failed != cache.failedBlocks.end())
+    {
+      outputs[b] = mdvtk::FailedMuscle(muscles[b].data, failed->second);
+      failedRows.push_back(names.size() - 1);
+      continue;
+    }
+    const size_t m = found->second;
     const md::Points& points = r.points[step][m];
     const md::Points& rest = r.points[0][m];
     const md::MuscleStepMeasures& s = r.measures[step][m];
@@ -431,14 +493,14 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     vtkNew<vtkFieldData> fieldData;
     fieldData->DeepCopy(muscles[b].data->GetFieldData());
     // Each measure goes to the muscle's field data and to its row of the Measures table.
-    names.push_back(muscles[b].name.empty() ? muscles[b].label : muscles[b].name);
     size_t measureIndex = 0;
     auto measure = [&](const char* name, auto value) {
       mdvtk::AddFieldValue(fieldData, name, value);
-      if (m == 0)
+      if (columns.size() <= measureIndex)
       {
         columns.emplace_back(name, std::vector<double>());
       }
+      columns[measureIndex].second.resize(names.size() - 1, std::nan("")); // the failed rows before
       columns[measureIndex++].second.push_back(static_cast<double>(value));
     };
     measure("VolumeChangePercent", s.volumeChangePercent);
@@ -472,8 +534,14 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     muscleColumn->InsertNextValue(name);
   }
   table->AddColumn(muscleColumn);
-  for (const auto& [name, values] : columns)
+  columns.emplace_back(mdvtk::FailedArrayName, std::vector<double>(names.size(), 0.0));
+  for (size_t row : failedRows)
   {
+    columns.back().second[row] = 1;
+  }
+  for (auto& [name, values] : columns)
+  {
+    values.resize(names.size(), std::nan("")); // the failed rows after the last deformed one
     vtkNew<vtkDoubleArray> column;
     column->SetName(name.c_str());
     for (double value : values)

@@ -15,6 +15,7 @@
 #include <vtkPolyData.h>
 
 #include <algorithm>
+#include <map>
 
 vtkStandardNewMacro(vtkIntersectionResolve);
 
@@ -39,8 +40,10 @@ int vtkIntersectionResolve::FillInputPortInformation(int port, vtkInformation* i
 
 namespace
 {
-/// The meshes of the leaves (null leaves stay empty), checked.
-bool ReadLeafMeshes(const std::vector<mdvtk::Leaf>& leaves, std::vector<md::TriangleMesh>& meshes, std::string& error)
+/// The meshes of the leaves (null leaves stay empty), checked. A leaf that is no usable surface
+/// is an error, or with `failed` given, noted there (leaf -> why) while the others are read.
+bool ReadLeafMeshes(const std::vector<mdvtk::Leaf>& leaves, std::vector<md::TriangleMesh>& meshes, std::string& error,
+  std::map<size_t, std::string>* failed = nullptr)
 {
   meshes.resize(leaves.size());
   for (size_t b = 0; b < leaves.size(); ++b)
@@ -53,7 +56,11 @@ bool ReadLeafMeshes(const std::vector<mdvtk::Leaf>& leaves, std::vector<md::Tria
     if (meshes[b].triangles.rows() == 0)
     {
       error = leaves[b].label + " is not a usable surface: it has no triangles";
-      return false;
+      if (!failed)
+      {
+        return false;
+      }
+      (*failed)[b] = error;
     }
   }
   return true;
@@ -76,7 +83,8 @@ int vtkIntersectionResolve::RequestData(
   std::vector<std::string> obstacleNames, restObstacleNames;
   std::vector<md::TriangleMesh> obstacles, restObstacles;
   std::string error;
-  if (!mdvtk::CollectLeaves(input, "Input", leaves, error) || !ReadLeafMeshes(leaves, meshes, error) ||
+  std::map<size_t, std::string> failedBlocks; // one muscle's fault leaves the others to be resolved
+  if (!mdvtk::CollectLeaves(input, "Input", leaves, error) || !ReadLeafMeshes(leaves, meshes, error, &failedBlocks) ||
     !mdvtk::ReadMeshes(inputVector[1], "Obstacles", obstacleNames, obstacles, error) ||
     !mdvtk::ReadMeshes(inputVector[3], "ObstaclesRest", restObstacleNames, restObstacles, error))
   {
@@ -129,7 +137,7 @@ int vtkIntersectionResolve::RequestData(
   }
   for (size_t b = 0; b < leaves.size(); ++b)
   {
-    if (!leaves[b].data)
+    if (!leaves[b].data || failedBlocks.count(b))
     {
       continue;
     }
@@ -138,15 +146,23 @@ int vtkIntersectionResolve::RequestData(
       const md::TriangleMesh& rest = restMeshes[restOf[b]];
       if (rest.points.rows() != meshes[b].points.rows())
       {
-        vtkErrorMacro(<< restLeaves[restOf[b]].label << " has " << rest.points.rows() << " points but "
-                      << leaves[b].label << " has " << meshes[b].points.rows()
-                      << ": InputRest must be the Input in the rest pose, with the same points");
-        return 0;
+        failedBlocks[b] = restLeaves[restOf[b]].label + " has " + std::to_string(rest.points.rows()) +
+          " points but " + leaves[b].label + " has " + std::to_string(meshes[b].points.rows()) +
+          ": InputRest must be the Input in the rest pose, with the same points";
+        continue;
       }
       deformableRest.push_back({ rest.points, meshes[b].triangles });
     }
     deformable.push_back(meshes[b]);
     used.push_back(b);
+  }
+  for (const auto& [b, message] : failedBlocks)
+  {
+    vtkErrorMacro(<< message);
+  }
+  if (used.empty() && !failedBlocks.empty())
+  {
+    return 0; // nothing left to resolve, each failure said
   }
 
   // In the local frame of the meshes to resolve: the same answer wherever they sit, whatever
@@ -231,6 +247,10 @@ int vtkIntersectionResolve::RequestData(
     mdvtk::AddFieldValue(fieldData, "MaxNewPenetrationDepth", frame.LengthToWorld(left[k].maxDepth));
     output->SetFieldData(fieldData);
     outputs[b] = output;
+  }
+  for (const auto& [b, message] : failedBlocks)
+  {
+    outputs[b] = mdvtk::FailedMuscle(leaves[b].data, message);
   }
   mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), outputs, mdvtk::Role::Muscle);
   this->UpdateProgress(1.0);

@@ -153,6 +153,12 @@ int vtkMuscleDeformation::RequestData(
   std::vector<md::MuscleToDeform> toDeform;
   std::vector<size_t> blockOf;
   std::vector<double> hullSeconds(count, 0.0);
+  // One muscle's fault is reported and that muscle left out; the others go on.
+  std::map<size_t, std::string> failedBlocks;
+  auto fail = [&](size_t block, const std::string& message) {
+    vtkErrorMacro(<< message);
+    failedBlocks[block] = message;
+  };
   for (size_t b = 0; b < count; ++b)
   {
     const mdvtk::Leaf& leaf = muscles[b];
@@ -162,8 +168,8 @@ int vtkMuscleDeformation::RequestData(
     }
     if (leaf.data->GetNumberOfPolys() + leaf.data->GetNumberOfStrips() == 0)
     {
-      vtkErrorMacro(<< leaf.label << " has no surface (no polygons); a muscle must be a closed triangle surface");
-      return 0;
+      fail(b, leaf.label + " has no surface (no polygons); a muscle must be a closed triangle surface");
+      continue;
     }
     mdvtk::ReadTriangles(leaf.data, surfaces[b]); // coordinates checked finite by CollectLeaves
     md::MuscleToDeform muscle;
@@ -172,8 +178,8 @@ int vtkMuscleDeformation::RequestData(
     std::vector<std::string> notes;
     if (!ReadMatchedLines(lineLeaves[lineOf[b]], muscle.lines, notes, error))
     {
-      vtkErrorMacro(<< error << " (for " << leaf.label << ")");
-      return 0;
+      fail(b, error + " (for " + leaf.label + ")");
+      continue;
     }
     for (const std::string& note : notes)
     {
@@ -182,17 +188,27 @@ int vtkMuscleDeformation::RequestData(
     toDeform.push_back(std::move(muscle));
     blockOf.push_back(b);
   }
+  if (toDeform.empty() && !failedBlocks.empty())
+  {
+    return 0; // every muscle failed, each said why
+  }
+  // Failures from here on are per muscle to deform, reported as found.
+  std::vector<std::string> failures(toDeform.size());
+  auto failMuscle = [&](size_t m, const std::string& message) {
+    vtkErrorMacro(<< message);
+    failures[m] = message;
+  };
   if (hullGiven)
   {
-    for (size_t b : blockOf)
+    for (size_t m = 0; m < toDeform.size(); ++m)
     {
-      const mdvtk::Leaf& hullLeaf = hullLeaves[hullOf[b]];
+      const mdvtk::Leaf& hullLeaf = hullLeaves[hullOf[blockOf[m]]];
       if (!hullLeaf.data || hullLeaf.data->GetNumberOfPolys() == 0)
       {
-        vtkErrorMacro(<< hullLeaf.label << " has no surface");
-        return 0;
+        failMuscle(m, hullLeaf.label + " has no surface");
+        continue;
       }
-      mdvtk::ReadTriangles(hullLeaf.data, hulls[b]);
+      mdvtk::ReadTriangles(hullLeaf.data, hulls[blockOf[m]]);
     }
   }
 
@@ -245,6 +261,10 @@ int vtkMuscleDeformation::RequestData(
     {
       return 1; // stopped by the user: the executive empties the output
     }
+    if (!failures[m].empty())
+    {
+      continue;
+    }
     const auto hullStart = Clock::now();
     KeptMuscle& entry = kept.byBlock[b];
     if (!entry.Holds(surfaces[b], frame, hullGiven, hullGiven ? &hulls[b] : nullptr, this->HullTargetNumberOfPoints))
@@ -256,18 +276,19 @@ int vtkMuscleDeformation::RequestData(
         if (!md::CheckEdges(hulls[b].triangles).IsClosedOrientedManifold() ||
           md::SignedVolume(hulls[b].points, hulls[b].triangles) <= 0)
         {
-          vtkErrorMacro(<< hullLeaf.label
-                        << " is not a closed, outward-oriented manifold surface: build it with HullDecimation");
-          return 0;
+          failMuscle(m, hullLeaf.label + " is not a closed, outward-oriented manifold surface: build it with HullDecimation");
+          entry = KeptMuscle{};
+          continue;
         }
         const std::int64_t outside = md::CountPointsOutsideHull(hulls[b], surfaces[b], frame.rounding);
         if (outside > 0)
         {
-          vtkErrorMacro(<< hullLeaf.label << " does not enclose " << leaf.label << ": " << outside << " of "
-                        << md::UsedPoints(surfaces[b]).rows()
-                        << " muscle points are outside it, where mean value coordinates extrapolate; build the "
-                           "hull with HullDecimation or leave Hull empty");
-          return 0;
+          failMuscle(m, hullLeaf.label + " does not enclose " + leaf.label + ": " + std::to_string(outside) + " of " +
+            std::to_string(md::UsedPoints(surfaces[b]).rows()) +
+            " muscle points are outside it, where mean value coordinates extrapolate; build the "
+            "hull with HullDecimation or leave Hull empty");
+          entry = KeptMuscle{};
+          continue;
         }
         entry.hull = hulls[b];
       }
@@ -277,6 +298,7 @@ int vtkMuscleDeformation::RequestData(
         parameters.targetNumberOfPoints = this->HullTargetNumberOfPoints;
         parameters.cancelled = mdvtk::AbortRequested(this);
         int result = 1;
+        std::string failure;
         if (!mdvtk::CallCore(this, leaf.label + ": ", [&] {
               const md::MuscleHull built = md::BuildMuscleHull(surfaces[b], parameters);
               ++this->HullBuildCount;
@@ -285,12 +307,30 @@ int vtkMuscleDeformation::RequestData(
               {
                 entry.repairs = built.report.Describe();
               }
-            }, result))
+            }, result, &failure))
         {
-          return result;
+          if (failure.empty())
+          {
+            return result; // stopped by the user
+          }
+          failures[m] = failure; // reported
+          entry = KeptMuscle{};
+          continue;
         }
       }
-      entry.weights = md::MeanValueCoordinates(entry.hull, surfaces[b].points);
+      int result = 1;
+      std::string failure;
+      if (!mdvtk::CallCore(this, leaf.label + ": ",
+            [&] { entry.weights = md::MeanValueCoordinates(entry.hull, surfaces[b].points); }, result, &failure))
+      {
+        if (failure.empty())
+        {
+          return result; // stopped by the user
+        }
+        failures[m] = failure; // reported
+        entry = KeptMuscle{};
+        continue;
+      }
       entry.surface = surfaces[b];
       entry.frame = frame;
       entry.hullGiven = hullGiven;
@@ -315,12 +355,14 @@ int vtkMuscleDeformation::RequestData(
   parameters.preserveVolume = this->PreserveVolume;
   parameters.dynamicIntersections = this->DynamicIntersections;
   std::vector<md::DeformationResult> results;
+  const std::vector<std::string> reportedBefore = failures;
   int result = 1;
   if (!mdvtk::CallCore(this, "", [&] {
         const std::vector<md::Obstacle> obstacles = this->DynamicIntersections
           ? md::BuildObstacles(obstacleNames, obstacleMeshes)
           : std::vector<md::Obstacle>{};
-        results = md::DeformMuscles(toDeform, obstacles, parameters, mdvtk::ProgressOrCancel(this, 0.3, 0.7));
+        results =
+          md::DeformMusclesThatCan(toDeform, obstacles, parameters, failures, mdvtk::ProgressOrCancel(this, 0.3, 0.7));
       }, result))
   {
     return result;
@@ -331,6 +373,18 @@ int vtkMuscleDeformation::RequestData(
   for (size_t m = 0; m < results.size(); ++m)
   {
     const size_t b = blockOf[m];
+    if (!failures[m].empty())
+    {
+      if (reportedBefore[m].empty()) // the deformation's own failure, not said yet
+      {
+        fail(b, muscles[b].label + ": " + failures[m]);
+      }
+      else
+      {
+        failedBlocks[b] = failures[m];
+      }
+      continue;
+    }
     const md::DeformationResult& r = results[m];
     for (const std::string& warning : r.warnings)
     {
@@ -360,6 +414,10 @@ int vtkMuscleDeformation::RequestData(
     mdvtk::AddFieldValue(fieldData, "ElapsedSeconds", seconds);
     output->SetFieldData(fieldData);
     outputs[b] = output;
+  }
+  for (const auto& [b, message] : failedBlocks)
+  {
+    outputs[b] = mdvtk::FailedMuscle(muscles[b].data, message);
   }
   mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), outputs, mdvtk::Role::Muscle);
   this->UpdateProgress(1.0);

@@ -1,6 +1,7 @@
 #include "InterpolatedDeformation.h"
 
 #include "MeshChecks.h"
+#include "MuscleFailures.h"
 #include "VolumeConstrainedSolver.h"
 
 #include <Eigen/Cholesky>
@@ -106,21 +107,40 @@ void RelaxDetail(const Triangles& triangles, int iterations, Points& detail)
   }
 }
 
+/// What makes a muscle unusable before any work (empty when nothing does).
+std::string ProblemOf(const MuscleMotion& m)
+{
+  if (m.muscle.points.rows() == 0 || m.muscle.triangles.rows() == 0)
+  {
+    return "muscle '" + m.name + "' has no surface";
+  }
+  if (m.lines.empty())
+  {
+    return "muscle '" + m.name + "' has no action line: nothing says where it goes";
+  }
+  for (const MatchedLine& line : m.lines)
+  {
+    if (line.rest.rows() < 2 || line.rest.rows() != line.current.rows())
+    {
+      return "an action line of muscle '" + m.name +
+        "' is not matched: it needs at least two points, as many in the rest pose as in the current pose";
+    }
+  }
+  return {};
+}
+
 void Validate(const std::vector<MuscleMotion>& muscles, const std::vector<BoneMotion>& bones)
 {
   if (muscles.empty())
   {
     throw InputError("there is no muscle to deform");
   }
-  for (const MuscleMotion& m : muscles)
+  for (size_t i = 0; i < muscles.size(); ++i)
   {
-    if (m.muscle.points.rows() == 0 || m.muscle.triangles.rows() == 0)
+    const std::string problem = ProblemOf(muscles[i]);
+    if (!problem.empty())
     {
-      throw InputError("muscle '" + m.name + "' has no surface");
-    }
-    if (m.lines.empty())
-    {
-      throw InputError("muscle '" + m.name + "' has no action line: nothing says where it goes");
+      throw OfMuscle(InputError(problem), i);
     }
   }
   for (const BoneMotion& b : bones)
@@ -270,12 +290,14 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   {
     for (const MatchedLine& line : muscles[m].lines)
     {
-      if (line.rest.rows() < 2 || line.rest.rows() != line.current.rows())
+      try
       {
-        throw InputError("an action line of muscle '" + muscles[m].name +
-          "' is not matched: it needs at least two points, as many in the rest pose as in the current pose");
+        lineMotions[m].emplace_back(line.rest, line.current, parameters.interpolationMode);
       }
-      lineMotions[m].emplace_back(line.rest, line.current, parameters.interpolationMode);
+      catch (Error& e)
+      {
+        throw OfMuscle(InputError(std::string("an action line of muscle '") + muscles[m].name + "': " + e.what()), m);
+      }
     }
   }
 
@@ -310,17 +332,26 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       entry.hull = parameters.hull;
       entry.hull.cancelled = nullptr;
       entry.restHull = std::move(built[m]);
-      entry.weights = MeanValueCoordinates(entry.restHull, muscles[m].muscle.points);
+      try
+      {
+        entry.weights = MeanValueCoordinates(entry.restHull, muscles[m].muscle.points);
+      }
+      catch (const InputError& e)
+      {
+        errors[m] = "muscle '" + muscles[m].name + "': " + e.what();
+        entry = RestMappingCache::Entry{};
+        continue;
+      }
       ++rest.hullBuildCount;
       result.restHullSeconds[m] += SecondsSince(mappingStart);
     }
     report(0.15 * (m + 1) / count);
   }
-  for (const std::string& error : errors)
+  for (size_t m = 0; m < count; ++m)
   {
-    if (!error.empty())
+    if (!errors[m].empty())
     {
-      throw InputError(error);
+      throw OfMuscle(InputError(errors[m]), m);
     }
   }
   // Rebuild replaces hulls and weights; Refit moves only the hull's points.
@@ -534,7 +565,10 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
 }
 }
 
-InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscles,
+namespace
+{
+/// DeformByInterpolation of every muscle or none: throws what the first failure throws.
+InterpolationResult DeformEveryMuscle(const std::vector<MuscleMotion>& muscles,
   const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters,
   const std::function<void(double)>& progress, RestMappingCache* kept)
 {
@@ -567,6 +601,76 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
 
   InterpolationResult result = DeformInLocalFrame(localMuscles, localBones, local, progress, kept);
   ResultToWorld(frame, restPoints, result);
+  return result;
+}
+}
+
+InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscles,
+  const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters,
+  const std::function<void(double)>& progress, RestMappingCache* kept)
+{
+  // A muscle that fails is left out and the method runs again on the others, exactly as if it
+  // had not been given; the rest hulls built so far are kept. What is wrong with a muscle's own
+  // input is found first, so that the local frame and the kept hulls are those of the muscles
+  // that can go.
+  const size_t count = muscles.size();
+  RestMappingCache scratch;
+  RestMappingCache& cache = kept ? *kept : scratch;
+  cache.muscles.resize(count);
+  std::vector<std::string> failures(count);
+  std::transform(muscles.begin(), muscles.end(), failures.begin(), ProblemOf);
+  const std::function<void(double)> forward = ForwardOnly(progress);
+  InterpolationResult result = WithoutFailedMuscles(failures, [&](const std::vector<size_t>& active) {
+    std::vector<MuscleMotion> subset;
+    RestMappingCache subCache;
+    subCache.hullBuildCount = cache.hullBuildCount;
+    for (size_t m : active)
+    {
+      subset.push_back(muscles[m]);
+      subCache.muscles.push_back(std::move(cache.muscles[m]));
+    }
+    auto keep = [&] {
+      for (size_t k = 0; k < active.size(); ++k)
+      {
+        cache.muscles[active[k]] = std::move(subCache.muscles[k]);
+      }
+      cache.hullBuildCount = subCache.hullBuildCount;
+    };
+    InterpolationResult some;
+    try
+    {
+      some = DeformEveryMuscle(subset, bones, parameters, forward, &subCache);
+    }
+    catch (...)
+    {
+      keep();
+      throw;
+    }
+    keep();
+    if (active.size() == count)
+    {
+      return some;
+    }
+    // Back to the order of all muscles; a failed one has no points and default measures.
+    InterpolationResult all = some;
+    all.restHullSeconds.assign(count, 0.0);
+    for (size_t j = 0; j < some.points.size(); ++j)
+    {
+      all.points[j].assign(count, Points(0, 3));
+      all.measures[j].assign(count, MuscleStepMeasures{});
+      for (size_t k = 0; k < active.size(); ++k)
+      {
+        all.points[j][active[k]] = std::move(some.points[j][k]);
+        all.measures[j][active[k]] = std::move(some.measures[j][k]);
+      }
+    }
+    for (size_t k = 0; k < active.size(); ++k)
+    {
+      all.restHullSeconds[active[k]] = some.restHullSeconds[k];
+    }
+    return all;
+  });
+  result.failures = std::move(failures);
   return result;
 }
 

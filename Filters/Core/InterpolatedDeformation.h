@@ -130,6 +130,9 @@ struct InterpolationResult
   std::vector<double> stepSeconds;                  ///< [step], 0 for step 0
   double totalSeconds = 0;
   std::vector<std::string> warnings;
+  /// Per muscle: empty, or why it could not be deformed (its points are then empty at every
+  /// step, its measures the defaults): the others were deformed without it.
+  std::vector<std::string> failures;
 };
 
 /// The rest-pose hull of every muscle and the mean value coordinates of its points in it, kept
@@ -155,7 +158,10 @@ struct RestMappingCache
 int ResolveNumberOfSteps(const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters);
 
 /// Runs the whole method, in the muscles' LocalFrame (lengths in `parameters` and in the result
-/// in the data's units). Throws InputError naming the muscle or bone for input it cannot use.
+/// in the data's units). A muscle that cannot be deformed (no surface or action line, no hull, a
+/// deformation that diverges) is left out and named in `failures`; the others are deformed as if it
+/// had not been given. Throws InputError naming the bone for input it cannot use, and
+/// InputError or ComputationError when no muscle can be deformed.
 /// `progress` (optional) receives fractions in [0, 1]. `kept` (optional) holds the rest-pose hulls
 /// and mappings of an earlier run, used where they still hold and updated.
 InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscles,

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -34,7 +35,21 @@ class Error : public std::runtime_error
 {
 public:
   using std::runtime_error::runtime_error;
+  /// Set when the failure is one muscle's alone (its index among the muscles of the call): a
+  /// caller can then go on without that muscle (DeformByInterpolation does).
+  std::optional<size_t> muscle;
 };
+
+/// `error`, marked as muscle `index`'s own, unless it is already marked.
+template <class E>
+E OfMuscle(E error, size_t index)
+{
+  if (!error.muscle)
+  {
+    error.muscle = index;
+  }
+  return error;
+}
 
 /// Thrown when input data cannot be used.
 class InputError : public Error

@@ -1,6 +1,7 @@
 #include "MuscleDeformer.h"
 
 #include "MeshChecks.h"
+#include "MuscleFailures.h"
 #include "RigidMotion.h"
 #include "VolumeConstrainedSolver.h"
 
@@ -1072,6 +1073,15 @@ std::int64_t CountInsideTree(const TriangleTree& tree, const Points& points)
   return inside;
 }
 
+namespace
+{
+/// The index of a muscle's state among the muscles of the call.
+size_t IndexOf(const MuscleState& s, const std::vector<MuscleToDeform>& muscles)
+{
+  return static_cast<size_t>(s.input - muscles.data());
+}
+}
+
 std::vector<Obstacle> BuildObstacles(const std::vector<std::string>& names, const std::vector<TriangleMesh>& meshes)
 {
   std::vector<Obstacle> obstacles(meshes.size());
@@ -1125,22 +1135,30 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
     const auto start = Clock::now();
     MuscleState& s = states[m];
     s.input = &muscles[m];
-    Validate(muscles[m]);
-    const Points used = UsedPoints(*muscles[m].muscle);
-    for (const Obstacle& bone : bones)
+    try
     {
-      if (EntirelyInside(*bone.tree, used))
+      Validate(muscles[m]);
+      const Points used = UsedPoints(*muscles[m].muscle);
+      for (const Obstacle& bone : bones)
       {
-        throw InputError("muscle '" + muscles[m].name + "' lies entirely inside obstacle '" + bone.name +
-          "' before it moves: are the obstacles in the current pose, in the same units as the muscle?");
+        if (EntirelyInside(*bone.tree, used))
+        {
+          throw InputError("muscle '" + muscles[m].name + "' lies entirely inside obstacle '" + bone.name +
+            "' before it moves: are the obstacles in the current pose, in the same units as the muscle?");
+        }
+      }
+      SetUp(s, parameters);
+      report((m + 0.3) * share * 0.5);
+      RunCoarsePhase(s, parameters);
+      if (parameters.contactWeight > 0 && parameters.dynamicIntersections && !bones.empty()) // pushed by bones
+      {
+        PushOffBones(s, bones, parameters);
       }
     }
-    SetUp(s, parameters);
-    report((m + 0.3) * share * 0.5);
-    RunCoarsePhase(s, parameters);
-    if (parameters.contactWeight > 0 && parameters.dynamicIntersections && !bones.empty()) // pushed by bones
+    catch (Error& e)
     {
-      PushOffBones(s, bones, parameters);
+      e.muscle = e.muscle.value_or(m); // this muscle's alone
+      throw;
     }
     s.time += Clock::now() - start;
     report((m + 1) * share * 0.5);
@@ -1164,9 +1182,9 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
     // hull point far off that hardly weighs on the muscle is no harm.)
     if (Growth(s) > maximumGrowth)
     {
-      throw ComputationError("the deformation of muscle '" + s.input->name + "' diverged on its hull: the muscle spans " +
+      throw OfMuscle(ComputationError("the deformation of muscle '" + s.input->name + "' diverged on its hull: the muscle spans " +
         std::to_string(Growth(s)) + " times its starting size after " +
-        std::to_string(s.result.coarseIterations) + " iterations");
+        std::to_string(s.result.coarseIterations) + " iterations"), IndexOf(s, muscles));
     }
     if (parameters.dynamicIntersections)
     {
@@ -1275,7 +1293,8 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
       }
       if (!next.allFinite())
       {
-        throw ComputationError("the deformation of muscle '" + s.input->name + "' diverged on its full mesh");
+        throw OfMuscle(ComputationError("the deformation of muscle '" + s.input->name + "' diverged on its full mesh"),
+          IndexOf(s, muscles));
       }
       const Points change = next - s.hull;
       const double largest = change.cwiseAbs().maxCoeff();
@@ -1381,10 +1400,10 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
       if (!s.fellBack && ((parameters.preserveVolume && std::abs(r.volumeChangePercent) > 10.0) ||
         Growth(s) > maximumGrowth))
       {
-        throw ComputationError("the deformation of muscle '" + s.input->name + "' diverged: after " +
+        throw OfMuscle(ComputationError("the deformation of muscle '" + s.input->name + "' diverged: after " +
           std::to_string(parameters.maximumIterations) + " iterations its volume is off by " +
           std::to_string(r.volumeChangePercent) + " % and it spans " +
-          std::to_string(Growth(s)) + " times its starting size");
+          std::to_string(Growth(s)) + " times its starting size"), IndexOf(s, muscles));
       }
       if (!s.fellBack)
       {
@@ -1398,5 +1417,27 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
   }
   report(1.0);
   return results;
+}
+
+std::vector<DeformationResult> DeformMusclesThatCan(const std::vector<MuscleToDeform>& muscles,
+  const std::vector<Obstacle>& bones, const DeformationParameters& parameters, std::vector<std::string>& failures,
+  const std::function<void(double)>& progress)
+{
+  failures.resize(muscles.size());
+  const std::function<void(double)> forward = ForwardOnly(progress);
+  return WithoutFailedMuscles(failures, [&](const std::vector<size_t>& active) {
+    std::vector<MuscleToDeform> subset;
+    for (size_t m : active)
+    {
+      subset.push_back(muscles[m]);
+    }
+    std::vector<DeformationResult> some = DeformMuscles(subset, bones, parameters, forward);
+    std::vector<DeformationResult> all(muscles.size());
+    for (size_t k = 0; k < active.size(); ++k)
+    {
+      all[active[k]] = std::move(some[k]);
+    }
+    return all;
+  });
 }
 }

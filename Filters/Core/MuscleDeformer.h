@@ -161,6 +161,15 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
   const std::vector<Obstacle>& bones, const DeformationParameters& parameters,
   const std::function<void(double)>& progress = {});
 
+/// DeformMuscles of every muscle that can be deformed: a muscle whose failure is its own (see
+/// DeformMuscles) is left out, `failures[m]` (one per muscle; those not empty on entry are left out
+/// from the start) says why, its result has no points, and the others are deformed as if it had
+/// not been given. Throws what DeformMuscles throws for every muscle's failure (an obstacle's) and
+/// when no muscle can be deformed.
+std::vector<DeformationResult> DeformMusclesThatCan(const std::vector<MuscleToDeform>& muscles,
+  const std::vector<Obstacle>& bones, const DeformationParameters& parameters, std::vector<std::string>& failures,
+  const std::function<void(double)>& progress = {});
+
 /// Lines of more than `maximumPoints` points (a path sampled densely, a scanned centreline) are
 /// cut down to `maximumPoints`, keeping the points that deviate most from the kept line in either
 /// pose (greedy Douglas-Peucker on both poses at once), so that the action-line rows, which grow

@@ -26,18 +26,17 @@ std::uint64_t EdgeKey(std::int64_t a, std::int64_t b)
   return (lo << 32) | hi;
 }
 
-struct CoordinateHash
+/// Points of a surface closer than this fraction of its size are one point (rounding noise, e.g. a
+/// scan's duplicate points exported in float or moved by 1e-7; scans' point spacing is ~1e-2 of
+/// their size).
+constexpr double kMergeTolerance = 1e-5;
+
+/// The diagonal of the bounding box of the points the triangles use.
+double UsedBoundingBoxDiagonal(const TriangleMesh& surface)
 {
-  size_t operator()(const std::array<double, 3>& p) const
-  {
-    size_t h = 0;
-    for (double c : p)
-    {
-      h = h * 1000003u ^ std::hash<double>()(c);
-    }
-    return h;
-  }
-};
+  const Points used = UsedPoints(surface);
+  return used.rows() > 0 ? (used.colwise().maxCoeff() - used.colwise().minCoeff()).norm() : 0.0;
+}
 
 struct TriangleHash
 {
@@ -426,24 +425,103 @@ void RemoveEnclosedPieces(TriangleMesh& mesh, RepairReport& report)
 
 using Pairing = std::map<std::pair<int, std::uint64_t>, int>; // (triangle, edge) -> triangle
 
-/// Merges points at identical coordinates (`representative`: each input
-/// point's surviving twin) and drops degenerate, duplicate and back-to-back triangles.
-std::vector<Triangle> MergeAndDeduplicate(
-  const TriangleMesh& surface, std::vector<std::int64_t>& representative, RepairReport& report)
+/// For every point, the smallest index among the points used by `triangles` that are joined to it by
+/// steps shorter than `tolerance` (itself when there is none): the representative of its cluster,
+/// whatever the order of the points. A grid of cells `tolerance` wide finds the pairs.
+std::vector<std::int64_t> ClusterNearPoints(const Points& points, const Triangles& triangles, double tolerance)
 {
-  const auto pointCount = static_cast<std::int64_t>(surface.points.rows());
-  // Merge points at identical coordinates.
-  representative.assign(static_cast<size_t>(pointCount), 0);
+  const auto pointCount = static_cast<std::int64_t>(points.rows());
+  std::vector<std::int64_t> root(static_cast<size_t>(pointCount));
+  std::iota(root.begin(), root.end(), std::int64_t{ 0 });
+  std::vector<char> used(static_cast<size_t>(pointCount), 0);
+  for (Eigen::Index i = 0; i < triangles.size(); ++i)
   {
-    std::unordered_map<std::array<double, 3>, std::int64_t, CoordinateHash> first;
-    first.reserve(static_cast<size_t>(pointCount));
-    for (std::int64_t i = 0; i < pointCount; ++i)
+    used[triangles.data()[i]] = 1;
+  }
+  auto find = [&](std::int64_t i) {
+    while (root[i] != i)
     {
-      const std::array<double, 3> key{ surface.points(i, 0), surface.points(i, 1), surface.points(i, 2) };
-      auto inserted = first.emplace(key, i);
-      representative[i] = inserted.first->second;
+      root[i] = root[root[i]];
+      i = root[i];
+    }
+    return i;
+  };
+  using Cell = std::array<std::int64_t, 3>;
+  struct CellHash
+  {
+    size_t operator()(const Cell& c) const
+    {
+      return static_cast<size_t>(c[0]) * 73856093u ^ static_cast<size_t>(c[1]) * 19349663u ^
+        static_cast<size_t>(c[2]) * 83492791u;
+    }
+  };
+  std::unordered_map<Cell, std::vector<std::int64_t>, CellHash> grid;
+  auto cellOf = [&](std::int64_t i) {
+    Cell c;
+    for (int k = 0; k < 3; ++k)
+    {
+      c[k] = static_cast<std::int64_t>(std::floor(points(i, k) / tolerance));
+    }
+    return c;
+  };
+  for (std::int64_t i = 0; i < pointCount; ++i)
+  {
+    if (used[i])
+    {
+      grid[cellOf(i)].push_back(i);
     }
   }
+  for (std::int64_t i = 0; i < pointCount; ++i)
+  {
+    if (!used[i])
+    {
+      continue;
+    }
+    const Cell c = cellOf(i);
+    for (std::int64_t dx = -1; dx <= 1; ++dx)
+      for (std::int64_t dy = -1; dy <= 1; ++dy)
+        for (std::int64_t dz = -1; dz <= 1; ++dz)
+        {
+          const auto found = grid.find({ c[0] + dx, c[1] + dy, c[2] + dz });
+          if (found == grid.end())
+          {
+            continue;
+          }
+          for (std::int64_t j : found->second)
+          {
+            if (j > i && (points.row(i) - points.row(j)).squaredNorm() < tolerance * tolerance)
+            {
+              const std::int64_t a = find(i), b = find(j);
+              root[std::max(a, b)] = std::min(a, b);
+            }
+          }
+        }
+  }
+  for (std::int64_t i = 0; i < pointCount; ++i)
+  {
+    root[i] = find(i);
+  }
+  return root;
+}
+
+/// Merges points closer than `tolerance` (`representative`: each input point's surviving twin, the
+/// lowest index of its cluster; the merged points at other coordinates are added to
+/// report.pointsToEnclose) and drops degenerate, duplicate and back-to-back triangles.
+std::vector<Triangle> MergeAndDeduplicate(const TriangleMesh& surface, double tolerance,
+  std::vector<std::int64_t>& representative, RepairReport& report)
+{
+  const auto pointCount = static_cast<std::int64_t>(surface.points.rows());
+  representative = ClusterNearPoints(surface.points, surface.triangles, tolerance);
+  std::vector<Eigen::RowVector3d> movedByMerge;
+  for (std::int64_t i = 0; i < pointCount; ++i)
+  {
+    if (representative[i] != i && surface.points.row(i) != surface.points.row(representative[i]))
+    {
+      ++report.nearDuplicatePointsMerged;
+      movedByMerge.push_back(surface.points.row(i));
+    }
+  }
+  AppendRows(report.pointsToEnclose, movedByMerge);
   std::vector<bool> used(static_cast<size_t>(pointCount), false);
   std::vector<bool> mergedAway(static_cast<size_t>(pointCount), false);
   std::vector<Triangle> triangles;
@@ -834,6 +912,12 @@ std::string RepairReport::Describe() const
   };
   say(unusedPointsRemoved, "removed unused points:");
   say(duplicatePointsMerged, "merged duplicate points:");
+  if (nearDuplicatePointsMerged > 0)
+  {
+    out << separator << "of them " << nearDuplicatePointsMerged << " closer than " << mergeTolerance
+        << " (1e-5 of the surface's size) but not at the same coordinates";
+    separator = ", ";
+  }
   say(degenerateTrianglesRemoved, "removed degenerate triangles:");
   say(duplicateTrianglesRemoved, "removed duplicate triangles:");
   say(finTrianglesRemoved, "removed back-to-back triangles (fins of no thickness):");
@@ -870,8 +954,10 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
       }
     }
   }
+  const double size = UsedBoundingBoxDiagonal(surface);
+  report.mergeTolerance = kMergeTolerance * size;
   std::vector<std::int64_t> representative;
-  std::vector<Triangle> triangles = MergeAndDeduplicate(surface, representative, report);
+  std::vector<Triangle> triangles = MergeAndDeduplicate(surface, report.mergeTolerance, representative, report);
   if (triangles.size() < 4)
   {
     throw InputError("the surface has fewer than 4 usable triangles once degenerate, duplicate and "
@@ -882,7 +968,6 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
   int parts = 0;
   const std::vector<int> part = OrientConsistently(triangles, edges, parts, report);
   Points points = surface.points;
-  const double size = (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
   const Pairing pairing = PairTrianglesAtPinches(points, triangles, edges, report);
   SplitPinchedPoints(points, triangles, edges, pairing, surface.points, 1e-6 * size, report);
   TriangleMesh out = Compact(points, triangles, surface, representative, report);

@@ -11,7 +11,9 @@ namespace md
 struct RepairReport
 {
   std::int64_t unusedPointsRemoved = 0;
-  std::int64_t duplicatePointsMerged = 0;     ///< points at exactly the same coordinates
+  std::int64_t duplicatePointsMerged = 0;     ///< points closer than mergeTolerance to another
+  std::int64_t nearDuplicatePointsMerged = 0; ///< of them, those not at the same coordinates
+  double mergeTolerance = 0;                  ///< 1e-5 of the surface's size
   std::int64_t degenerateTrianglesRemoved = 0; ///< triangles repeating a point
   std::int64_t duplicateTrianglesRemoved = 0;
   std::int64_t finTrianglesRemoved = 0;        ///< back-to-back pairs on the same points
@@ -38,7 +40,9 @@ struct RepairReport
   std::string Describe() const;
 };
 
-/// A closed, manifold, outward-oriented copy of `surface`. Non-manifold edges
+/// A closed, manifold, outward-oriented copy of `surface`. Points closer than 1e-5 of the
+/// surface's size (its bounding box's diagonal) are merged into one, the one of lowest index, so
+/// that rounding noise cannot open a scan along its duplicate points. Non-manifold edges
 /// (two sheets pinched along an edge) are cut apart: the triangles around the
 /// edge are paired so that each pair bounds one lobe, and every point whose
 /// triangles then form several fans gets a copy per fan, moved by a tiny

@@ -21,18 +21,23 @@ struct MotionCase
 
 /// The case with every coordinate rounded to float (as VTK pipelines with
 /// float points carry them) and, for seed > 0, first moved by a pseudo-random
-/// amount of that size (up to 1e-7 of the coordinate, a function of the
-/// value and the seed, so that equal coordinates stay equal): how much the
-/// results depend on such perturbations.
-inline MotionCase Perturbed(MotionCase c, int seed)
+/// amount of that size (up to 1e-7 of the coordinate). By default the move is
+/// a function of the value and the seed, so that equal coordinates stay equal
+/// (a scan's duplicate points stay duplicates); with `splitDuplicates` it is a
+/// function of the coordinate's place, so that they part by about 1e-7: how
+/// much the results depend on such perturbations.
+inline MotionCase Perturbed(MotionCase c, int seed, bool splitDuplicates = false)
 {
+  int array = 0;
   auto perturb = [&](md::Points& points) {
+    ++array;
     for (Eigen::Index i = 0; i < points.size(); ++i)
     {
       double& x = points.data()[i];
       if (seed > 0)
       {
-        std::seed_seq sequence{ static_cast<int>(std::hash<double>{}(x)), seed };
+        const int key = splitDuplicates ? static_cast<int>(i) * 131 + array : static_cast<int>(std::hash<double>{}(x));
+        std::seed_seq sequence{ key, seed };
         std::mt19937 random(sequence);
         x *= 1 + 1e-7 * std::uniform_real_distribution<double>(-1.0, 1.0)(random);
       }

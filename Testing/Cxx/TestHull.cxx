@@ -201,6 +201,67 @@ TEST(SurfaceRepair, UndoesAFoldAndRemembersWhereThePointsWere)
   EXPECT_GE(report.pointsToEnclose.rows(), 1);
 }
 
+namespace
+{
+/// A sphere cut open along a seam: the triangles of its x > 0 half use copies of their points,
+/// moved by `split` (a fraction of the sphere's size) in a direction of their own, as a scan
+/// exported in pieces, or in float, carries them.
+TriangleMesh SphereWithASeam(double split)
+{
+  TriangleMesh sphere = Sphere(Eigen::Vector3d(100, 50, 20), 10, 3);
+  const Eigen::Index n = sphere.points.rows();
+  std::vector<Eigen::Index> copyOf(static_cast<size_t>(n), -1);
+  for (Eigen::Index t = 0; t < sphere.triangles.rows(); ++t)
+  {
+    Eigen::RowVector3d centroid = Eigen::RowVector3d::Zero();
+    for (int k = 0; k < 3; ++k)
+    {
+      centroid += sphere.points.row(sphere.triangles(t, k)) / 3.0;
+    }
+    if (centroid.x() <= 100)
+    {
+      continue;
+    }
+    for (int k = 0; k < 3; ++k)
+    {
+      Eigen::Index& copy = copyOf[sphere.triangles(t, k)];
+      if (copy < 0)
+      {
+        copy = sphere.points.rows();
+        sphere.points.conservativeResize(copy + 1, 3);
+        const double angle = 0.7 * static_cast<double>(copy);
+        sphere.points.row(copy) = sphere.points.row(sphere.triangles(t, k)) +
+          split * 20 * Eigen::RowVector3d(std::cos(angle), std::sin(angle), 0.5).normalized();
+      }
+      sphere.triangles(t, k) = copy;
+    }
+  }
+  return sphere;
+}
+}
+
+// Rounding noise must not open a scan along its duplicate points: points closer than 1e-5 of
+// the surface's size are one point (and the hull encloses both); farther apart they are not.
+TEST(SurfaceRepair, MergesPointsRoundingNoiseSplitAndSaysSo)
+{
+  for (double split : { 0.0, 1e-7, 5e-6 })
+  {
+    SCOPED_TRACE(split);
+    const TriangleMesh seam = SphereWithASeam(split);
+    md::RepairReport report;
+    const TriangleMesh clean = md::RepairClosedSurface(seam, report);
+    EXPECT_TRUE(md::CheckEdges(clean.triangles).IsClosedOrientedManifold());
+    EXPECT_GT(report.duplicatePointsMerged, 10);
+    EXPECT_EQ(report.nearDuplicatePointsMerged, split > 0 ? report.duplicatePointsMerged : 0);
+    EXPECT_NEAR(report.mergeTolerance, 1e-5 * 20 * std::sqrt(3.0), 1e-5); // of the box's diagonal
+    EXPECT_EQ(report.Describe().find("closer than") != std::string::npos, split > 0) << report.Describe();
+    const md::MuscleHull hull = md::BuildMuscleHull(seam, md::HullParameters{ 100 });
+    EXPECT_EQ(md::CountOutside(hull.result.hull, md::UsedPoints(seam), 0.0), 0);
+  }
+  md::RepairReport report;
+  EXPECT_THROW(md::RepairClosedSurface(SphereWithASeam(1e-4), report), md::InputError); // a real gap
+}
+
 TEST(SurfaceRepair, RefusesWhatCannotBeRepaired)
 {
   TriangleMesh box = Box({ 0, 0, 0 }, { 1, 1, 1 });

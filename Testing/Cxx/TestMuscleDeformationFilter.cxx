@@ -6,7 +6,9 @@
 
 #include "vtkActionLineMatching.h"
 #include "vtkBoneInterpolation.h"
+#include "vtkHullDecimation.h"
 #include "vtkInterpolatedMuscleDeformation.h"
+#include "vtkIntersectionResolve.h"
 #include "vtkMuscleDeformation.h"
 #include "vtkMusculoskeletalPhantom.h"
 
@@ -14,11 +16,15 @@
 #include <vtkCommand.h>
 #include <vtkDataArray.h>
 #include <vtkFieldData.h>
+#include <vtkIdList.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
+#include <vtkStringArray.h>
 #include <vtkTable.h>
 #include <vtkVariant.h>
 
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace
 {
@@ -341,5 +347,115 @@ TEST(InterpolatedMuscleDeformationFilter, OutputsTheBonesAndActionLinesOfTheSame
         vtkPolyData::SafeDownCast(muscles->GetBlock(b))->GetFieldData()->GetArray(name)->GetTuple1(0))
         << name;
     }
+  }
+}
+
+namespace
+{
+/// The phantom's muscles with muscle `broken` opened (its last triangle taken away, or with
+/// `keep` 0 all of them): no hull can enclose it.
+vtkSmartPointer<vtkMultiBlockDataSet> MusclesWithAHole(
+  vtkMusculoskeletalPhantom* phantom, unsigned int broken, vtkIdType keep = -1)
+{
+  phantom->Update();
+  auto muscles = vtkSmartPointer<vtkMultiBlockDataSet>::New();
+  muscles->DeepCopy(phantom->GetOutputDataObject(vtkMusculoskeletalPhantom::MUSCLES));
+  auto* block = vtkPolyData::SafeDownCast(muscles->GetBlock(broken));
+  vtkNew<vtkCellArray> polys;
+  keep = keep < 0 ? block->GetNumberOfPolys() - 1 : keep;
+  for (vtkIdType c = 0; c < keep; ++c)
+  {
+    vtkNew<vtkIdList> ids;
+    block->GetCellPoints(c, ids);
+    polys->InsertNextCell(ids);
+  }
+  block->SetPolys(polys);
+  return muscles;
+}
+
+/// Every muscle computed but `broken`, which is an empty block flagged with why.
+void ExpectOnlyTheBrokenMuscleFailed(
+  vtkDataObject* output, unsigned int broken, CapturedMessages& messages, const std::string& why = "open")
+{
+  auto* tree = vtkMultiBlockDataSet::SafeDownCast(output);
+  ASSERT_NE(tree, nullptr);
+  ASSERT_EQ(tree->GetNumberOfBlocks(), 3u);
+  const std::string name = BlockName(tree, broken);
+  EXPECT_TRUE(messages.Contains("ERROR")) << messages.Text();
+  EXPECT_TRUE(messages.Contains(name)) << messages.Text();
+  EXPECT_TRUE(messages.Contains(why)) << messages.Text();
+  for (unsigned int k = 0; k < 3; ++k)
+  {
+    SCOPED_TRACE(BlockName(tree, k));
+    auto* block = vtkPolyData::SafeDownCast(tree->GetBlock(k));
+    ASSERT_NE(block, nullptr);
+    vtkDataArray* failed = block->GetFieldData()->GetArray("DeformationFailed");
+    if (k != broken)
+    {
+      EXPECT_GT(block->GetNumberOfPoints(), 0);
+      EXPECT_EQ(failed, nullptr);
+      continue;
+    }
+    EXPECT_EQ(block->GetNumberOfPoints(), 0);
+    ASSERT_NE(failed, nullptr);
+    EXPECT_EQ(failed->GetTuple1(0), 1.0);
+    auto* message = vtkStringArray::SafeDownCast(block->GetFieldData()->GetAbstractArray("FailureMessage"));
+    ASSERT_NE(message, nullptr);
+    EXPECT_NE(message->GetValue(0).find(why), std::string::npos) << message->GetValue(0);
+  }
+}
+}
+
+// One muscle no hull can be built for is reported by name and flagged in its block; the other
+// muscles of the input are computed, by every filter that takes muscles.
+TEST(MuscleFilters, OneBadMuscleDoesNotTakeTheOthersDown)
+{
+  PhantomPipeline pipeline;
+  const unsigned int broken = 1;
+  vtkSmartPointer<vtkMultiBlockDataSet> muscles = MusclesWithAHole(pipeline.phantom, broken);
+  {
+    vtkNew<vtkHullDecimation> f;
+    f->SetInputDataObject(0, muscles);
+    f->SetTargetNumberOfPoints(100);
+    CapturedMessages messages;
+    f->Update();
+    ExpectOnlyTheBrokenMuscleFailed(f->GetOutputDataObject(0), broken, messages);
+  }
+  {
+    vtkNew<vtkMuscleDeformation> f;
+    pipeline.Connect(f);
+    f->SetInputDataObject(0, muscles);
+    CapturedMessages messages;
+    f->Update();
+    ExpectOnlyTheBrokenMuscleFailed(f->GetOutputDataObject(0), broken, messages);
+  }
+  {
+    vtkNew<vtkInterpolatedMuscleDeformation> f;
+    pipeline.Connect(f);
+    f->SetInputDataObject(0, muscles);
+    f->SetNumberOfSteps(2);
+    CapturedMessages messages;
+    f->Update();
+    ExpectOnlyTheBrokenMuscleFailed(f->GetOutputDataObject(0), broken, messages);
+    // The measures table has every muscle's row: the failed one's NaN, and flagged.
+    vtkTable* table = vtkTable::SafeDownCast(f->GetOutputDataObject(3));
+    ASSERT_EQ(table->GetNumberOfRows(), 3);
+    vtkAbstractArray* flag = table->GetColumnByName("DeformationFailed");
+    vtkAbstractArray* volume = table->GetColumnByName("VolumeChangePercent");
+    ASSERT_NE(flag, nullptr);
+    ASSERT_NE(volume, nullptr);
+    for (vtkIdType row = 0; row < 3; ++row)
+    {
+      EXPECT_EQ(flag->GetVariantValue(row).ToDouble(), row == broken ? 1.0 : 0.0);
+      EXPECT_EQ(std::isnan(volume->GetVariantValue(row).ToDouble()), row == broken);
+    }
+  }
+  {
+    vtkNew<vtkIntersectionResolve> f; // a surface with a hole can be resolved; one of no triangles not
+    f->SetInputDataObject(0, MusclesWithAHole(pipeline.phantom, broken, 0));
+    f->AddInputConnection(1, pipeline.phantom->GetOutputPort(vtkMusculoskeletalPhantom::BONES_CURRENT));
+    CapturedMessages messages;
+    f->Update();
+    ExpectOnlyTheBrokenMuscleFailed(f->GetOutputDataObject(0), broken, messages, "no triangles");
   }
 }

@@ -7,9 +7,9 @@
 #include "RealData.h"
 #include "SurfaceRepair.h"
 
-
 #include <gtest/gtest.h>
 
+#include <random>
 
 namespace
 {
@@ -58,3 +58,36 @@ INSTANTIATE_TEST_SUITE_P(LhdlAndVhf, RealMuscleHull,
     }
     return name;
   });
+
+// Noise of 1e-7 of each coordinate that splits a scan's duplicate points apart (the scans
+// carry exact duplicates) made the LHDL gluteus medius's hull non-manifold: the repair now merges
+// them, and every LHDL muscle gets its enclosing hull under such noise.
+TEST(RealMuscleHulls, RoundingNoiseThatSplitsDuplicatePointsIsNoFailure)
+{
+  for (const char* name : { "gluteus_maximus_r", "gluteus_medius_r", "iliacus_r", "psoas_r" })
+  {
+    const std::string path = RealDataFile(std::string("lhdl_hip_r/") + name + ".vtk");
+    if (path.empty())
+    {
+      GTEST_SKIP() << "lhdl_hip_r not found: set MUSCLEDEFORMATION_DATA_DIR (default ../shared/data)";
+    }
+    const md::TriangleMesh muscle = ReadSurface(path);
+    md::RepairReport exact;
+    md::RepairClosedSurface(muscle, exact);
+    for (unsigned seed : { 1u, 2u })
+    {
+      SCOPED_TRACE(std::string(name) + ", seed " + std::to_string(seed));
+      md::TriangleMesh noisy = muscle;
+      std::mt19937 random(seed);
+      std::uniform_real_distribution<double> noise(-1e-7, 1e-7);
+      for (Eigen::Index i = 0; i < noisy.points.size(); ++i)
+      {
+        noisy.points.data()[i] *= 1 + noise(random); // each copy of a point moves its own way
+      }
+      md::MuscleHull built;
+      ASSERT_NO_THROW(built = md::BuildMuscleHull(noisy, md::HullParameters{}));
+      EXPECT_TRUE(md::CheckEdges(built.result.hull.triangles).IsClosedOrientedManifold());
+      EXPECT_EQ(built.report.duplicatePointsMerged, exact.duplicatePointsMerged); // the same ones
+    }
+  }
+}

@@ -77,8 +77,8 @@ TEST(RealInterpolation, HipFlexion60InFourStepsBeatsTheOnePassMethodAndRefitIsCo
   const auto flips = &md::MuscleStepMeasures::flippedTriangleCount;
   // Measured here: largest static shift 5.4 mm against 18.2 mm in one pass
   // with the paper's step and 17.1 mm with the method's own (0.29 and 0.31;
-  // the issue asks for at most 0.6, the paper reports about half); 272 new
-  // sharp edges against 432 and 482, 16 flipped triangles against 62 and 110.
+  // the issue asks for at most 0.6, the paper reports about half); 266 new
+  // sharp edges against 414 and 476, 19 flipped triangles against 61 and 109.
   // The largest shift is one point's and moves by millimetres when the inputs
   // move by 1e-7: over six such perturbations it is 0.32-0.64 of the
   // one-pass figure, the sharp edges and flips always fewer (BENCHMARKS.md).
@@ -90,7 +90,7 @@ TEST(RealInterpolation, HipFlexion60InFourStepsBeatsTheOnePassMethodAndRefitIsCo
     EXPECT_LT(Total(refit, flips), Total(*onePass, flips));
   }
   // Refit against the paper's Rebuild: comparable quality (here 5.4 against
-  // 8.1 mm, 272 against 259 sharp edges, 16 against 27 flips; over the
+  // 8.1 mm, 266 against 274 sharp edges, 19 against 18 flips; over the
   // perturbations, BENCHMARKS.md).
   EXPECT_LE(Largest(refit, shift), 1.25 * Largest(rebuild, shift));
   EXPECT_LE(Total(refit, sharp), 1.3 * Total(rebuild, sharp));

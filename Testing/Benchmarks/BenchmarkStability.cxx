@@ -1,0 +1,247 @@
+// How much the method's output moves when its input moves by rounding noise or
+// when the hull's resolution changes (issue 13): the largest and the RMS
+// distance between corresponding points of the output surfaces, per muscle, of
+//   (a) the exact input against inputs moved by up to 1e-7 of each coordinate
+//       (several seeds), with a scan's duplicate points kept equal and split;
+//   (b) HullTargetNumberOfPoints 150, 200, 320, 400 against 250, and the
+//       largest of all pairs among 200..400;
+// for the one-pass method with the paper's step (N = 1, contact weight 0) and
+// the interpolation method (Refit) at N = 1, 4, 8, on the phantom and, when
+// present, the LHDL hip in four poses. Prints figures; asserts nothing.
+//
+//   BenchmarkStability [data folder] [case: all|phantom|flexion30|flexion60|adduction-40|adduction40]
+//                      [seeds (3)] [methods: all|one-pass|N (1, 4, 8)]
+#include "RealData.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace
+{
+struct Method
+{
+  std::string label;
+  int steps;
+  double contactWeight;
+};
+
+/// The last step's points of every muscle, or `failure` set.
+struct Output
+{
+  std::vector<md::Points> points;
+  std::string failure;
+  double seconds = 0;
+};
+
+Output Run(const MotionCase& c, const Method& method, int hullPoints, md::RestMappingCache& cache)
+{
+  md::InterpolationParameters parameters;
+  parameters.numberOfSteps = method.steps;
+  parameters.deformation.contactWeight = method.contactWeight;
+  parameters.hull.targetNumberOfPoints = hullPoints;
+  Output out;
+  const auto start = std::chrono::steady_clock::now();
+  try
+  {
+    md::InterpolationResult r = md::DeformByInterpolation(c.muscles, c.bones, parameters, {}, &cache);
+    out.points = r.points.back();
+  }
+  catch (const std::exception& e)
+  {
+    out.failure = e.what();
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+struct Distance
+{
+  double largest = 0;  ///< over all muscles and points
+  double rmsLow = 1e300, rmsHigh = 0; ///< the per-muscle RMS, min-max
+  std::string worst;   ///< the muscle of the largest
+};
+
+Distance Between(const MotionCase& c, const Output& a, const Output& b)
+{
+  Distance d;
+  for (size_t m = 0; m < c.muscles.size(); ++m)
+  {
+    const Eigen::VectorXd per = (a.points[m] - b.points[m]).rowwise().norm();
+    const double rms = std::sqrt(per.squaredNorm() / static_cast<double>(per.size()));
+    d.rmsLow = std::min(d.rmsLow, rms);
+    d.rmsHigh = std::max(d.rmsHigh, rms);
+    if (per.maxCoeff() >= d.largest)
+    {
+      d.largest = per.maxCoeff();
+      d.worst = c.muscles[m].name;
+    }
+  }
+  return d;
+}
+
+void Print(const std::string& method, const std::string& variation, const Output& run, const Distance* d)
+{
+  if (!run.failure.empty())
+  {
+    std::printf("  %-28s %-26s FAILED (%.1f s): %s\n", method.c_str(), variation.c_str(), run.seconds, run.failure.c_str());
+    return;
+  }
+  std::printf("  %-28s %-26s %9.4f %9.4f-%-9.4f %-18s %5.1f\n", method.c_str(), variation.c_str(), d->largest,
+    d->rmsLow, d->rmsHigh, d->worst.c_str(), run.seconds);
+}
+
+/// The spread of one kind of variation: the largest distance and the largest RMS over its runs.
+struct Spread
+{
+  double largest = 0, rms = 0;
+  int failed = 0, runs = 0;
+  void Add(bool failure, const Distance& d)
+  {
+    ++runs;
+    if (failure)
+    {
+      ++failed;
+      return;
+    }
+    largest = std::max(largest, d.largest);
+    rms = std::max(rms, d.rmsHigh);
+  }
+  std::string Text() const
+  {
+    char text[160];
+    std::snprintf(text, sizeof text, "largest %.4f mm, RMS up to %.4f mm, %d of %d runs failed", largest, rms, failed, runs);
+    return text;
+  }
+};
+
+void Study(const MotionCase& exact, const std::vector<Method>& methods, int seeds)
+{
+  std::printf("\n%s (%zu muscles, %zu bones)\n", exact.name.c_str(), exact.muscles.size(), exact.bones.size());
+  std::printf("  %-28s %-26s %9s %19s %-18s %5s\n", "method", "against the exact input", "largest", "RMS per muscle",
+    "muscle of largest", "s");
+  // Inputs with their own rest hulls, shared by every method.
+  struct Input
+  {
+    std::string label;
+    MotionCase input;
+    int hullPoints;
+    md::RestMappingCache cache;
+  };
+  std::vector<Input> inputs;
+  inputs.push_back({ "exact, hull 250", exact, 250, {} });
+  for (int seed = 1; seed <= seeds; ++seed)
+  {
+    inputs.push_back({ "1e-7, seed " + std::to_string(seed), Perturbed(exact, seed), 250, {} });
+  }
+  for (int seed = 1; seed <= seeds; ++seed)
+  {
+    inputs.push_back({ "1e-7 split dup., seed " + std::to_string(seed), Perturbed(exact, seed, true), 250, {} });
+  }
+  const std::vector<int> hullSizes{ 150, 200, 320, 400 };
+  for (int size : hullSizes)
+  {
+    inputs.push_back({ "hull " + std::to_string(size), exact, size, {} });
+  }
+  for (const Method& method : methods)
+  {
+    std::vector<Output> runs;
+    for (Input& in : inputs)
+    {
+      runs.push_back(Run(in.input, method, in.hullPoints, in.cache));
+    }
+    if (!runs[0].failure.empty())
+    {
+      Print(method.label, inputs[0].label, runs[0], nullptr);
+      continue;
+    }
+    Spread noise, split, hulls, hullPairs;
+    for (size_t i = 1; i < inputs.size(); ++i)
+    {
+      const Distance d = runs[i].failure.empty() ? Between(exact, runs[0], runs[i]) : Distance{};
+      Print(method.label, inputs[i].label, runs[i], &d);
+      const std::string& label = inputs[i].label;
+      (label.find("split") != std::string::npos ? split
+          : label.find("1e-7") != std::string::npos ? noise
+                                                     : hulls)
+        .Add(!runs[i].failure.empty(), d);
+    }
+    // Every pair among the hull sizes 200..400 (250 is the exact run).
+    std::vector<const Output*> sized{ &runs[0] };
+    for (size_t i = 0; i < hullSizes.size(); ++i)
+    {
+      if (hullSizes[i] >= 200)
+      {
+        sized.push_back(&runs[inputs.size() - hullSizes.size() + i]);
+      }
+    }
+    for (size_t i = 0; i < sized.size(); ++i)
+    {
+      for (size_t j = i + 1; j < sized.size(); ++j)
+      {
+        const bool failed = !sized[i]->failure.empty() || !sized[j]->failure.empty();
+        hullPairs.Add(failed, failed ? Distance{} : Between(exact, *sized[i], *sized[j]));
+      }
+    }
+    std::printf("  %s: noise, duplicates kept: %s\n", method.label.c_str(), noise.Text().c_str());
+    std::printf("  %s: noise, duplicates split: %s\n", method.label.c_str(), split.Text().c_str());
+    std::printf("  %s: hull 150..400 against 250: %s\n", method.label.c_str(), hulls.Text().c_str());
+    std::printf("  %s: every pair of hull 200, 250, 320, 400: %s\n", method.label.c_str(), hullPairs.Text().c_str());
+  }
+}
+}
+
+int main(int argc, char* argv[])
+{
+  const std::string folder = argc > 1 ? argv[1] : "";
+  const std::string which = argc > 2 ? argv[2] : "all";
+  const int seeds = argc > 3 ? std::max(1, std::atoi(argv[3])) : 3;
+  const std::string methodsArg = argc > 4 ? argv[4] : "all";
+  std::vector<Method> methods;
+  if (methodsArg == "all" || methodsArg == "one-pass")
+  {
+    methods.push_back({ "one pass, paper's step", 1, 0.0 });
+  }
+  for (int n : { 1, 4, 8 })
+  {
+    if (methodsArg == "all" || methodsArg == std::to_string(n))
+    {
+      methods.push_back({ "interpolation N = " + std::to_string(n), n, md::StepDeformationDefaults().contactWeight });
+    }
+  }
+  if (methods.empty())
+  {
+    std::fprintf(stderr, "unknown methods '%s': all, one-pass, 1, 4 or 8\n", methodsArg.c_str());
+    return 2;
+  }
+  std::printf("Distances (mm) between corresponding points of the last step's muscles, per variation against the\n"
+              "exact input with hull 250; Release build. 1e-7: every coordinate moved by up to 1e-7 of itself and\n"
+              "rounded to float; split dup.: the same, with a scan's duplicate points moved apart.\n");
+  if (which == "all" || which == "phantom")
+  {
+    Study(PhantomMotion(30), methods, seeds);
+  }
+  const std::map<std::string, std::pair<std::string, int>> poses{ { "flexion30", { "hip_flexion", 20 } },
+    { "flexion60", { "hip_flexion", 35 } }, { "adduction-40", { "hip_adduction", 0 } },
+    { "adduction40", { "hip_adduction", 40 } } };
+  for (const auto& pose : poses)
+  {
+    if (which != "all" && which != pose.first)
+    {
+      continue;
+    }
+    MotionCase lhdl;
+    if (!LhdlMotion(pose.second.first, pose.second.second, lhdl, folder))
+    {
+      std::printf("\nLHDL data not found: skipped (pass the data folder or set MUSCLEDEFORMATION_DATA_DIR)\n");
+      return 0;
+    }
+    lhdl.name += " (" + pose.first + ")";
+    Study(lhdl, methods, seeds);
+  }
+  return 0;
+}
