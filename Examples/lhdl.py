@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Reading the LHDL right-hip data set (../shared/data/lhdl_hip_r) into the pipeline (pvpython).
 
 The model and its motions come from the data set's own OpenSim files (LHDL_hip_r.osim,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The LHDL hip pipeline exactly as the README's GUI click path builds it, from the data set's
 own files and no Python of ours: OpenSim Model Reader, Legacy VTK readers, Group Datasets, Move
 With Bodies, Action Line Grouping, Interpolated Muscle Deformation.

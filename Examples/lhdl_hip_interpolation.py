@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The LHDL right hip (real scans): the whole interpolation method against the one-pass method.
 
 Run with pvpython (under xvfb-run on a machine without a display):

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Helpers shared by the MuscleDeformation example scripts and image tests (pvpython).
 
 Finding and loading the plugin, a fixed render view, screenshots, and writing

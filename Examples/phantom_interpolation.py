@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The whole interpolation method on the MusculoskeletalPhantom, with screenshots of every step.
 
 Run with pvpython (under xvfb-run on a machine without a display):

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Installs what is missing (Debian 12), builds, and runs the main job: the whole interpolation
 # method against the one-pass method on the MusculoskeletalPhantom and, when present, on the real
 # LHDL hip data (60 degrees of hip flexion, 4 steps).

@@ -1,43 +1,44 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "MDBlocks.h"
 
 #include <vtkStreamingDemandDrivenPipeline.h>
 
+#include <vtkAOSDataArrayTemplate.h>
+#include <vtkAbstractArray.h>
+#include <vtkAlgorithm.h>
 #include <vtkCellArray.h>
-#include <vtkCellData.h>
-#include <vtkUnsignedCharArray.h>
 #include <vtkCellArrayIterator.h>
+#include <vtkCellData.h>
 #include <vtkCompositeDataSet.h>
 #include <vtkDataObjectTreeIterator.h>
 #include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
-#include <vtkIntArray.h>
 #include <vtkIdList.h>
+#include <vtkIdTypeArray.h>
 #include <vtkInformation.h>
 #include <vtkInformationVector.h>
+#include <vtkIntArray.h>
 #include <vtkMultiBlockDataSet.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkStringArray.h>
-#include <vtkAOSDataArrayTemplate.h>
-#include <vtkAbstractArray.h>
-#include <vtkAlgorithm.h>
-#include <vtkIdTypeArray.h>
 #include <vtkTriangleFilter.h>
+#include <vtkUnsignedCharArray.h>
 
 #include <map>
-#include <sstream>
 #include <optional>
 #include <set>
+#include <sstream>
 
 namespace mdvtk
 {
 using md::Points;
-using md::Triangles;
 using md::TriangleMesh;
+using md::Triangles;
 namespace
 {
-template <typename Visitor>
+template<typename Visitor>
 void ForEachLeaf(vtkMultiBlockDataSet* tree, Visitor&& visit)
 {
   vtkSmartPointer<vtkDataObjectTreeIterator> it;
@@ -83,7 +84,7 @@ void AcceptPolyDataOrMultiBlock(vtkInformation* info)
 namespace
 {
 /// The first of `count` ids outside [0, points), if any.
-template <typename Value>
+template<typename Value>
 std::optional<vtkIdType> FirstOutOfRange(const Value* ids, vtkIdType count, vtkIdType points)
 {
   for (vtkIdType i = 0; i < count; ++i)
@@ -149,8 +150,8 @@ bool CheckLeaf(vtkPolyData* data, const std::string& label, std::string& error)
     const std::optional<vtkIdType> bad = FirstIdOutOfRange(cells->GetConnectivityArray(), points);
     if (bad)
     {
-      error = label + " has a " + kinds[k] + " cell that refers to point " + std::to_string(*bad) +
-        ", but it has " + std::to_string(points) + " points (ids 0 to " + std::to_string(points - 1) + ")";
+      error = label + " has a " + kinds[k] + " cell that refers to point " + std::to_string(*bad) + ", but it has " +
+        std::to_string(points) + " points (ids 0 to " + std::to_string(points - 1) + ")";
       return false;
     }
   }
@@ -169,8 +170,7 @@ bool CheckLeaf(vtkPolyData* data, const std::string& label, std::string& error)
 }
 }
 
-bool CollectLeaves(
-  vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves, std::string& error)
+bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves, std::string& error)
 {
   leaves.clear();
   if (!input)
@@ -186,8 +186,8 @@ bool CollectLeaves(
   auto* tree = vtkMultiBlockDataSet::SafeDownCast(input);
   if (!tree)
   {
-    error = inputName + " is a " + input->GetClassName() +
-      "; it must be a vtkPolyData or a vtkMultiBlockDataSet of them";
+    error =
+      inputName + " is a " + input->GetClassName() + "; it must be a vtkPolyData or a vtkMultiBlockDataSet of them";
     return false;
   }
   bool ok = true;
@@ -197,8 +197,8 @@ bool CollectLeaves(
     {
       name = it->GetCurrentMetaData()->Get(vtkCompositeDataSet::NAME());
     }
-    const std::string label = inputName + " block " +
-      (name.empty() ? "#" + std::to_string(leaves.size()) : "'" + name + "'");
+    const std::string label =
+      inputName + " block " + (name.empty() ? "#" + std::to_string(leaves.size()) : "'" + name + "'");
     vtkDataObject* leaf = it->GetCurrentDataObject();
     auto* polyData = vtkPolyData::SafeDownCast(leaf);
     if (leaf && !polyData && ok)
@@ -220,8 +220,8 @@ bool CollectLeaves(
   return ok;
 }
 
-bool PairLeaves(vtkObject* reporter, const std::vector<Leaf>& a, const std::string& nameA,
-  const std::vector<Leaf>& b, const std::string& nameB, std::vector<size_t>& partner, std::string& error)
+bool PairLeaves(vtkObject* reporter, const std::vector<Leaf>& a, const std::string& nameA, const std::vector<Leaf>& b,
+  const std::string& nameB, std::vector<size_t>& partner, std::string& error)
 {
   partner.assign(a.size(), 0);
   auto uniquelyNamed = [](const std::vector<Leaf>& leaves) {
@@ -270,8 +270,8 @@ bool PairLeaves(vtkObject* reporter, const std::vector<Leaf>& a, const std::stri
   }
   if (a.size() != b.size())
   {
-    error = nameA + " has " + std::to_string(a.size()) + " block(s) but " + nameB + " has " +
-      std::to_string(b.size()) + "; blocks pair by name when both inputs name them alike, or else by order";
+    error = nameA + " has " + std::to_string(a.size()) + " block(s) but " + nameB + " has " + std::to_string(b.size()) +
+      "; blocks pair by name when both inputs name them alike, or else by order";
     return false;
   }
   for (size_t i = 0; i < a.size(); ++i)
@@ -287,10 +287,9 @@ bool PairLeaves(vtkObject* reporter, const std::vector<Leaf>& a, const std::stri
     {
       pairs += (i ? ", '" : "'") + a[i].name + "' with '" + b[i].name + "'";
     }
-    vtkWarningWithObjectMacro(reporter, << nameA << " and " << nameB
-                                        << " share no block name, so their blocks pair by order: " << pairs
-                                        << (a.size() > 4 ? ", ..." : "")
-                                        << ". Give the blocks the same names to pair them by name.");
+    vtkWarningWithObjectMacro(
+      reporter, << nameA << " and " << nameB << " share no block name, so their blocks pair by order: " << pairs
+                << (a.size() > 4 ? ", ..." : "") << ". Give the blocks the same names to pair them by name.");
   }
   return true;
 }
@@ -366,7 +365,9 @@ vtkSmartPointer<vtkPolyData> FailedMuscle(vtkPolyData* input, const std::string&
 
 std::function<bool()> AbortRequested(vtkAlgorithm* filter)
 {
-  return [filter] { return filter->GetAbortExecute() != 0; };
+  return [filter] {
+    return filter->GetAbortExecute() != 0;
+  };
 }
 
 void ClearOutputs(vtkInformationVector* outputVector)
@@ -474,8 +475,8 @@ void AddBlock(vtkMultiBlockDataSet* tree, const std::string& name, vtkDataObject
   tree->GetMetaData(index)->Set(vtkCompositeDataSet::NAME(), name.c_str());
 }
 
-void AssignLeaves(vtkDataObject* input, vtkDataObject* output,
-  const std::vector<vtkSmartPointer<vtkPolyData>>& results, Role role)
+void AssignLeaves(
+  vtkDataObject* input, vtkDataObject* output, const std::vector<vtkSmartPointer<vtkPolyData>>& results, Role role)
 {
   if (auto* polyData = vtkPolyData::SafeDownCast(output))
   {
@@ -551,8 +552,7 @@ vtkSmartPointer<vtkPolyData> ToPolyData(const TriangleMesh& mesh)
   polyData->SetPoints(ToVtkPoints(mesh.points));
   vtkNew<vtkIdTypeArray> connectivity;
   connectivity->SetNumberOfValues(mesh.triangles.size());
-  std::copy(mesh.triangles.data(), mesh.triangles.data() + mesh.triangles.size(),
-    connectivity->GetPointer(0));
+  std::copy(mesh.triangles.data(), mesh.triangles.data() + mesh.triangles.size(), connectivity->GetPointer(0));
   vtkNew<vtkCellArray> polys;
   polys->SetData(3, connectivity);
   polyData->SetPolys(polys);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Helpers shared by the MuscleDeformation filters: walking and pairing the
 // leaves of polydata / multiblock inputs, and moving geometry between VTK and
 // the Eigen-based core. Not part of the public API.
@@ -41,8 +42,7 @@ struct Leaf
 /// vtkPolyData, when the input is missing or has no leaves, or when a leaf has
 /// non-finite coordinates (or beyond 1e100), a cell referring to a point it does
 /// not have, or a point array whose length is not its number of points.
-bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves,
-  std::string& error);
+bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves, std::string& error);
 
 /// partner[i] = index in `b` of the leaf paired with a[i]: by name when every leaf of both inputs
 /// has a unique name and some names are shared or the counts differ (then all must pair);
@@ -50,8 +50,8 @@ bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vect
 /// warning through `reporter` (may be null) saying which block goes with which when both inputs
 /// have names but share none (as Group Datasets in the GUI names blocks after its inputs). Fails,
 /// naming the unmatched block, when the pairing cannot be made.
-bool PairLeaves(vtkObject* reporter, const std::vector<Leaf>& a, const std::string& nameA,
-  const std::vector<Leaf>& b, const std::string& nameB, std::vector<size_t>& partner, std::string& error);
+bool PairLeaves(vtkObject* reporter, const std::vector<Leaf>& a, const std::string& nameA, const std::vector<Leaf>& b,
+  const std::string& nameB, std::vector<size_t>& partner, std::string& error);
 
 /// What a piece of the model is. The filters write it as cell array "Role" on their outputs (the
 /// active scalars, unless the data brings its own), and the plugin registers a categorical colour
@@ -84,8 +84,8 @@ std::string DefaultDisplaySettings();
 /// type as `input` (see vtkPassInputTypeAlgorithm): for a multiblock input the
 /// output gets the input's structure and block names. The results then get `role` (MarkRoles);
 /// they must be the filter's own objects, not the input's.
-void AssignLeaves(vtkDataObject* input, vtkDataObject* output,
-  const std::vector<vtkSmartPointer<vtkPolyData>>& results, Role role);
+void AssignLeaves(
+  vtkDataObject* input, vtkDataObject* output, const std::vector<vtkSmartPointer<vtkPolyData>>& results, Role role);
 
 /// Appends `block` to `tree` under the block name `name`.
 void AddBlock(vtkMultiBlockDataSet* tree, const std::string& name, vtkDataObject* block);

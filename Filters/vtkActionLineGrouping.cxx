@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "vtkActionLineGrouping.h"
 
 #include "MDBlocks.h"
@@ -65,8 +66,7 @@ int vtkActionLineGrouping::RequestData(
   const bool haveCurrent = inputVector[2]->GetNumberOfInformationObjects() > 0;
   if (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[0], 0), "Input", muscles, error) ||
     !mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[1], 0), "Paths", paths, error) ||
-    (haveCurrent &&
-      !mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[2], 0), "PathsCurrent", current, error)))
+    (haveCurrent && !mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[2], 0), "PathsCurrent", current, error)))
   {
     vtkErrorMacro(<< error);
     return 0;
@@ -91,7 +91,8 @@ int vtkActionLineGrouping::RequestData(
   std::vector<md::Points> lines;
   for (size_t p = 0; p < paths.size(); ++p)
   {
-    const std::vector<md::Points> polylines = paths[p].data ? mdvtk::ToPolylines(paths[p].data) : std::vector<md::Points>();
+    const std::vector<md::Points> polylines =
+      paths[p].data ? mdvtk::ToPolylines(paths[p].data) : std::vector<md::Points>();
     if (polylines.size() != 1 || polylines[0].rows() < 2)
     {
       vtkErrorMacro(<< paths[p].label << " must hold one polyline of at least 2 points (one path)");
@@ -102,10 +103,13 @@ int vtkActionLineGrouping::RequestData(
   }
   md::osim::PathGrouping grouping;
   int result = 1;
-  if (!mdvtk::CallCore(this, "PathsOfMuscle: ", [&] {
-        grouping = md::osim::GroupPaths(meshes, muscleNames, lines, pathNames,
-          md::osim::ParseAssignments(this->PathsOfMuscle ? this->PathsOfMuscle : ""));
-      }, result))
+  if (!mdvtk::CallCore(
+        this, "PathsOfMuscle: ",
+        [&] {
+          grouping = md::osim::GroupPaths(meshes, muscleNames, lines, pathNames,
+            md::osim::ParseAssignments(this->PathsOfMuscle ? this->PathsOfMuscle : ""));
+        },
+        result))
   {
     return result;
   }
@@ -118,8 +122,8 @@ int vtkActionLineGrouping::RequestData(
       continue;
     }
     decision << pathNames[p] << " -> " << muscleNames[grouping.muscleOfPath[p]] << " ("
-             << (grouping.assignedByUser[p] ? "as given, " : "") << static_cast<int>(100 * grouping.insideFraction[p] + 0.5)
-             << " % of its length inside)\n";
+             << (grouping.assignedByUser[p] ? "as given, " : "")
+             << static_cast<int>(100 * grouping.insideFraction[p] + 0.5) << " % of its length inside)\n";
   }
   for (size_t m = 0; m < muscles.size(); ++m)
   {
@@ -135,7 +139,8 @@ int vtkActionLineGrouping::RequestData(
   vtkOutputWindow::GetInstance()->DisplayText(("ActionLineGrouping:\n" + this->Decision).c_str());
   if (unassigned.tellp() > 0)
   {
-    vtkWarningMacro(<< "paths that run inside no muscle (less than 5 % of their length) are left out: " << unassigned.str());
+    vtkWarningMacro(<< "paths that run inside no muscle (less than 5 % of their length) are left out: "
+                    << unassigned.str());
   }
 
   auto build = [&](const std::vector<mdvtk::Leaf>& source, bool isCurrent, vtkMultiBlockDataSet* output) {

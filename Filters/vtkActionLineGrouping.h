@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /**
  * @class   vtkActionLineGrouping
  * @brief   Groups muscle paths (one polyline per path, e.g. an OpenSim model's) into the action

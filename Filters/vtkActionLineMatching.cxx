@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "vtkActionLineMatching.h"
 
 #include "ActionLineMatching.h"
@@ -113,8 +114,7 @@ int vtkActionLineMatching::RequestData(
     {
       if (rest.data || current.data)
       {
-        vtkErrorMacro(<< (rest.data ? current.label : rest.label)
-                      << " is empty but its partner is not");
+        vtkErrorMacro(<< (rest.data ? current.label : rest.label) << " is empty but its partner is not");
         return 0;
       }
       continue;
@@ -128,9 +128,8 @@ int vtkActionLineMatching::RequestData(
     }
     if (restLines.size() != currentLines.size())
     {
-      vtkErrorMacro(<< rest.label << " has " << restLines.size() << " polyline(s) but "
-                    << current.label << " has " << currentLines.size()
-                    << "; the polylines of a block pair by order");
+      vtkErrorMacro(<< rest.label << " has " << restLines.size() << " polyline(s) but " << current.label << " has "
+                    << currentLines.size() << "; the polylines of a block pair by order");
       return 0;
     }
     LineBuilder restBuilder, currentBuilder;
@@ -139,7 +138,8 @@ int vtkActionLineMatching::RequestData(
     {
       md::MatchedActionLines matched;
       int result = 1;
-      if (!mdvtk::CallCore(this, "polyline " + std::to_string(l) + " of " + rest.label + " / " + current.label + ": ",
+      if (!mdvtk::CallCore(
+            this, "polyline " + std::to_string(l) + " of " + rest.label + " / " + current.label + ": ",
             [&] { matched = md::MatchActionLines(restLines[l], currentLines[l], this->Tolerance); }, result))
       {
         return result;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /**
  * @class   vtkActionLineMatching
  * @brief   Matches rest-pose and current-pose action lines point by point.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "vtkBoneInterpolation.h"
 
 #include "BoneInterpolation.h"
@@ -39,8 +40,7 @@ bool SameCells(vtkCellArray* a, vtkCellArray* b)
   a->ExportLegacyFormat(legacyA);
   b->ExportLegacyFormat(legacyB);
   return legacyA->GetNumberOfValues() == legacyB->GetNumberOfValues() &&
-    std::equal(legacyA->GetPointer(0), legacyA->GetPointer(0) + legacyA->GetNumberOfValues(),
-      legacyB->GetPointer(0));
+    std::equal(legacyA->GetPointer(0), legacyA->GetPointer(0) + legacyA->GetNumberOfValues(), legacyB->GetPointer(0));
 }
 
 bool SameTopology(vtkPolyData* rest, vtkPolyData* current)
@@ -49,10 +49,8 @@ bool SameTopology(vtkPolyData* rest, vtkPolyData* current)
   {
     return true;
   }
-  return SameCells(rest->GetVerts(), current->GetVerts()) &&
-    SameCells(rest->GetLines(), current->GetLines()) &&
-    SameCells(rest->GetPolys(), current->GetPolys()) &&
-    SameCells(rest->GetStrips(), current->GetStrips());
+  return SameCells(rest->GetVerts(), current->GetVerts()) && SameCells(rest->GetLines(), current->GetLines()) &&
+    SameCells(rest->GetPolys(), current->GetPolys()) && SameCells(rest->GetStrips(), current->GetStrips());
 }
 
 }
@@ -73,8 +71,7 @@ int vtkBoneInterpolation::FillInputPortInformation(int port, vtkInformation* inf
   return 1;
 }
 
-bool vtkBoneInterpolation::ReadPoses(
-  vtkDataObject* restInput, vtkDataObject* currentInput, std::vector<Pose>& poses)
+bool vtkBoneInterpolation::ReadPoses(vtkDataObject* restInput, vtkDataObject* currentInput, std::vector<Pose>& poses)
 {
   std::vector<mdvtk::Leaf> restLeaves, currentLeaves;
   std::vector<size_t> partner;
@@ -111,8 +108,8 @@ bool vtkBoneInterpolation::ReadPoses(
       const std::string& currentLabel = currentLeaves[partner[b]].label;
       if (!current || current->GetNumberOfPoints() != rest.data->GetNumberOfPoints())
       {
-        vtkErrorMacro(<< rest.label << " has " << rest.data->GetNumberOfPoints() << " points but "
-                      << currentLabel << " has " << (current ? current->GetNumberOfPoints() : 0)
+        vtkErrorMacro(<< rest.label << " has " << rest.data->GetNumberOfPoints() << " points but " << currentLabel
+                      << " has " << (current ? current->GetNumberOfPoints() : 0)
                       << "; the current pose must have the same points in the same order");
         return false;
       }
@@ -165,8 +162,7 @@ int vtkBoneInterpolation::RequestInformation(
     }
     std::vector<Pose> poses;
     if (!this->ReadPoses(vtkDataObject::GetData(inputVector[0], 0),
-          this->GetNumberOfInputConnections(1) ? vtkDataObject::GetData(inputVector[1], 0) : nullptr,
-          poses))
+          this->GetNumberOfInputConnections(1) ? vtkDataObject::GetData(inputVector[1], 0) : nullptr, poses))
     {
       return 0;
     }
@@ -176,8 +172,8 @@ int vtkBoneInterpolation::RequestInformation(
       largest = std::max(largest, md::MaximumDisplacement(pose.rest, pose.current));
     }
     int result = 1;
-    if (!mdvtk::CallCore(this, "", [&] { steps = md::AutomaticNumberOfSteps(largest, this->MaximumStepDisplacement); },
-          result))
+    if (!mdvtk::CallCore(
+          this, "", [&] { steps = md::AutomaticNumberOfSteps(largest, this->MaximumStepDisplacement); }, result))
     {
       return result;
     }
@@ -206,8 +202,7 @@ int vtkBoneInterpolation::RequestUpdateExtent(
   {
     for (int i = 0; i < inputVector[port]->GetNumberOfInformationObjects(); ++i)
     {
-      inputVector[port]->GetInformationObject(i)->Remove(
-        vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+      inputVector[port]->GetInformationObject(i)->Remove(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
     }
   }
   return 1;
@@ -249,30 +244,34 @@ int vtkBoneInterpolation::RequestData(
     output->GetFieldData()->DeepCopy(pose.restData->GetFieldData());
     vtkFieldData* fieldData = output->GetFieldData();
     int result = 1;
-    if (!mdvtk::CallCore(this, pose.label + ": ", [&] {
-          const md::PoseInterpolator interpolator(pose.rest, pose.current, mode);
-          positions = interpolator.AtStep(step, steps);
-          if (interpolator.Fit())
-          {
-            const md::RigidFit& fit = *interpolator.Fit();
-            mdvtk::AddFieldValue(fieldData, "RigidFitRMSResidual", fit.rmsResidual);
-            mdvtk::AddFieldValue(fieldData, "RigidFitMaxResidual", fit.maxResidual);
-            mdvtk::AddFieldValue(fieldData, "RotationAngleDegrees", vtkMath::DegreesFromRadians(interpolator.RotationAngle()));
-            double bounds[6];
-            pose.restData->GetBounds(bounds);
-            const double diagonal = std::sqrt(vtkMath::Distance2BetweenPoints(
-              std::array<double, 3>{ bounds[0], bounds[2], bounds[4] }.data(),
-              std::array<double, 3>{ bounds[1], bounds[3], bounds[5] }.data()));
-            if (fit.maxResidual > 1e-3 * diagonal)
+    if (!mdvtk::CallCore(
+          this, pose.label + ": ",
+          [&] {
+            const md::PoseInterpolator interpolator(pose.rest, pose.current, mode);
+            positions = interpolator.AtStep(step, steps);
+            if (interpolator.Fit())
             {
-              vtkWarningMacro(<< "the motion of " << pose.label << " is not rigid: the best rigid fit "
-                              << "misses the current pose by up to " << fit.maxResidual << " ("
-                              << 100.0 * fit.maxResidual / diagonal
-                              << " % of its size); Rigid mode blends that residual in linearly, "
-                                 "Linear mode may suit this motion better");
+              const md::RigidFit& fit = *interpolator.Fit();
+              mdvtk::AddFieldValue(fieldData, "RigidFitRMSResidual", fit.rmsResidual);
+              mdvtk::AddFieldValue(fieldData, "RigidFitMaxResidual", fit.maxResidual);
+              mdvtk::AddFieldValue(
+                fieldData, "RotationAngleDegrees", vtkMath::DegreesFromRadians(interpolator.RotationAngle()));
+              double bounds[6];
+              pose.restData->GetBounds(bounds);
+              const double diagonal = std::sqrt(
+                vtkMath::Distance2BetweenPoints(std::array<double, 3>{ bounds[0], bounds[2], bounds[4] }.data(),
+                  std::array<double, 3>{ bounds[1], bounds[3], bounds[5] }.data()));
+              if (fit.maxResidual > 1e-3 * diagonal)
+              {
+                vtkWarningMacro(<< "the motion of " << pose.label << " is not rigid: the best rigid fit "
+                                << "misses the current pose by up to " << fit.maxResidual << " ("
+                                << 100.0 * fit.maxResidual / diagonal
+                                << " % of its size); Rigid mode blends that residual in linearly, "
+                                   "Linear mode may suit this motion better");
+              }
             }
-          }
-        }, result))
+          },
+          result))
     {
       return result;
     }
@@ -307,7 +306,6 @@ void vtkBoneInterpolation::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "NumberOfSteps: " << this->NumberOfSteps << "\n";
   os << indent << "MaximumStepDisplacement: " << this->MaximumStepDisplacement << "\n";
-  os << indent << "InterpolationMode: " << (this->InterpolationMode == LINEAR ? "Linear" : "Rigid")
-     << "\n";
+  os << indent << "InterpolationMode: " << (this->InterpolationMode == LINEAR ? "Linear" : "Rigid") << "\n";
   os << indent << "ResolvedNumberOfSteps: " << this->ResolvedNumberOfSteps << "\n";
 }

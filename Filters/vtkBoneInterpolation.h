@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /**
  * @class   vtkBoneInterpolation
  * @brief   Geometry at an intermediate step between its rest and current pose.

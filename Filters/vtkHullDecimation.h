@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /**
  * @class   vtkHullDecimation
  * @brief   The coarse outer hull of each muscle: closed, manifold, enclosing it.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "vtkInterpolatedMuscleDeformation.h"
 
 #include "ActionLineMatching.h"
@@ -28,16 +29,16 @@ struct vtkInterpolatedMuscleDeformation::Cache
 {
   vtkMTimeType inputsTime = 0;
   vtkMTimeType filterTime = 0;
-  std::vector<size_t> blockOf; // block of each muscle
+  std::vector<size_t> blockOf;                // block of each muscle
   std::map<size_t, std::string> failedBlocks; // muscles that could not be deformed, and why
   md::InterpolationResult result;
   // What outputs 1 and 2 show at each step: the bones and matched action lines moved as the
   // method moved them (the same interpolators, in the same local frame).
   md::LocalFrame frame;
   std::vector<md::PoseInterpolator> boneMotions;
-  std::vector<size_t> boneLeaf;                          // BonesRest leaf of each bone
+  std::vector<size_t> boneLeaf;                               // BonesRest leaf of each bone
   std::vector<std::vector<md::PoseInterpolator>> lineMotions; // per muscle
-  std::vector<size_t> lineLeaf;                          // ActionLinesRest leaf of each muscle
+  std::vector<size_t> lineLeaf;                               // ActionLinesRest leaf of each muscle
 };
 
 namespace
@@ -183,7 +184,8 @@ int vtkInterpolatedMuscleDeformation::RequestInformation(
     parameters.numberOfSteps = 0;
     parameters.maximumStepDisplacement = this->MaximumStepDisplacement; // bones in world units here
     int result = 1;
-    if (!mdvtk::CallCore(this, "", [&] { steps = md::ResolveNumberOfSteps(bones, parameters); }, result))
+    if (!mdvtk::CallCore(
+          this, "", [&] { steps = md::ResolveNumberOfSteps(bones, parameters); }, result))
     {
       return result;
     }
@@ -325,29 +327,34 @@ int vtkInterpolatedMuscleDeformation::RequestData(
       }
       if (rest.empty())
       {
-        fail(b, restLeaf.label + " has no polylines: muscle " + leaf.label +
+        fail(b,
+          restLeaf.label + " has no polylines: muscle " + leaf.label +
             " needs its action lines, or nothing says where it goes");
         continue;
       }
       if (rest.size() != current.size())
       {
-        fail(b, restLeaf.label + " has " + std::to_string(rest.size()) + " action lines but " + currentLeaf.label +
-            " has " + std::to_string(current.size()) + ": the lines of a muscle pair by order");
+        fail(b,
+          restLeaf.label + " has " + std::to_string(rest.size()) + " action lines but " + currentLeaf.label + " has " +
+            std::to_string(current.size()) + ": the lines of a muscle pair by order");
         continue;
       }
       int result = 1;
       std::string failure;
-      if (!mdvtk::CallCore(this, "an action line of " + restLeaf.label + " or " + currentLeaf.label + ": ", [&] {
-            for (size_t l = 0; l < rest.size(); ++l)
-            {
-              const md::MatchedActionLines pair = md::MatchActionLines(rest[l], current[l], this->MatchingTolerance);
-              motion.lines.push_back({ pair.rest, pair.current });
-            }
-            for (const std::string& note : md::LimitActionLinePoints(motion.lines))
-            {
-              vtkWarningMacro(<< restLeaf.label << ": " << note);
-            }
-          }, result, &failure))
+      if (!mdvtk::CallCore(
+            this, "an action line of " + restLeaf.label + " or " + currentLeaf.label + ": ",
+            [&] {
+              for (size_t l = 0; l < rest.size(); ++l)
+              {
+                const md::MatchedActionLines pair = md::MatchActionLines(rest[l], current[l], this->MatchingTolerance);
+                motion.lines.push_back({ pair.rest, pair.current });
+              }
+              for (const std::string& note : md::LimitActionLinePoints(motion.lines))
+              {
+                vtkWarningMacro(<< restLeaf.label << ": " << note);
+              }
+            },
+            result, &failure))
       {
         if (failure.empty())
         {
@@ -388,14 +395,17 @@ int vtkInterpolatedMuscleDeformation::RequestData(
       restPoints.push_back(&worldMuscles[blockIndex.at(b)]);
     }
     int result = 1;
-    if (!mdvtk::CallCore(this, "", [&] {
-          if (motions.empty())
-          {
-            throw md::InputError("no muscle could be deformed (see the errors above)");
-          }
-          cache.result = md::DeformByInterpolation(
-            motions, bones, parameters, mdvtk::ProgressOrCancel(this), this->KeptRest.get());
-        }, result))
+    if (!mdvtk::CallCore(
+          this, "",
+          [&] {
+            if (motions.empty())
+            {
+              throw md::InputError("no muscle could be deformed (see the errors above)");
+            }
+            cache.result = md::DeformByInterpolation(
+              motions, bones, parameters, mdvtk::ProgressOrCancel(this), this->KeptRest.get());
+          },
+          result))
     {
       cache = Cache{};
       return result;
@@ -448,9 +458,9 @@ int vtkInterpolatedMuscleDeformation::RequestData(
   this->ShownNumberOfSteps = steps;
   this->ShownStep = step;
   std::vector<vtkSmartPointer<vtkPolyData>> outputs(muscles.size());
-  std::vector<std::string> names;                                  // Measures rows
+  std::vector<std::string> names;                                   // Measures rows
   std::vector<std::pair<std::string, std::vector<double>>> columns; // Measures columns
-  std::vector<size_t> failedRows;                                  // muscles not deformed: NaN
+  std::vector<size_t> failedRows;                                   // muscles not deformed: NaN
   std::map<size_t, size_t> muscleOfBlock;
   for (size_t m = 0; m < cache.blockOf.size(); ++m)
   {
@@ -585,7 +595,9 @@ int vtkInterpolatedMuscleDeformation::RequestData(
   mdvtk::AssignLeaves(inputs[3], vtkDataObject::GetData(outputVector, 2), lineOutputs, mdvtk::Role::ActionLine);
   for (int p = 0; p < this->GetNumberOfOutputPorts(); ++p)
   {
-    vtkDataObject::GetData(outputVector, p)->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), static_cast<double>(step));
+    vtkDataObject::GetData(outputVector, p)
+      ->GetInformation()
+      ->Set(vtkDataObject::DATA_TIME_STEP(), static_cast<double>(step));
   }
   this->UpdateProgress(1.0);
   return 1;

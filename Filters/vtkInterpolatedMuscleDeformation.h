@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /**
  * @class   vtkInterpolatedMuscleDeformation
  * @brief   Deforms muscles from the rest pose to the current pose by the interpolation method.

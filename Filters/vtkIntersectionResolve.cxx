@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "vtkIntersectionResolve.h"
 
 #include "LocalFrame.h"
@@ -105,8 +106,8 @@ int vtkIntersectionResolve::RequestData(
   {
     if (restObstacles.size() != obstacles.size())
     {
-      vtkErrorMacro(<< "ObstaclesRest has " << restObstacles.size() << " meshes but Obstacles has "
-                    << obstacles.size() << ": connect the same obstacles in both poses, in the same order");
+      vtkErrorMacro(<< "ObstaclesRest has " << restObstacles.size() << " meshes but Obstacles has " << obstacles.size()
+                    << ": connect the same obstacles in both poses, in the same order");
       return 0;
     }
     for (size_t o = 0; o < obstacles.size(); ++o)
@@ -146,8 +147,8 @@ int vtkIntersectionResolve::RequestData(
       const md::TriangleMesh& rest = restMeshes[restOf[b]];
       if (rest.points.rows() != meshes[b].points.rows())
       {
-        failedBlocks[b] = restLeaves[restOf[b]].label + " has " + std::to_string(rest.points.rows()) +
-          " points but " + leaves[b].label + " has " + std::to_string(meshes[b].points.rows()) +
+        failedBlocks[b] = restLeaves[restOf[b]].label + " has " + std::to_string(rest.points.rows()) + " points but " +
+          leaves[b].label + " has " + std::to_string(meshes[b].points.rows()) +
           ": InputRest must be the Input in the rest pose, with the same points";
         continue;
       }
@@ -194,27 +195,30 @@ int vtkIntersectionResolve::RequestData(
   md::StaticResolveResult resolved;
   std::vector<md::Penetration> left;
   int result = 1;
-  if (!mdvtk::CallCore(this, "", [&] {
-        trees = md::BuildObstacles(obstacleNames, obstacles);
-        this->UpdateProgress(0.2);
-        if (restGiven)
-        {
-          restTrees = restObstacles.empty() ? trees : md::BuildObstacles(restObstacleNames, restObstacles);
-          existing = md::FindOverlaps(deformableRest, fixedOf(restTrees));
-        }
-        this->UpdateProgress(0.4);
-        md::StaticResolveParameters parameters;
-        parameters.deformableShare = this->DeformableShare;
-        const std::vector<md::FixedObstacle> fixed = fixedOf(trees);
-        resolved = md::ResolveStaticIntersections(deformable, fixed, restGiven ? &existing : nullptr, parameters);
-        this->UpdateProgress(0.8);
-        std::vector<md::TriangleMesh> after = deformable;
-        for (size_t k = 0; k < after.size(); ++k)
-        {
-          after[k].points = resolved.points[k];
-        }
-        left = md::MeasureNewPenetration(after, fixed, restGiven ? &existing : nullptr);
-      }, result))
+  if (!mdvtk::CallCore(
+        this, "",
+        [&] {
+          trees = md::BuildObstacles(obstacleNames, obstacles);
+          this->UpdateProgress(0.2);
+          if (restGiven)
+          {
+            restTrees = restObstacles.empty() ? trees : md::BuildObstacles(restObstacleNames, restObstacles);
+            existing = md::FindOverlaps(deformableRest, fixedOf(restTrees));
+          }
+          this->UpdateProgress(0.4);
+          md::StaticResolveParameters parameters;
+          parameters.deformableShare = this->DeformableShare;
+          const std::vector<md::FixedObstacle> fixed = fixedOf(trees);
+          resolved = md::ResolveStaticIntersections(deformable, fixed, restGiven ? &existing : nullptr, parameters);
+          this->UpdateProgress(0.8);
+          std::vector<md::TriangleMesh> after = deformable;
+          for (size_t k = 0; k < after.size(); ++k)
+          {
+            after[k].points = resolved.points[k];
+          }
+          left = md::MeasureNewPenetration(after, fixed, restGiven ? &existing : nullptr);
+        },
+        result))
   {
     return result;
   }

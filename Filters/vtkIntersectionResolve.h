@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /**
  * @class   vtkIntersectionResolve
  * @brief   Moves the points of deformable meshes out of obstacles (static intersections).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "vtkMoveWithBodies.h"
 
 #include "MDBlocks.h"
@@ -99,7 +100,8 @@ int vtkMoveWithBodies::RequestData(
   std::vector<vtkSmartPointer<vtkPolyData>> results(leaves.size());
   std::vector<std::pair<std::string, std::vector<std::string>>> assignments;
   int result = 1;
-  if (!mdvtk::CallCore(this, "BodyOfSurface: ",
+  if (!mdvtk::CallCore(
+        this, "BodyOfSurface: ",
         [&] { assignments = md::osim::ParseAssignments(this->BodyOfSurface ? this->BodyOfSurface : ""); }, result))
   {
     return result;

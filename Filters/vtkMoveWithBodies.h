@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /**
  * @class   vtkMoveWithBodies
  * @brief   Moves surfaces (scanned bones) with the bodies of an OpenSim model.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "vtkMuscleDeformation.h"
 
 #include "LocalFrame.h"
@@ -36,8 +37,8 @@ double SecondsSince(Clock::time_point start)
 /// The action lines of one block: each polyline's points and their
 /// CurrentPosition (from ActionLineMatching), lines of too many points cut down (said in
 /// `notes`). Fails with a message.
-bool ReadMatchedLines(const mdvtk::Leaf& leaf, std::vector<md::MatchedLine>& lines, std::vector<std::string>& notes,
-  std::string& error)
+bool ReadMatchedLines(
+  const mdvtk::Leaf& leaf, std::vector<md::MatchedLine>& lines, std::vector<std::string>& notes, std::string& error)
 {
   vtkPolyData* data = leaf.data;
   if (!data || !data->GetLines() || data->GetLines()->GetNumberOfCells() == 0)
@@ -48,8 +49,7 @@ bool ReadMatchedLines(const mdvtk::Leaf& leaf, std::vector<md::MatchedLine>& lin
   vtkDataArray* current = data->GetPointData()->GetArray("CurrentPosition");
   if (!current || current->GetNumberOfComponents() != 3)
   {
-    error = leaf.label +
-      " has no point array CurrentPosition (3 components): connect output 0 of ActionLineMatching";
+    error = leaf.label + " has no point array CurrentPosition (3 components): connect output 0 of ActionLineMatching";
     return false;
   }
   const md::Points currentPositions = mdvtk::ToPoints(current);
@@ -250,7 +250,7 @@ int vtkMuscleDeformation::RequestData(
   for (auto entry = kept.byBlock.begin(); entry != kept.byBlock.end();)
   {
     entry = std::find(blockOf.begin(), blockOf.end(), entry->first) == blockOf.end() ? kept.byBlock.erase(entry)
-                                                                                      : std::next(entry);
+                                                                                     : std::next(entry);
   }
   for (size_t m = 0; m < toDeform.size(); ++m)
   {
@@ -276,17 +276,19 @@ int vtkMuscleDeformation::RequestData(
         if (!md::CheckEdges(hulls[b].triangles).IsClosedOrientedManifold() ||
           md::SignedVolume(hulls[b].points, hulls[b].triangles) <= 0)
         {
-          failMuscle(m, hullLeaf.label + " is not a closed, outward-oriented manifold surface: build it with HullDecimation");
+          failMuscle(
+            m, hullLeaf.label + " is not a closed, outward-oriented manifold surface: build it with HullDecimation");
           entry = KeptMuscle{};
           continue;
         }
         const std::int64_t outside = md::CountPointsOutsideHull(hulls[b], surfaces[b], frame.rounding);
         if (outside > 0)
         {
-          failMuscle(m, hullLeaf.label + " does not enclose " + leaf.label + ": " + std::to_string(outside) + " of " +
-            std::to_string(md::UsedPoints(surfaces[b]).rows()) +
-            " muscle points are outside it, where mean value coordinates extrapolate; build the "
-            "hull with HullDecimation or leave Hull empty");
+          failMuscle(m,
+            hullLeaf.label + " does not enclose " + leaf.label + ": " + std::to_string(outside) + " of " +
+              std::to_string(md::UsedPoints(surfaces[b]).rows()) +
+              " muscle points are outside it, where mean value coordinates extrapolate; build the "
+              "hull with HullDecimation or leave Hull empty");
           entry = KeptMuscle{};
           continue;
         }
@@ -299,15 +301,18 @@ int vtkMuscleDeformation::RequestData(
         parameters.cancelled = mdvtk::AbortRequested(this);
         int result = 1;
         std::string failure;
-        if (!mdvtk::CallCore(this, leaf.label + ": ", [&] {
-              const md::MuscleHull built = md::BuildMuscleHull(surfaces[b], parameters);
-              ++this->HullBuildCount;
-              entry.hull = built.result.hull;
-              if (built.report.Changed())
-              {
-                entry.repairs = built.report.Describe();
-              }
-            }, result, &failure))
+        if (!mdvtk::CallCore(
+              this, leaf.label + ": ",
+              [&] {
+                const md::MuscleHull built = md::BuildMuscleHull(surfaces[b], parameters);
+                ++this->HullBuildCount;
+                entry.hull = built.result.hull;
+                if (built.report.Changed())
+                {
+                  entry.repairs = built.report.Describe();
+                }
+              },
+              result, &failure))
         {
           if (failure.empty())
           {
@@ -320,8 +325,9 @@ int vtkMuscleDeformation::RequestData(
       }
       int result = 1;
       std::string failure;
-      if (!mdvtk::CallCore(this, leaf.label + ": ",
-            [&] { entry.weights = md::MeanValueCoordinates(entry.hull, surfaces[b].points); }, result, &failure))
+      if (!mdvtk::CallCore(
+            this, leaf.label + ": ", [&] { entry.weights = md::MeanValueCoordinates(entry.hull, surfaces[b].points); },
+            result, &failure))
       {
         if (failure.empty())
         {
@@ -357,13 +363,16 @@ int vtkMuscleDeformation::RequestData(
   std::vector<md::DeformationResult> results;
   const std::vector<std::string> reportedBefore = failures;
   int result = 1;
-  if (!mdvtk::CallCore(this, "", [&] {
-        const std::vector<md::Obstacle> obstacles = this->DynamicIntersections
-          ? md::BuildObstacles(obstacleNames, obstacleMeshes)
-          : std::vector<md::Obstacle>{};
-        results =
-          md::DeformMusclesThatCan(toDeform, obstacles, parameters, failures, mdvtk::ProgressOrCancel(this, 0.3, 0.7));
-      }, result))
+  if (!mdvtk::CallCore(
+        this, "",
+        [&] {
+          const std::vector<md::Obstacle> obstacles = this->DynamicIntersections
+            ? md::BuildObstacles(obstacleNames, obstacleMeshes)
+            : std::vector<md::Obstacle>{};
+          results = md::DeformMusclesThatCan(
+            toDeform, obstacles, parameters, failures, mdvtk::ProgressOrCancel(this, 0.3, 0.7));
+        },
+        result))
   {
     return result;
   }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /**
  * @class   vtkMuscleDeformation
  * @brief   Deforms muscles from the rest pose to the current pose in one pass.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "vtkMusculoskeletalPhantom.h"
 
 #include "MDBlocks.h"
@@ -38,8 +39,7 @@ vtkMusculoskeletalPhantom::vtkMusculoskeletalPhantom()
   this->SetNumberOfOutputPorts(5);
 }
 
-int vtkMusculoskeletalPhantom::RequestData(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+int vtkMusculoskeletalPhantom::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   md::PhantomParameters parameters;
   parameters.flexionDegrees = this->Flexion;
@@ -47,25 +47,27 @@ int vtkMusculoskeletalPhantom::RequestData(
   parameters.resolution = this->Resolution;
   md::Phantom phantom;
   int result = 1;
-  if (!mdvtk::CallCore(this, "", [&] { phantom = md::BuildPhantom(parameters); }, result))
+  if (!mdvtk::CallCore(
+        this, "", [&] { phantom = md::BuildPhantom(parameters); }, result))
   {
     return result;
   }
-  auto output = [&](int port) { return vtkMultiBlockDataSet::GetData(outputVector, port); };
+  auto output = [&](int port) {
+    return vtkMultiBlockDataSet::GetData(outputVector, port);
+  };
 
   for (const md::PhantomMuscle& muscle : phantom.muscles)
   {
     mdvtk::AddBlock(output(MUSCLES), muscle.name, mdvtk::ToPolyData(muscle.rest));
-    mdvtk::AddBlock(output(ACTION_LINES_REST), muscle.name,
-      Polylines(muscle.actionLinesRest, muscle.actionLineNames));
-    mdvtk::AddBlock(output(ACTION_LINES_CURRENT), muscle.name,
-      Polylines(muscle.actionLinesCurrent, muscle.actionLineNames));
+    mdvtk::AddBlock(output(ACTION_LINES_REST), muscle.name, Polylines(muscle.actionLinesRest, muscle.actionLineNames));
+    mdvtk::AddBlock(
+      output(ACTION_LINES_CURRENT), muscle.name, Polylines(muscle.actionLinesCurrent, muscle.actionLineNames));
   }
   for (const md::PhantomBone& bone : phantom.bones)
   {
     mdvtk::AddBlock(output(BONES_REST), bone.name, mdvtk::ToPolyData(bone.rest));
-    mdvtk::AddBlock(output(BONES_CURRENT), bone.name,
-      mdvtk::ToPolyData(md::TriangleMesh{ bone.currentPoints, bone.rest.triangles }));
+    mdvtk::AddBlock(
+      output(BONES_CURRENT), bone.name, mdvtk::ToPolyData(md::TriangleMesh{ bone.currentPoints, bone.rest.triangles }));
   }
   mdvtk::MarkRoles(output(MUSCLES), mdvtk::Role::Muscle);
   for (int port : { BONES_REST, BONES_CURRENT })

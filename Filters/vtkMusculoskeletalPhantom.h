@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /**
  * @class   vtkMusculoskeletalPhantom
  * @brief   A synthetic right hip in its rest and current pose.

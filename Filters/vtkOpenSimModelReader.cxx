@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "vtkOpenSimModelReader.h"
 
 #include "MDBlocks.h"
@@ -61,7 +62,7 @@ struct BodyMesh
   vtkSmartPointer<vtkCellArray> polys;
 };
 
-template <typename Reader>
+template<typename Reader>
 vtkSmartPointer<vtkPolyData> ReadWith(const std::string& path)
 {
   vtkNew<Reader> reader;
@@ -75,10 +76,10 @@ vtkSmartPointer<vtkPolyData> ReadMeshFile(const std::string& path)
 {
   const std::string extension = vtksys::SystemTools::LowerCase(vtksys::SystemTools::GetFilenameLastExtension(path));
   vtkSmartPointer<vtkPolyData> mesh = extension == ".vtp" ? ReadWith<vtkXMLPolyDataReader>(path)
-    : extension == ".stl"                               ? ReadWith<vtkSTLReader>(path)
-    : extension == ".obj"                               ? ReadWith<vtkOBJReader>(path)
-    : extension == ".vtk"                               ? ReadWith<vtkPolyDataReader>(path)
-                                                        : nullptr;
+    : extension == ".stl"                                 ? ReadWith<vtkSTLReader>(path)
+    : extension == ".obj"                                 ? ReadWith<vtkOBJReader>(path)
+    : extension == ".vtk"                                 ? ReadWith<vtkPolyDataReader>(path)
+                                                          : nullptr;
   if (mesh && (!mesh->GetPoints() || mesh->GetNumberOfPoints() == 0))
   {
     mesh = nullptr;
@@ -150,7 +151,8 @@ bool vtkOpenSimModelReader::Load()
     vtkErrorMacro(<< "no FileName: give the OpenSim model (.osim) to read");
     return false;
   }
-  const std::string modelKey = fileName + "|" + Text(this->GeometrySearchPath) + "|" + std::to_string(this->LoadGeometry);
+  const std::string modelKey =
+    fileName + "|" + Text(this->GeometrySearchPath) + "|" + std::to_string(this->LoadGeometry);
   std::vector<std::string> warnings;
   try
   {
@@ -253,15 +255,16 @@ bool vtkOpenSimModelReader::Load()
       if (!wrapped.empty())
       {
         warnings.push_back("paths are not wrapped yet: these muscles have wrap objects and are drawn as "
-                           "straight polylines through their path points: " + wrapped);
+                           "straight polylines through their path points: " +
+          wrapped);
       }
       in.modelKey = modelKey;
       in.haveModel = true;
     }
     osim::MotionOptions options;
     options.angles = this->AngleUnit == ANGLES_IN_DEGREES ? osim::AngleUnit::Degrees
-      : this->AngleUnit == ANGLES_IN_RADIANS             ? osim::AngleUnit::Radians
-                                                         : osim::AngleUnit::FromFile;
+      : this->AngleUnit == ANGLES_IN_RADIANS              ? osim::AngleUnit::Radians
+                                                          : osim::AngleUnit::FromFile;
     options.ignoreUnknownColumns = this->IgnoreUnknownColumns;
     const std::string motionKey = Text(this->MotionFileName) + "|" + std::to_string(this->AngleUnit) + "|" +
       std::to_string(this->IgnoreUnknownColumns);
@@ -285,7 +288,8 @@ bool vtkOpenSimModelReader::Load()
       if (!Text(this->RestPoseFileName).empty())
       {
         // The first row of a motion file (a static trial in the scan pose), read as the motion is.
-        const osim::CoordinateTrajectory pose = osim::MapMotion(in.model, osim::ReadMotion(this->RestPoseFileName), options);
+        const osim::CoordinateTrajectory pose =
+          osim::MapMotion(in.model, osim::ReadMotion(this->RestPoseFileName), options);
         in.rest = pose.frames.front();
       }
       osim::SetCoordinates(in.model, Text(this->RestPoseCoordinates), true, in.rest);
@@ -382,7 +386,9 @@ int vtkOpenSimModelReader::RequestData(
   const std::vector<RigidTransform> poses = osim::BodyPoses(model, q);
   const double scale = this->Scale;
   // Body frame -> output frame (scaled separately).
-  auto placed = [&](const std::vector<RigidTransform>& p, size_t body) { return Compose(in.toOutput, p[body]); };
+  auto placed = [&](const std::vector<RigidTransform>& p, size_t body) {
+    return Compose(in.toOutput, p[body]);
+  };
   auto toOutput = [&](const RigidTransform& t, const md::Points& local) {
     md::Points out = t.Apply(local);
     out *= scale;
@@ -505,7 +511,8 @@ int vtkOpenSimModelReader::RequestData(
   for (size_t c = 0; c < model.coordinates.size(); ++c)
   {
     const bool rotational = model.coordinates[c].motionType == osim::MotionType::Rotational;
-    mdvtk::AddFieldValue(table->GetFieldData(), model.coordinates[c].name.c_str(), rotational ? q[c] * 180.0 / M_PI : q[c]);
+    mdvtk::AddFieldValue(
+      table->GetFieldData(), model.coordinates[c].name.c_str(), rotational ? q[c] * 180.0 / M_PI : q[c]);
   }
   if (this->PlayMotion && !in.trajectory.times.empty())
   {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /**
  * @class   vtkOpenSimModelReader
  * @brief   Reads an OpenSim model (.osim) and, optionally, a motion (.mot/.sto): bodies, muscle

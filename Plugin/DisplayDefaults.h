@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Run by ParaView when it loads the plugin (paraview_add_plugin INITIALIZERS).
 #pragma once
 

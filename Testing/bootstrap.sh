@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Installs what is missing on Debian 12, then configures and builds MuscleDeformation (Release).
 # Sourced by Examples/run_main_job.sh and Testing/run_test_suite.sh.
 #   MUSCLEDEFORMATION_BUILD_DIR  build folder (default: build/ in the source tree)
@@ -22,9 +23,13 @@ MD_PACKAGES=(
   libqt5svg5
 )
 
+# What the test suite needs besides: its hygiene checks (Testing/lint.sh).
+MD_TEST_PACKAGES=(clang-format clang-tidy git)
+
+# Installs what is missing of MD_PACKAGES (and of any packages named as arguments).
 md_install_dependencies() {
   local missing=() package
-  for package in "${MD_PACKAGES[@]}"; do
+  for package in "${MD_PACKAGES[@]}" "$@"; do
     if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
       missing+=("$package")
     fi

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Runs a command with an X display: the one in $DISPLAY, or a private Xvfb.
 # Used instead of xvfb-run, whose start-up check was seen to let the command
 # start before the server listened when the machine was busy.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "ActionLineMatching.h"
 
 #include <algorithm>
@@ -11,8 +12,7 @@ std::vector<double> NormalisedArcLength(const Points& line)
   const Eigen::Index n = line.rows();
   if (n < 2)
   {
-    throw InputError("an action line needs at least two points, this one has " +
-      std::to_string(n));
+    throw InputError("an action line needs at least two points, this one has " + std::to_string(n));
   }
   if (!AllFinite(line))
   {
@@ -36,8 +36,7 @@ std::vector<double> NormalisedArcLength(const Points& line)
   return t;
 }
 
-Eigen::RowVector3d PointAtParameter(
-  const Points& line, const std::vector<double>& parameters, double s)
+Eigen::RowVector3d PointAtParameter(const Points& line, const std::vector<double>& parameters, double s)
 {
   s = std::clamp(s, 0.0, 1.0);
   // First segment end with parameter >= s; segments of zero length are skipped
@@ -83,11 +82,10 @@ struct Pair
 };
 }
 
-double EffectiveMatchingTolerance(const std::vector<double>& restParameters,
-  const std::vector<double>& currentParameters, double requestedTolerance)
+double EffectiveMatchingTolerance(
+  const std::vector<double>& restParameters, const std::vector<double>& currentParameters, double requestedTolerance)
 {
-  const double cap =
-    0.5 * std::min(SmallestPositiveGap(restParameters), SmallestPositiveGap(currentParameters));
+  const double cap = 0.5 * std::min(SmallestPositiveGap(restParameters), SmallestPositiveGap(currentParameters));
   return std::clamp(requestedTolerance, 0.0, cap);
 }
 
@@ -145,8 +143,8 @@ MatchedActionLines MatchActionLines(const Points& rest, const Points& current, d
     const Pair& p = pairs[k];
     result.rest.row(k) =
       p.restIndex >= 0 ? Eigen::RowVector3d(rest.row(p.restIndex)) : PointAtParameter(rest, tR, p.restT);
-    result.current.row(k) = p.currentIndex >= 0 ? Eigen::RowVector3d(current.row(p.currentIndex))
-                                                : PointAtParameter(current, tC, p.currentT);
+    result.current.row(k) =
+      p.currentIndex >= 0 ? Eigen::RowVector3d(current.row(p.currentIndex)) : PointAtParameter(current, tC, p.currentT);
     result.restParameters.push_back(p.restT);
     result.currentParameters.push_back(p.currentT);
     result.restInserted.push_back(p.restIndex < 0);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "BoneInterpolation.h"
 
 #include <algorithm>
@@ -38,9 +39,8 @@ PoseInterpolator::PoseInterpolator(const Points& rest, const Points& current, In
 {
   if (rest.rows() != current.rows())
   {
-    throw InputError("the rest pose has " + std::to_string(rest.rows()) +
-      " points but the current pose has " + std::to_string(current.rows()) +
-      "; both poses must have the same points in the same order");
+    throw InputError("the rest pose has " + std::to_string(rest.rows()) + " points but the current pose has " +
+      std::to_string(current.rows()) + "; both poses must have the same points in the same order");
   }
   if (rest.rows() == 0)
   {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Interpolation of a body between its rest pose and its current pose
 // (Hajkova & Kohout, sec. 4.1, eq. 1; and a rigid mode beyond the paper).
 #pragma once
@@ -34,7 +35,6 @@ public:
   /// Positions at fraction s in [0, 1] of the way.
   Points AtFraction(double s) const;
 
-  InterpolationMode Mode() const { return this->Mode_; }
   /// The least-squares rigid fit of the RP -> CP motion (computed in Rigid mode only).
   const std::optional<RigidFit>& Fit() const { return this->Fit_; }
   /// Rotation angle of the fitted motion (Rigid mode), in radians.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "ConvexProjection.h"
 
 #include <Eigen/LU>
@@ -41,8 +42,8 @@ std::optional<Eigen::Vector3d> FeasiblePointAlongRay(
   return Eigen::Vector3d(origin + lowest * direction);
 }
 
-std::optional<Eigen::Vector3d> ProjectOntoPolyhedron(const Eigen::Vector3d& target,
-  const std::vector<HalfSpace>& halfSpaces, const Eigen::Vector3d& feasibleStart)
+std::optional<Eigen::Vector3d> ProjectOntoPolyhedron(
+  const Eigen::Vector3d& target, const std::vector<HalfSpace>& halfSpaces, const Eigen::Vector3d& feasibleStart)
 {
   const int n = static_cast<int>(halfSpaces.size());
   Eigen::Vector3d x = feasibleStart;
@@ -64,8 +65,7 @@ std::optional<Eigen::Vector3d> ProjectOntoPolyhedron(const Eigen::Vector3d& targ
     }
     else if (working.size() == 2)
     {
-      independent =
-        std::abs(halfSpaces[working[0]].normal.cross(halfSpaces[working[1]].normal).dot(normal)) > 1e-9;
+      independent = std::abs(halfSpaces[working[0]].normal.cross(halfSpaces[working[1]].normal).dot(normal)) > 1e-9;
     }
     if (independent)
     {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Euclidean projection of a point onto a convex polyhedron given by half-spaces.
 #pragma once
 
@@ -19,8 +20,8 @@ struct HalfSpace
 /// method (at most three constraints are active in 3D) started from
 /// `feasibleStart`, which must satisfy every half-space. Returns nothing when
 /// the iteration does not settle (degenerate input).
-std::optional<Eigen::Vector3d> ProjectOntoPolyhedron(const Eigen::Vector3d& target,
-  const std::vector<HalfSpace>& halfSpaces, const Eigen::Vector3d& feasibleStart);
+std::optional<Eigen::Vector3d> ProjectOntoPolyhedron(
+  const Eigen::Vector3d& target, const std::vector<HalfSpace>& halfSpaces, const Eigen::Vector3d& feasibleStart);
 
 /// A point satisfying every half-space, searched along `direction` from
 /// `origin` (the first point of that ray inside all of them), or nothing.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "InterpolatedDeformation.h"
 
 #include "MeshChecks.h"
@@ -43,9 +44,8 @@ std::vector<TriangleMesh> BuildHulls(const std::vector<MuscleMotion>& muscles, c
       order.push_back(m);
     }
   }
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    return muscles[a].muscle.triangles.rows() > muscles[b].muscle.triangles.rows();
-  });
+  std::stable_sort(order.begin(), order.end(),
+    [&](size_t a, size_t b) { return muscles[a].muscle.triangles.rows() > muscles[b].muscle.triangles.rows(); });
   std::vector<TriangleMesh> hulls(count);
   errors.assign(count, std::string());
   seconds.assign(count, 0.0);
@@ -233,9 +233,8 @@ int ResolveNumberOfSteps(const std::vector<BoneMotion>& bones, const Interpolati
 namespace
 {
 /// DeformByInterpolation on input already in its local frame.
-InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
-  const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters,
-  const std::function<void(double)>& progress, RestMappingCache* kept)
+InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles, const std::vector<BoneMotion>& bones,
+  const InterpolationParameters& parameters, const std::function<void(double)>& progress, RestMappingCache* kept)
 {
   const auto start = Clock::now();
   auto report = [&](double fraction) {
@@ -478,10 +477,8 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       }
     }
 
-    const std::vector<DeformationResult> deformed =
-      DeformMuscles(toDeform, obstacles, stepParameters, [&](double fraction) {
-        report(stepStart + 0.9 * stepShare * fraction);
-      });
+    const std::vector<DeformationResult> deformed = DeformMuscles(
+      toDeform, obstacles, stepParameters, [&](double fraction) { report(stepStart + 0.9 * stepShare * fraction); });
     std::vector<TriangleMesh> next(count);
     for (size_t m = 0; m < count; ++m)
     {
@@ -568,9 +565,8 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
 namespace
 {
 /// DeformByInterpolation of every muscle or none: throws what the first failure throws.
-InterpolationResult DeformEveryMuscle(const std::vector<MuscleMotion>& muscles,
-  const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters,
-  const std::function<void(double)>& progress, RestMappingCache* kept)
+InterpolationResult DeformEveryMuscle(const std::vector<MuscleMotion>& muscles, const std::vector<BoneMotion>& bones,
+  const InterpolationParameters& parameters, const std::function<void(double)>& progress, RestMappingCache* kept)
 {
   // Everything in the muscles' local frame, lengths given in data units with it.
   std::vector<const Points*> restPoints;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The interpolation method (Hajkova & Kohout sec. 4.3; docs/DESIGN.md section 6):
 // the motion split into N steps, bones and matched action lines interpolated
 // at every step, each step deformed from the previous result (all muscles
@@ -85,8 +86,8 @@ inline DeformationParameters StepDeformationDefaults()
 
 struct InterpolationParameters
 {
-  int numberOfSteps = 4;                ///< N; 0: automatic
-  double maximumStepDisplacement = 20;  ///< largest bone-point move per step when N is automatic
+  int numberOfSteps = 4;               ///< N; 0: automatic
+  double maximumStepDisplacement = 20; ///< largest bone-point move per step when N is automatic
   InterpolationMode interpolationMode = InterpolationMode::Rigid; ///< bones and action lines
   HullMode hullMode = HullMode::Refit;
   double refitRegularisation = 1e-3; ///< HullRefitter's, relative (the filter's default too)
@@ -101,8 +102,8 @@ struct InterpolationParameters
 /// The measures of one muscle after step j (docs/DESIGN.md, "Measures").
 struct MuscleStepMeasures
 {
-  double volumeChangePercent = 0;         ///< against the rest pose
-  std::int64_t newPenetrationCount = 0;   ///< inside a bone or another muscle, not so in the rest pose
+  double volumeChangePercent = 0;       ///< against the rest pose
+  std::int64_t newPenetrationCount = 0; ///< inside a bone or another muscle, not so in the rest pose
   double maxNewPenetrationDepth = 0;
   std::int64_t newBonePenetrationCount = 0; ///< the same, bones only
   double maxNewBonePenetrationDepth = 0;
@@ -112,22 +113,22 @@ struct MuscleStepMeasures
   std::int64_t sharpEdgeCount = 0;        ///< dihedral angle > 60 degrees, not so in the rest pose
   std::int64_t flippedTriangleCount = 0;  ///< against the rest pose
   int stepIterations = 0;
-  int iterations = 0;                     ///< steps 1..j
-  bool converged = true;                  ///< every step so far
+  int iterations = 0;                       ///< steps 1..j
+  bool converged = true;                    ///< every step so far
   std::int64_t pointsFrozenInObstacles = 0; ///< this step
-  double hullSeconds = 0;                 ///< this step's hull work: refit, or rebuild and mapping
-  double deformationSeconds = 0;          ///< this step's deformation and static resolution (its share)
-  Points staticShift;                     ///< this step's static move, per point
+  double hullSeconds = 0;                   ///< this step's hull work: refit, or rebuild and mapping
+  double deformationSeconds = 0;            ///< this step's deformation and static resolution (its share)
+  Points staticShift;                       ///< this step's static move, per point
 };
 
 struct InterpolationResult
 {
   int numberOfSteps = 0;
-  bool zeroMotion = false;                          ///< RP = CP: every step is the input
-  std::vector<std::vector<Points>> points;          ///< [step][muscle], step 0 the rest pose
+  bool zeroMotion = false;                               ///< RP = CP: every step is the input
+  std::vector<std::vector<Points>> points;               ///< [step][muscle], step 0 the rest pose
   std::vector<std::vector<MuscleStepMeasures>> measures; ///< [step][muscle]
-  std::vector<double> restHullSeconds;              ///< per muscle: rest hull and mapping
-  std::vector<double> stepSeconds;                  ///< [step], 0 for step 0
+  std::vector<double> restHullSeconds;                   ///< per muscle: rest hull and mapping
+  std::vector<double> stepSeconds;                       ///< [step], 0 for step 0
   double totalSeconds = 0;
   std::vector<std::string> warnings;
   /// Per muscle: empty, or why it could not be deformed (its points are then empty at every
@@ -144,8 +145,8 @@ struct RestMappingCache
 {
   struct Entry
   {
-    TriangleMesh surface;    ///< the rest pose it was made from (in the method's local frame)
-    HullParameters hull;     ///< and the hull parameters
+    TriangleMesh surface; ///< the rest pose it was made from (in the method's local frame)
+    HullParameters hull;  ///< and the hull parameters
     TriangleMesh restHull;
     WeightMatrix weights;
   };

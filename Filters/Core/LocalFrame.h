@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Coordinates relative to a local origin and in a power-of-two unit, so that the method's
 // arithmetic (volumes and their gradients, cross products, tolerances relative to a size) gives
 // the same answer wherever the data sits and whatever its units.

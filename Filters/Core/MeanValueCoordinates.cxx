@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "MeanValueCoordinates.h"
 
 #include <Eigen/LU>
@@ -111,8 +112,7 @@ void MeanValueCoordinateCalculator::Compute(const Eigen::Vector3d& x, Eigen::Ref
         area[i] = toPoint.row(p[(i + 1) % 3]).cross(toPoint.row(p[(i + 2) % 3])).dot(normal.transpose()) / normalLength;
       }
       const double total = area[0] + area[1] + area[2];
-      if (area[0] >= -onCage * normalLength && area[1] >= -onCage * normalLength &&
-        area[2] >= -onCage * normalLength)
+      if (area[0] >= -onCage * normalLength && area[1] >= -onCage * normalLength && area[2] >= -onCage * normalLength)
       {
         weights.setZero();
         for (int i = 0; i < 3; ++i)
@@ -125,8 +125,7 @@ void MeanValueCoordinateCalculator::Compute(const Eigen::Vector3d& x, Eigen::Ref
       continue;
     }
     // det(e1, e2, e3) of the unit directions, from the signed distance.
-    const double determinant =
-      signedDistance * normalLength / (distance(p[0]) * distance(p[1]) * distance(p[2]));
+    const double determinant = signedDistance * normalLength / (distance(p[0]) * distance(p[1]) * distance(p[2]));
     Eigen::Vector3d cross[3];
     Eigen::Vector3d mean = Eigen::Vector3d::Zero(); // integral of u over the spherical triangle
     for (int i = 0; i < 3; ++i)

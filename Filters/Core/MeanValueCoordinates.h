@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Mean value coordinates with respect to a closed triangle mesh (Ju, Schaefer
 // & Warren 2005; computed in the form of Floater, Kos & Reimers 2005).
 #pragma once
@@ -34,7 +35,7 @@ public:
 private:
   const TriangleMesh& Cage;
   Eigen::Vector3d Centre;
-  Points Centred;                    // cage points minus Centre
+  Points Centred;                        // cage points minus Centre
   Eigen::Matrix4d ConstraintGramInverse; // (A A^T)^-1, A = [centred^T; 1^T]
   double Size = 0;
   Eigen::Matrix<std::int64_t, Eigen::Dynamic, 2, Eigen::RowMajor> Edges; // each cage edge once: its two points

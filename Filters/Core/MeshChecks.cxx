@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "MeshChecks.h"
 
 #include "TriangleIntersection.h"
@@ -235,7 +236,9 @@ std::vector<std::vector<std::int64_t>> PointNeighbours(const Triangles& triangle
 std::vector<int> Components(
   const Triangles& triangles, Eigen::Index points, int& count, const std::vector<char>* member)
 {
-  auto isMember = [&](std::int64_t i) { return !member || (*member)[static_cast<size_t>(i)]; };
+  auto isMember = [&](std::int64_t i) {
+    return !member || (*member)[static_cast<size_t>(i)];
+  };
   std::vector<int> parent(static_cast<size_t>(points));
   std::iota(parent.begin(), parent.end(), 0);
   auto root = [&](int x) {
@@ -284,7 +287,8 @@ std::int64_t CountNewSharpEdges(
   {
     for (int k = 0; k < 3; ++k)
     {
-      const auto a = static_cast<std::uint64_t>(triangles(t, k)), b = static_cast<std::uint64_t>(triangles(t, (k + 1) % 3));
+      const auto a = static_cast<std::uint64_t>(triangles(t, k)),
+                 b = static_cast<std::uint64_t>(triangles(t, (k + 1) % 3));
       auto [entry, added] = edges.try_emplace((std::min(a, b) << 32) | std::max(a, b), t, -1);
       if (!added)
       {

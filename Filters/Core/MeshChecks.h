@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Checks and measures on closed triangle surfaces.
 #pragma once
 
@@ -9,9 +10,9 @@ namespace md
 {
 struct EdgeReport
 {
-  std::int64_t boundaryEdges = 0;     ///< edges used by one triangle (holes)
-  std::int64_t nonManifoldEdges = 0;  ///< edges used by more than two triangles
-  std::int64_t inconsistentEdges = 0; ///< edges walked the same way by both triangles
+  std::int64_t boundaryEdges = 0;       ///< edges used by one triangle (holes)
+  std::int64_t nonManifoldEdges = 0;    ///< edges used by more than two triangles
+  std::int64_t inconsistentEdges = 0;   ///< edges walked the same way by both triangles
   std::int64_t degenerateTriangles = 0; ///< triangles repeating a point index
 
   bool Closed() const { return this->boundaryEdges == 0; }
@@ -19,8 +20,7 @@ struct EdgeReport
   bool ConsistentlyOriented() const { return this->inconsistentEdges == 0; }
   bool IsClosedOrientedManifold() const
   {
-    return this->Closed() && this->Manifold() && this->ConsistentlyOriented() &&
-      this->degenerateTriangles == 0;
+    return this->Closed() && this->Manifold() && this->ConsistentlyOriented() && this->degenerateTriangles == 0;
   }
 };
 

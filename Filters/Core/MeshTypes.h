@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Plain data types shared by the algorithm core (no VTK here).
 #pragma once
 
@@ -41,7 +42,7 @@ public:
 };
 
 /// `error`, marked as muscle `index`'s own, unless it is already marked.
-template <class E>
+template<class E>
 E OfMuscle(E error, size_t index)
 {
   if (!error.muscle)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "MuscleDeformer.h"
 
 #include "MeshChecks.h"
@@ -8,14 +9,14 @@
 #include <Eigen/SparseCholesky>
 
 #include <algorithm>
-#include <queue>
-#include <iomanip>
-#include <sstream>
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <iomanip>
 #include <limits>
 #include <numeric>
+#include <queue>
+#include <sstream>
 
 namespace md
 {
@@ -181,21 +182,21 @@ double FractionInside(const TriangleTree& tree, const Points& points)
 struct MuscleState
 {
   const MuscleToDeform* input = nullptr;
-  double size = 0; // span (box diagonal) of the muscle where the pass starts
+  double size = 0;                       // span (box diagonal) of the muscle where the pass starts
   WeightMatrix ownWeights;               // when not given
   const WeightMatrix* weights = nullptr; // full mesh = weights * hull
   std::unique_ptr<VolumeConstrainedSolver> solver;
   Points targets;
-  Points currentSamples; // action-line samples in the current pose
-  Points hull;    // X
-  Points points;  // the full mesh as it moves (W X where nothing held it)
-  Points start;   // where the pass starts
+  Points currentSamples;             // action-line samples in the current pose
+  Points hull;                       // X
+  Points points;                     // the full mesh as it moves (W X where nothing held it)
+  Points start;                      // where the pass starts
   const Points* reference = nullptr; // the shape folds are judged against (MuscleToDeform::reference)
   double hullVolume = 0, restVolume = 0;
-  std::vector<char> frozen;  // inside a bone before a step: stays
-  std::vector<char> stopped; // held at an obstacle in the last move
-  std::vector<char> touched; // held at an obstacle in any move: left out of the volume gradient, which
-                             // would otherwise swing as points come off the obstacle and back
+  std::vector<char> frozen;           // inside a bone before a step: stays
+  std::vector<char> stopped;          // held at an obstacle in the last move
+  std::vector<char> touched;          // held at an obstacle in any move: left out of the volume gradient, which
+                                      // would otherwise swing as points come off the obstacle and back
   std::unique_ptr<TriangleTree> tree; // of `points`, for the other muscles
   // Of the full mesh's points, when the unfolding first needs them: their
   // neighbours and the triangles they are corners of.
@@ -204,12 +205,12 @@ struct MuscleState
   double orientation = 1; // +1 when the triangles face outwards
   bool converged = false;
   bool fineDone = false;
-  bool fellBack = false;  // the fine phase tore the muscle apart: it keeps its coarse result
+  bool fellBack = false; // the fine phase tore the muscle apart: it keeps its coarse result
   Points fineStartPoints, fineStartHull;
   int unfoldings = 0;
   bool flipsCheckedClean = false;
-  bool unfoldingBlocked = false; // the last unfolding left folds (pinned at a bone): no more
-  double fineStep = 1;                                   // step length of the fine phase
+  bool unfoldingBlocked = false;                          // the last unfolding left folds (pinned at a bone): no more
+  double fineStep = 1;                                    // step length of the fine phase
   double lastChange = std::numeric_limits<double>::max(); // largest hull change of the last fine step
   Clock::duration time{};
   DeformationResult result;
@@ -363,8 +364,8 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
       s.targets.row(followStart + i) = followWeight * NearestSegment(p, m.lines).Follow(p).transpose();
     }
   }
-  s.solver =
-    std::make_unique<VolumeConstrainedSolver>(StackRows(laplacian, sampleWeights, anchored, followWeight), hull.triangles);
+  s.solver = std::make_unique<VolumeConstrainedSolver>(
+    StackRows(laplacian, sampleWeights, anchored, followWeight), hull.triangles);
 
   s.hull = hull.points;
   s.start = m.muscle->points;
@@ -652,8 +653,7 @@ std::int64_t PinDeeperInBones(MuscleState& s, const std::vector<Obstacle>& bones
 /// surface, and a point already inside one that it would carry deeper stays
 /// where it was, held as part of the region's border. Returns whether any
 /// point moved.
-bool UnfoldFlippedTriangles(
-  MuscleState& s, const std::vector<Obstacle>& bones, bool dynamicIntersections, bool onBones)
+bool UnfoldFlippedTriangles(MuscleState& s, const std::vector<Obstacle>& bones, bool dynamicIntersections, bool onBones)
 {
   const Triangles& triangles = s.input->muscle->triangles;
   const Points& reference = *s.reference;
@@ -902,10 +902,10 @@ std::vector<std::string> LimitActionLinePoints(std::vector<MatchedLine>& lines, 
       Span out{ 0.0, first, last, -1 };
       for (Eigen::Index k = first + 1; k < last; ++k)
       {
-        const double d = std::max(
-          SegmentDistance(line.rest.row(k).transpose(), line.rest.row(first).transpose(), line.rest.row(last).transpose()),
-          SegmentDistance(line.current.row(k).transpose(), line.current.row(first).transpose(),
-            line.current.row(last).transpose()));
+        const double d = std::max(SegmentDistance(line.rest.row(k).transpose(), line.rest.row(first).transpose(),
+                                    line.rest.row(last).transpose()),
+          SegmentDistance(
+            line.current.row(k).transpose(), line.current.row(first).transpose(), line.current.row(last).transpose()));
         if (d > out.deviation || out.worst < 0)
         {
           out.deviation = d;
@@ -993,8 +993,8 @@ void SampleMatchedLines(
   }
 }
 
-std::vector<Eigen::Index> FlippedTriangles(const Points& rest, const Points& deformed, const Triangles& triangles,
-  const std::vector<Eigen::Index>* candidates)
+std::vector<Eigen::Index> FlippedTriangles(
+  const Points& rest, const Points& deformed, const Triangles& triangles, const std::vector<Eigen::Index>* candidates)
 {
   // Each point's local motion: the covariance of its edges, rest against
   // deformed (only at the corners of the triangles to check).
@@ -1034,7 +1034,8 @@ std::vector<Eigen::Index> FlippedTriangles(const Points& rest, const Points& def
   {
     const Eigen::Index t = candidates ? (*candidates)[c] : c;
     const Eigen::Vector3d a0 = rest.row(triangles(t, 0)).transpose(), a1 = deformed.row(triangles(t, 0)).transpose();
-    const Eigen::Vector3d n0 = (rest.row(triangles(t, 1)).transpose() - a0).cross(rest.row(triangles(t, 2)).transpose() - a0);
+    const Eigen::Vector3d n0 =
+      (rest.row(triangles(t, 1)).transpose() - a0).cross(rest.row(triangles(t, 2)).transpose() - a0);
     const Eigen::Vector3d n1 =
       (deformed.row(triangles(t, 1)).transpose() - a1).cross(deformed.row(triangles(t, 2)).transpose() - a1);
     if (n0.squaredNorm() == 0 || n1.squaredNorm() == 0)
@@ -1182,9 +1183,10 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
     // hull point far off that hardly weighs on the muscle is no harm.)
     if (Growth(s) > maximumGrowth)
     {
-      throw OfMuscle(ComputationError("the deformation of muscle '" + s.input->name + "' diverged on its hull: the muscle spans " +
-        std::to_string(Growth(s)) + " times its starting size after " +
-        std::to_string(s.result.coarseIterations) + " iterations"), IndexOf(s, muscles));
+      throw OfMuscle(ComputationError("the deformation of muscle '" + s.input->name +
+                       "' diverged on its hull: the muscle spans " + std::to_string(Growth(s)) +
+                       " times its starting size after " + std::to_string(s.result.coarseIterations) + " iterations"),
+        IndexOf(s, muscles));
     }
     if (parameters.dynamicIntersections)
     {
@@ -1333,7 +1335,8 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
         }
         s.fellBack = s.fineDone = true;
         s.result.warnings.push_back("the fine phase of muscle '" + s.input->name + "' diverged (" +
-          std::to_string(std::count(s.frozen.begin(), s.frozen.end(), 1) + std::count(s.touched.begin(), s.touched.end(), 1)) +
+          std::to_string(
+            std::count(s.frozen.begin(), s.frozen.end(), 1) + std::count(s.touched.begin(), s.touched.end(), 1)) +
           " points held by obstacles): the muscle keeps its coarse result, without the volume of its full mesh held");
       }
       else if (largest < parameters.convergenceTolerance)
@@ -1397,13 +1400,14 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
       // Unconverged but sound (a small swing) is a warning; unconverged and
       // torn apart (volume far off, or the muscle grown far beyond its size)
       // is no result to hand on.
-      if (!s.fellBack && ((parameters.preserveVolume && std::abs(r.volumeChangePercent) > 10.0) ||
-        Growth(s) > maximumGrowth))
+      if (!s.fellBack &&
+        ((parameters.preserveVolume && std::abs(r.volumeChangePercent) > 10.0) || Growth(s) > maximumGrowth))
       {
         throw OfMuscle(ComputationError("the deformation of muscle '" + s.input->name + "' diverged: after " +
-          std::to_string(parameters.maximumIterations) + " iterations its volume is off by " +
-          std::to_string(r.volumeChangePercent) + " % and it spans " +
-          std::to_string(Growth(s)) + " times its starting size"), IndexOf(s, muscles));
+                         std::to_string(parameters.maximumIterations) + " iterations its volume is off by " +
+                         std::to_string(r.volumeChangePercent) + " % and it spans " + std::to_string(Growth(s)) +
+                         " times its starting size"),
+          IndexOf(s, muscles));
       }
       if (!s.fellBack)
       {

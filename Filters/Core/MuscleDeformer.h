@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // One rest-pose -> current-pose pass of the muscle deformation (Kellnhofer &
 // Kohout, after Huang et al. 2006; docs/DESIGN.md section 4):
 // least squares on the hull points, shape rows (cotangent Laplacian with
@@ -71,7 +72,7 @@ struct DeformationParameters
 /// One muscle to deform.
 struct MuscleToDeform
 {
-  std::string name;           ///< for messages
+  std::string name;                     ///< for messages
   const TriangleMesh* muscle = nullptr; ///< full mesh in the rest pose (any point order; unused points follow too)
   const TriangleMesh* hull = nullptr;   ///< rest-pose hull enclosing the muscle (BuildProgressiveHull)
   std::vector<MatchedLine> lines;
@@ -105,7 +106,7 @@ struct DeformationResult
   int iterations = 0;
   int coarseIterations = 0;
   bool converged = false;
-  double volumeChangePercent = 0; ///< of the full mesh
+  double volumeChangePercent = 0;    ///< of the full mesh
   std::int64_t flippedTriangles = 0; ///< against the reference shape
   /// Points left where they were because they were inside a bone when the
   /// fine phase started (frozen), and points stopped at an obstacle's surface
@@ -190,7 +191,6 @@ std::int64_t CountFlippedTriangles(const Points& rest, const Points& deformed, c
 /// The same triangles, listed; only among `candidates` when given.
 std::vector<Eigen::Index> FlippedTriangles(const Points& rest, const Points& deformed, const Triangles& triangles,
   const std::vector<Eigen::Index>* candidates = nullptr);
-
 
 /// Number of `points` inside the closed surface of `tree` (bounding-box check first).
 std::int64_t CountInsideTree(const TriangleTree& tree, const Points& points);

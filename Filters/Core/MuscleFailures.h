@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // One muscle's failure must not take the others down: a computation over several muscles runs
 // again without a muscle whose failure is its own (Error::muscle), and says why in `failures`.
 #pragma once
@@ -31,7 +32,7 @@ inline std::function<void(double)> ForwardOnly(const std::function<void(double)>
 /// `active`), that muscle's entry of `failures` gets the message and `run` is called again without
 /// it. Anything else is thrown on, and so is the failure when no muscle is left: as it was thrown
 /// for a single muscle, else as an InputError naming every muscle's failure.
-template <class Run>
+template<class Run>
 auto WithoutFailedMuscles(std::vector<std::string>& failures, Run run)
 {
   std::vector<size_t> active;

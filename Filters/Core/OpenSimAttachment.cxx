@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "OpenSimAttachment.h"
 
 #include "TriangleTree.h"
@@ -113,8 +114,9 @@ PathGrouping GroupPaths(const std::vector<TriangleMesh>& muscles, const std::vec
   for (const auto& [muscle, pathList] : assignments)
   {
     const auto m = std::find(muscleNames.begin(), muscleNames.end(), muscle);
+    const std::string& wanted = muscle; // (a lambda may not capture a structured binding in C++17)
     const auto stem = std::find_if(muscleNames.begin(), muscleNames.end(),
-      [&](const std::string& name) { return WithoutExtension(name) == muscle; });
+      [&](const std::string& name) { return WithoutExtension(name) == wanted; });
     if (m == muscleNames.end() && stem == muscleNames.end())
     {
       throw InputError("'" + muscle + "' is not one of the muscles");

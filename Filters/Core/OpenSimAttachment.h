@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tying the user's own surfaces to an OpenSim model: which body a scanned bone moves with,
 // and which muscle paths are the action lines of which muscle surface.
 #pragma once

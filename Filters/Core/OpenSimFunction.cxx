@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "OpenSimFunction.h"
 
 #include "MeshTypes.h"
@@ -28,14 +29,15 @@ void CheckKnots(const std::vector<double>& x, const std::vector<double>& y, cons
     }
     if (i > 0 && !(x[i] > x[i - 1]))
     {
-      throw InputError(std::string(what) + " has x values that do not increase (knots " + std::to_string(i) +
-        " and " + std::to_string(i + 1) + ")");
+      throw InputError(std::string(what) + " has x values that do not increase (knots " + std::to_string(i) + " and " +
+        std::to_string(i + 1) + ")");
     }
   }
 }
 
 /// Knot spacing h_i = x_i+1 - x_i and the slope of each span.
-void Spans(const std::vector<double>& x, const std::vector<double>& y, std::vector<double>& h, std::vector<double>& slope)
+void Spans(
+  const std::vector<double>& x, const std::vector<double>& y, std::vector<double>& h, std::vector<double>& slope)
 {
   h.resize(x.size() - 1);
   slope.resize(x.size() - 1);

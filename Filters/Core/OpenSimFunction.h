@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Functions of one coordinate as OpenSim's model files define them: the
 // displacements of a CustomJoint's axes, the locations of moving path points,
 // coordinate couplers. Plain C++, no XML here (OpenSimModel reads them).

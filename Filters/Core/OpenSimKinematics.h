@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Forward kinematics of an OpenSim model: coordinates -> body poses -> muscle paths.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "OpenSimModel.h"
 
 #include <pugixml.hpp>
@@ -15,7 +16,7 @@ namespace md::osim
 {
 namespace
 {
-template <typename Item>
+template<typename Item>
 int IndexOfName(const std::vector<Item>& items, const std::string& name)
 {
   for (size_t i = 0; i < items.size(); ++i)
@@ -48,10 +49,10 @@ namespace
 {
 using Node = pugi::xml_node;
 
-const std::set<std::string> kFunctionTypes = { "Constant", "LinearFunction", "SimmSpline",
-  "NaturalCubicSpline", "PiecewiseLinearFunction", "PolynomialFunction", "MultiplierFunction" };
-const std::set<std::string> kJointTypes = { "CustomJoint", "PinJoint", "WeldJoint", "BallJoint",
-  "UniversalJoint", "SliderJoint", "PlanarJoint", "FreeJoint", "GimbalJoint" };
+const std::set<std::string> kFunctionTypes = { "Constant", "LinearFunction", "SimmSpline", "NaturalCubicSpline",
+  "PiecewiseLinearFunction", "PolynomialFunction", "MultiplierFunction" };
+const std::set<std::string> kJointTypes = { "CustomJoint", "PinJoint", "WeldJoint", "BallJoint", "UniversalJoint",
+  "SliderJoint", "PlanarJoint", "FreeJoint", "GimbalJoint" };
 const std::set<std::string> kPointTypes = { "PathPoint", "ConditionalPathPoint", "MovingPathPoint" };
 
 /// Reads the document and says where things are for messages.
@@ -110,8 +111,9 @@ public:
     {
       return 0;
     }
-    return 1 + static_cast<size_t>(std::count(this->text.begin(),
-                 this->text.begin() + std::min<ptrdiff_t>(offset, this->text.size()), '\n'));
+    return 1 +
+      static_cast<size_t>(
+        std::count(this->text.begin(), this->text.begin() + std::min<ptrdiff_t>(offset, this->text.size()), '\n'));
   }
 
   std::vector<double> Numbers(Node node, const char* child, size_t expected = 0) const
@@ -136,8 +138,7 @@ public:
     }
     if (expected && values.size() != expected)
     {
-      this->Fail(element,
-        "expected " + std::to_string(expected) + " numbers, found " + std::to_string(values.size()));
+      this->Fail(element, "expected " + std::to_string(expected) + " numbers, found " + std::to_string(values.size()));
     }
     return values;
   }
@@ -163,7 +164,7 @@ public:
 
   /// `make()`, whose complaints (knots that do not increase, ...) are told with this node's place
   /// in the file.
-  template <typename Make>
+  template<typename Make>
   Function Located(Node node, Make make) const
   {
     try
@@ -260,8 +261,7 @@ public:
 Eigen::Matrix3d BodyFixedXYZ(const Eigen::Vector3d& angles)
 {
   return (Eigen::AngleAxisd(angles[0], Eigen::Vector3d::UnitX()) *
-    Eigen::AngleAxisd(angles[1], Eigen::Vector3d::UnitY()) *
-    Eigen::AngleAxisd(angles[2], Eigen::Vector3d::UnitZ()))
+    Eigen::AngleAxisd(angles[1], Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(angles[2], Eigen::Vector3d::UnitZ()))
     .toRotationMatrix();
 }
 
@@ -502,7 +502,8 @@ private:
           this->frameNodes[childPath] = child;
           this->frameNodes.emplace(name, child);
         }
-        visit(child, std::string(child.name()) == "objects" || child.name() == std::string("frames") ||
+        visit(child,
+          std::string(child.name()) == "objects" || child.name() == std::string("frames") ||
               child.name() == std::string("components")
             ? path
             : childPath);
@@ -589,9 +590,8 @@ private:
       parent = owner.attribute("name").value();
     }
     const FrameOnBody base = this->ResolveFrame(frame, parent, Node(), depth + 1);
-    const RigidTransform own =
-      Offset(this->reader.Vector(frame, "translation", Eigen::Vector3d::Zero()),
-        this->reader.Vector(frame, "orientation", Eigen::Vector3d::Zero()));
+    const RigidTransform own = Offset(this->reader.Vector(frame, "translation", Eigen::Vector3d::Zero()),
+      this->reader.Vector(frame, "orientation", Eigen::Vector3d::Zero()));
     return { base.body, Compose(base.offset, own) };
   }
 
@@ -640,8 +640,7 @@ private:
       {
         coordinates.push_back(this->AddCoordinate(c, name));
       }
-      const FrameOnBody parent =
-        this->ResolveFrame(joint, joint.child("socket_parent_frame").text().get(), joint);
+      const FrameOnBody parent = this->ResolveFrame(joint, joint.child("socket_parent_frame").text().get(), joint);
       const FrameOnBody child = this->ResolveFrame(joint, joint.child("socket_child_frame").text().get(), joint);
       j.parentBody = parent.body;
       j.parentOffset = parent.offset;
@@ -761,8 +760,8 @@ private:
 
   void ReadSpatialTransform(Node joint, Joint& j, const std::vector<int>& jointCoordinates)
   {
-    static const char* axisNames[6] = { "rotation1", "rotation2", "rotation3", "translation1",
-      "translation2", "translation3" };
+    static const char* axisNames[6] = { "rotation1", "rotation2", "rotation3", "translation1", "translation2",
+      "translation3" };
     Node transform = joint.child("SpatialTransform");
     if (!transform)
     {
@@ -865,8 +864,7 @@ private:
     {
       if (!placed[b])
       {
-        this->reader.Fail(modelNode,
-          "body '" + this->model.bodies[b].name + "' is not connected to ground by joints");
+        this->reader.Fail(modelNode, "body '" + this->model.bodies[b].name + "' is not connected to ground by joints");
       }
     }
     this->model.joints = ordered;
@@ -954,8 +952,8 @@ private:
     const std::vector<std::string> independent = Words(constraint.child("independent_coordinate_names").text().get());
     if (independent.size() != 1)
     {
-      this->reader.Fail(constraint, "a coupler with " + std::to_string(independent.size()) +
-          " independent coordinates (one is supported)");
+      this->reader.Fail(constraint,
+        "a coupler with " + std::to_string(independent.size()) + " independent coordinates (one is supported)");
     }
     c.independent = this->CoordinateOf(constraint, independent[0]);
     c.dependent = this->CoordinateOf(constraint, constraint.child("dependent_coordinate_name").text().get());
@@ -1074,10 +1072,11 @@ Model ParseModel(const std::string& text, const std::string& fileName)
   Reader reader(text, fileName);
   if (!parsed)
   {
-    const size_t line = 1 + static_cast<size_t>(std::count(text.begin(),
-                              text.begin() + std::min<ptrdiff_t>(parsed.offset, text.size()), '\n'));
-    throw InputError("OpenSim model '" + fileName + "', line " + std::to_string(line) +
-      ": malformed XML: " + parsed.description());
+    const size_t line = 1 +
+      static_cast<size_t>(
+        std::count(text.begin(), text.begin() + std::min<ptrdiff_t>(parsed.offset, text.size()), '\n'));
+    throw InputError(
+      "OpenSim model '" + fileName + "', line " + std::to_string(line) + ": malformed XML: " + parsed.description());
   }
   Node root = document.child("OpenSimDocument");
   Model model;
@@ -1099,7 +1098,8 @@ Model ParseModel(const std::string& text, const std::string& fileName)
     model.version = root.attribute("Version").as_int(0);
     if (model.version < 20000)
     {
-      reader.Fail(root, "format version " + std::to_string(model.version) +
+      reader.Fail(root,
+        "format version " + std::to_string(model.version) +
           " is not supported (OpenSim 3.x is 20000-30516, 4.x 40000 and later)");
     }
   }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // An OpenSim musculoskeletal model (.osim, format 3.x and 4.x) read into plain data:
 // bodies, joints, coordinates, muscle paths, wrap objects, coordinate couplers.
 // Forward kinematics and path geometry are in OpenSimKinematics.h.
@@ -103,14 +104,13 @@ struct PathPoint
   std::string name;
   PathPointKind kind = PathPointKind::Fixed;
   int body = 0;
-  RigidTransform frame;             ///< the point's frame -> body frame (identity on a body)
+  RigidTransform frame;                               ///< the point's frame -> body frame (identity on a body)
   Eigen::Vector3d location = Eigen::Vector3d::Zero(); ///< in the point's frame
   // Conditional: active while coordinate is in [rangeMin - 1e-5, rangeMax + 1e-5].
   int coordinate = -1;
   double rangeMin = 0.0, rangeMax = 0.0;
   // Moving: location[i] = function[i](clamped coordinate[i]).
-  std::array<Function, 3> locationFunction = { Function::Constant(0), Function::Constant(0),
-    Function::Constant(0) };
+  std::array<Function, 3> locationFunction = { Function::Constant(0), Function::Constant(0), Function::Constant(0) };
   std::array<int, 3> locationCoordinate = { -1, -1, -1 };
 };
 
@@ -137,8 +137,8 @@ struct Model
 {
   std::string name;
   std::string file;
-  int version = 0; ///< OpenSimDocument Version (30000: 3.x, 40000: 4.x)
-  std::vector<Body> bodies; ///< bodies[0] is ground
+  int version = 0;           ///< OpenSimDocument Version (30000: 3.x, 40000: 4.x)
+  std::vector<Body> bodies;  ///< bodies[0] is ground
   std::vector<Joint> joints; ///< parents before children
   std::vector<Coordinate> coordinates;
   std::vector<CoordinateCoupler> couplers; ///< in the order to apply them

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "OpenSimMotion.h"
 
 #include "OpenSimKinematics.h"
@@ -142,8 +143,9 @@ MotionTable ReadMotion(const std::string& fileName)
     }
     if (fields.size() != labels.size())
     {
-      fail(lineNumber, "a row of " + std::to_string(fields.size()) + " values under " +
-          std::to_string(labels.size()) + " column labels");
+      fail(lineNumber,
+        "a row of " + std::to_string(fields.size()) + " values under " + std::to_string(labels.size()) +
+          " column labels");
     }
     std::vector<double> row(fields.size());
     for (size_t i = 0; i < fields.size(); ++i)
@@ -204,7 +206,8 @@ CoordinateTrajectory MapMotion(const Model& model, const MotionTable& motion, co
   }
   if (!skipped.empty())
   {
-    trajectory.warnings.push_back("motion file '" + motion.file + "': columns naming no coordinate of the model were skipped: " + skipped);
+    trajectory.warnings.push_back(
+      "motion file '" + motion.file + "': columns naming no coordinate of the model were skipped: " + skipped);
   }
   std::string missing;
   std::vector<bool> dependent(model.coordinates.size(), false);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // OpenSim motion and storage files (.mot, .sto): a table of coordinate values over time, and
 // its mapping onto a model's coordinates.
 #pragma once

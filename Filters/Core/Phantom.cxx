@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "Phantom.h"
 
 #include <algorithm>
@@ -114,8 +115,7 @@ Points RoundedPolyline(const Points& controlPoints, double cornerRadius, double 
     const Vec3 previous = controlPoints.row(i - 1).transpose();
     const Vec3 corner = controlPoints.row(i).transpose();
     const Vec3 next = controlPoints.row(i + 1).transpose();
-    const double r = std::min(
-      { cornerRadius, 0.45 * (corner - previous).norm(), 0.45 * (next - corner).norm() });
+    const double r = std::min({ cornerRadius, 0.45 * (corner - previous).norm(), 0.45 * (next - corner).norm() });
     const Vec3 a = corner - r * (corner - previous).normalized();
     const Vec3 b = corner + r * (next - corner).normalized();
     constexpr int filletSamples = 16;
@@ -192,8 +192,7 @@ TriangleMesh BuildTube(const TubeSpecification& spec)
     {
       ++profileIndex;
     }
-    const double f = (target - profileS[profileIndex - 1]) /
-      (profileS[profileIndex] - profileS[profileIndex - 1]);
+    const double f = (target - profileS[profileIndex - 1]) / (profileS[profileIndex] - profileS[profileIndex - 1]);
     const double x = (1 - f) * profileX[profileIndex - 1] + f * profileX[profileIndex];
     while (segment + 1 < static_cast<size_t>(segments) && s[segment + 1] < x)
     {
@@ -281,8 +280,7 @@ Phantom BuildPhantom(const PhantomParameters& parameters)
     const Vec3 neckCorner = k * Vec3(50, 0, -45);
     const Vec3 headPole = phantom.hipCentre - headRadius * (neckCorner - phantom.hipCentre).normalized();
     TubeSpecification femur;
-    femur.centreline =
-      RoundedPolyline(Rows({ headPole, neckCorner, k * Vec3(58, 0, -400) }), 30 * k, spacing);
+    femur.centreline = RoundedPolyline(Rows({ headPole, neckCorner, k * Vec3(58, 0, -400) }), 30 * k, spacing);
     femur.radii = [k, headRadius](double x, double length) {
       const double neck = 13 * k, shaft = 14 * k, condyle = 26 * k;
       const double fromHeadCentre = x - headRadius;
@@ -293,8 +291,7 @@ Phantom BuildPhantom(const PhantomParameters& parameters)
       }
       else
       {
-        const double sphere =
-          std::sqrt(std::max(0.0, headRadius * headRadius - fromHeadCentre * fromHeadCentre));
+        const double sphere = std::sqrt(std::max(0.0, headRadius * headRadius - fromHeadCentre * fromHeadCentre));
         const double body = neck + (shaft - neck) * SmoothStep(60 * k, 120 * k, x) +
           (condyle - shaft) * SmoothStep(length - 90 * k, length - condyle, x);
         r = std::max(sphere, body * CapFactor(x, length, condyle));

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // MusculoskeletalPhantom: a synthetic right hip built from swept tubes, so that
 // demos and tests never depend on outside data.
 #pragma once
@@ -24,7 +25,7 @@ struct TubeSpecification
   /// reach 0 at x = 0 and x = length, where the tube is closed by a pole.
   std::function<Eigen::Vector2d(double x, double length)> radii;
   Eigen::Vector3d normalHint = Eigen::Vector3d::UnitX(); ///< first semi-axis direction
-  int resolution = 24; ///< points around each cross-section
+  int resolution = 24;                                   ///< points around each cross-section
 };
 
 /// Closed, manifold, outward-oriented triangle surface swept along the centreline.

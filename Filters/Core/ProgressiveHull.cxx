@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "ProgressiveHull.h"
 
 #include "ConvexProjection.h"
@@ -170,9 +171,9 @@ private:
       double nearest = std::numeric_limits<double>::max();
       for (Eigen::Index t = 0; t < hull.triangles.rows(); ++t)
       {
-        nearest = std::min(nearest, PointTriangleDistance(p, hull.points.row(hull.triangles(t, 0)).transpose(),
-                                      hull.points.row(hull.triangles(t, 1)).transpose(),
-                                      hull.points.row(hull.triangles(t, 2)).transpose()));
+        nearest = std::min(nearest,
+          PointTriangleDistance(p, hull.points.row(hull.triangles(t, 0)).transpose(),
+            hull.points.row(hull.triangles(t, 1)).transpose(), hull.points.row(hull.triangles(t, 2)).transpose()));
       }
       isOutside[i] = nearest > tolerance ? 1 : 0;
     }
@@ -194,7 +195,9 @@ private:
   /// (when a disk), the whole connected facing region, other single triangles.
   bool BumpOut(const Vec3& q)
   {
-    auto faces = [&](const Face& face) { return this->Normal(face).dot(q - this->P[face[0]]) > 0; };
+    auto faces = [&](const Face& face) {
+      return this->Normal(face).dot(q - this->P[face[0]]) > 0;
+    };
     std::vector<std::pair<double, int>> facing;
     for (int f = 0; f < static_cast<int>(this->F.size()); ++f)
     {
@@ -314,7 +317,7 @@ private:
 
   /// Triangles satisfying `faces`, connected through edges to `seed`, within
   /// `rings` steps of it (all of them when rings < 0).
-  template <typename Predicate>
+  template<typename Predicate>
   std::vector<int> FacingRegion(int seed, Predicate&& faces, int rings) const
   {
     std::vector<int> region{ seed };
@@ -353,7 +356,9 @@ private:
   bool DiskBoundary(const std::vector<int>& region, std::vector<std::pair<int, int>>& loop) const
   {
     std::unordered_map<std::uint64_t, int> directed; // edges walked by the region's triangles
-    auto key = [](int x, int y) { return (static_cast<std::uint64_t>(x) << 32) | static_cast<std::uint32_t>(y); };
+    auto key = [](int x, int y) {
+      return (static_cast<std::uint64_t>(x) << 32) | static_cast<std::uint32_t>(y);
+    };
     std::vector<int> points;
     for (int f : region)
     {
@@ -394,7 +399,8 @@ private:
       }
       loop.emplace_back(at, found->second);
       at = found->second;
-    } while (at != start && static_cast<int>(loop.size()) <= edges);
+    }
+    while (at != start && static_cast<int>(loop.size()) <= edges);
     std::sort(points.begin(), points.end());
     points.erase(std::unique(points.begin(), points.end()), points.end());
     const int interior = static_cast<int>(points.size()) - edges;
@@ -492,14 +498,10 @@ private:
     return { static_cast<long>(std::floor(p[0] / this->CellSize)), static_cast<long>(std::floor(p[1] / this->CellSize)),
       static_cast<long>(std::floor(p[2] / this->CellSize)) };
   }
-  template <typename Visit>
+  template<typename Visit>
   void ForCells(const Vec3& low, const Vec3& high, Visit&& visit) const
   {
-    const auto lo = this->Cell(low), hi = this->Cell(high);
-    for (long i = lo[0]; i <= hi[0]; ++i)
-      for (long j = lo[1]; j <= hi[1]; ++j)
-        for (long k = lo[2]; k <= hi[2]; ++k)
-          visit(GridCellKey(i, j, k));
+    ForEachGridCell(this->Cell(low), this->Cell(high), visit);
   }
   /// The live faces in the grid cells that the boxes of `faces` reach, each
   /// once (in NearbyBuffer; this->Visit marks them, instead of sorting).
@@ -1002,14 +1004,14 @@ private:
   std::vector<Vec3> P;
   std::vector<Face> F;
   std::vector<char> FaceAlive;
-  std::vector<char> Folded; // input triangles that cross another (indexed by face id)
-  std::vector<std::pair<int, int>> EdgeBuffer;              // edges to re-cost after a collapse
-  std::vector<std::optional<Candidate>> CandidateBuffer;   // their costs
-  std::unordered_map<std::uint64_t, double> LastCost;      // latest cost of each edge
-  std::vector<int> NearbyBuffer;          // reused by NewFacesAcceptable
-  std::vector<unsigned> VisitedFace;      // last Visit that gathered each face
-  std::vector<unsigned> ReplacedMark;     // Visit in which a face is being replaced
-  std::vector<Vec3> FaceLow, FaceHigh;    // bounding boxes (faces never change)
+  std::vector<char> Folded;                              // input triangles that cross another (indexed by face id)
+  std::vector<std::pair<int, int>> EdgeBuffer;           // edges to re-cost after a collapse
+  std::vector<std::optional<Candidate>> CandidateBuffer; // their costs
+  std::unordered_map<std::uint64_t, double> LastCost;    // latest cost of each edge
+  std::vector<int> NearbyBuffer;                         // reused by NewFacesAcceptable
+  std::vector<unsigned> VisitedFace;                     // last Visit that gathered each face
+  std::vector<unsigned> ReplacedMark;                    // Visit in which a face is being replaced
+  std::vector<Vec3> FaceLow, FaceHigh;                   // bounding boxes (faces never change)
   unsigned Visit = 0;
   std::vector<char> VertexAlive;
   std::vector<unsigned> Stamp;
@@ -1060,8 +1062,8 @@ MuscleHull BuildMuscleHull(const TriangleMesh& muscle, const HullParameters& par
   if (!edges.IsClosedOrientedManifold() || !(SignedVolume(hull.points, hull.triangles) > 0))
   {
     throw InputError("its hull came out as no closed, outward-oriented manifold surface (" +
-      std::to_string(edges.boundaryEdges) + " open, " + std::to_string(edges.nonManifoldEdges) +
-      " non-manifold and " + std::to_string(edges.inconsistentEdges) +
+      std::to_string(edges.boundaryEdges) + " open, " + std::to_string(edges.nonManifoldEdges) + " non-manifold and " +
+      std::to_string(edges.inconsistentEdges) +
       " inconsistently oriented edges): the surface is too noisy or too thin for a hull; smooth or remesh it");
   }
   const std::int64_t outside = CountPointsOutsideHull(hull, local);

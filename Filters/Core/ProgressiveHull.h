@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Coarse outer hull of a closed surface by progressive-hull edge collapse
 // (Sander et al. 2000, "Silhouette clipping"; Platis & Theoharis 2003).
 #pragma once
@@ -37,8 +38,8 @@ struct HullResult
 {
   TriangleMesh hull;
   int collapses = 0;
-  int rejectedCollapses = 0; ///< collapses refused by a quality or intersection check
-  int pointsBumpedIn = 0;     ///< points to enclose that had to be made hull points first
+  int rejectedCollapses = 0;          ///< collapses refused by a quality or intersection check
+  int pointsBumpedIn = 0;             ///< points to enclose that had to be made hull points first
   std::int64_t pointsLeftOutside = 0; ///< points to enclose still outside at the end (0 expected)
   bool reachedTarget = false;
 };

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "RigidMotion.h"
 
 #include <Eigen/SVD>
@@ -86,8 +87,8 @@ ScrewInterpolation::ScrewInterpolation(const RigidTransform& motion, const Eigen
   this->FixedPointOffset = Eigen::Vector3d::Zero();
   if (this->Angle > 0)
   {
-    this->FixedPointOffset = 0.5 * this->CentroidOffset +
-      0.5 / std::tan(0.5 * this->Angle) * this->Axis.cross(this->CentroidOffset);
+    this->FixedPointOffset =
+      0.5 * this->CentroidOffset + 0.5 / std::tan(0.5 * this->Angle) * this->Axis.cross(this->CentroidOffset);
   }
 }
 
@@ -105,8 +106,7 @@ RigidTransform ScrewInterpolation::At(double s) const
   else
   {
     const double sigma = s * this->Angle;
-    t.rotation =
-      Eigen::Quaterniond::Identity().slerp(s, this->Rotation).normalized().toRotationMatrix();
+    t.rotation = Eigen::Quaterniond::Identity().slerp(s, this->Rotation).normalized().toRotationMatrix();
     // (I - R(sigma)) q, written so that it stays accurate for small angles.
     const double halfSin = std::sin(0.5 * sigma);
     centroidMotion = 2 * halfSin * halfSin * this->FixedPointOffset -

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Rigid motions: least-squares fit (Kabsch) and constant-velocity interpolation.
 #pragma once
 
@@ -16,8 +17,7 @@ struct RigidTransform
   Eigen::Vector3d Apply(const Eigen::Vector3d& x) const { return rotation * x + translation; }
   Points Apply(const Points& points) const;
   /// Rotation about `centre` by `angleRadians` around `axis` (normalised here).
-  static RigidTransform AboutPoint(
-    const Eigen::Vector3d& axis, double angleRadians, const Eigen::Vector3d& centre);
+  static RigidTransform AboutPoint(const Eigen::Vector3d& axis, double angleRadians, const Eigen::Vector3d& centre);
 };
 
 /// a after b: x -> a(b(x)).
@@ -60,7 +60,7 @@ private:
   Eigen::Vector3d Axis;
   double Angle = 0;
   Eigen::Vector3d Centroid;
-  Eigen::Vector3d CentroidOffset;  // b = component of the centroid's motion normal to the axis
+  Eigen::Vector3d CentroidOffset;   // b = component of the centroid's motion normal to the axis
   Eigen::Vector3d FixedPointOffset; // q: (I - R) q = b, q normal to the axis
   double Slide = 0;                 // d: motion along the axis
 };

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "StaticIntersections.h"
 
 #include "MeshChecks.h"
@@ -63,8 +64,8 @@ struct Deepest
   Points nearest;
 };
 
-Deepest FindDeepest(const TriangleMesh& mesh, size_t m, const ObstacleSet& set, size_t fixedCount,
-  const OverlapMasks* existing)
+Deepest FindDeepest(
+  const TriangleMesh& mesh, size_t m, const ObstacleSet& set, size_t fixedCount, const OverlapMasks* existing)
 {
   const Eigen::Index n = mesh.points.rows();
   const std::vector<char> used = UsedMask(mesh);
@@ -87,7 +88,8 @@ Deepest FindDeepest(const TriangleMesh& mesh, size_t m, const ObstacleSet& set, 
       }
       // Bones come first: a point inside a bone goes out of the deepest bone
       // it is in, whatever muscle it is in too (muscles may overlap a little).
-      const bool isFixed = o < fixedCount, bestFixed = d.obstacle[i] >= 0 && d.obstacle[i] < static_cast<int>(fixedCount);
+      const bool isFixed = o < fixedCount,
+                 bestFixed = d.obstacle[i] >= 0 && d.obstacle[i] < static_cast<int>(fixedCount);
       if (bestFixed && !isFixed)
       {
         continue;
@@ -527,7 +529,8 @@ std::vector<double> RestoreVolumes(std::vector<TriangleMesh>& meshes, const std:
         if (first <= 1)
         {
           moving[i] = 0; // at an obstacle from now on
-          mesh.points.row(i) = (from + std::max(0.0, first - backOff / std::max(length, 1e-300)) * (to - from)).transpose();
+          mesh.points.row(i) =
+            (from + std::max(0.0, first - backOff / std::max(length, 1e-300)) * (to - from)).transpose();
         }
         else
         {

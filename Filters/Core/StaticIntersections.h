@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Static intersection resolution (Hajkova & Kohout sec. 3.1; docs/DESIGN.md
 // section 5), once after a deformation, on the full meshes: the
 // vertices of deformable meshes (muscles) that lie inside an obstacle (a bone,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "SurfaceRepair.h"
 
 #include "MeshChecks.h"
@@ -128,7 +129,10 @@ void RestoreTowardsOriginal(TriangleMesh& mesh, const Points& original, const st
     edge += (mesh.points.row(mesh.triangles(t, 0)) - mesh.points.row(mesh.triangles(t, 1))).norm();
   }
   const double cell = 2.0 * edge / static_cast<double>(mesh.triangles.rows());
-  auto cellOf = [cell](double x) { return static_cast<long>(std::floor(x / cell)); };
+  auto cellsOf = [cell](const Eigen::Vector3d& p) {
+    return std::array<long, 3>{ static_cast<long>(std::floor(p[0] / cell)), static_cast<long>(std::floor(p[1] / cell)),
+      static_cast<long>(std::floor(p[2] / cell)) };
+  };
   auto bounds = [&](Eigen::Index t, Eigen::Vector3d& low, Eigen::Vector3d& high) {
     low = high = mesh.points.row(mesh.triangles(t, 0)).transpose();
     bool widen = false;
@@ -149,10 +153,7 @@ void RestoreTowardsOriginal(TriangleMesh& mesh, const Points& original, const st
   {
     Eigen::Vector3d low, high;
     bounds(t, low, high);
-    for (long i = cellOf(low[0]); i <= cellOf(high[0]); ++i)
-      for (long j = cellOf(low[1]); j <= cellOf(high[1]); ++j)
-        for (long k = cellOf(low[2]); k <= cellOf(high[2]); ++k)
-          grid[GridCellKey(i, j, k)].push_back(t);
+    ForEachGridCell(cellsOf(low), cellsOf(high), [&](std::uint64_t cell) { grid[cell].push_back(t); });
   }
   auto corners = [&](Eigen::Index t) {
     return std::array<Eigen::Vector3d, 3>{ mesh.points.row(mesh.triangles(t, 0)).transpose(),
@@ -175,33 +176,35 @@ void RestoreTowardsOriginal(TriangleMesh& mesh, const Points& original, const st
     {
       Eigen::Vector3d low, high;
       exactBounds(t, low, high);
-      for (long i = cellOf(low[0]); i <= cellOf(high[0]); ++i)
-        for (long j = cellOf(low[1]); j <= cellOf(high[1]); ++j)
-          for (long k = cellOf(low[2]); k <= cellOf(high[2]); ++k)
+      const bool clear = ForEachGridCell(cellsOf(low), cellsOf(high), [&](std::uint64_t cell) {
+        auto found = grid.find(cell);
+        if (found == grid.end())
+        {
+          return true;
+        }
+        for (Eigen::Index u : found->second)
+        {
+          if (u == t)
           {
-            auto found = grid.find(GridCellKey(i, j, k));
-            if (found == grid.end())
-            {
-              continue;
-            }
-            for (Eigen::Index u : found->second)
-            {
-              if (u == t)
-              {
-                continue;
-              }
-              Eigen::Vector3d otherLow, otherHigh;
-              exactBounds(u, otherLow, otherHigh);
-              if ((otherLow.array() > high.array()).any() || (otherHigh.array() < low.array()).any())
-              {
-                continue;
-              }
-              if (TrianglesIntersect(corners(t), ids(t), corners(u), ids(u)))
-              {
-                return false;
-              }
-            }
+            continue;
           }
+          Eigen::Vector3d otherLow, otherHigh;
+          exactBounds(u, otherLow, otherHigh);
+          if ((otherLow.array() > high.array()).any() || (otherHigh.array() < low.array()).any())
+          {
+            continue;
+          }
+          if (TrianglesIntersect(corners(t), ids(t), corners(u), ids(u)))
+          {
+            return false;
+          }
+        }
+        return true;
+      });
+      if (!clear)
+      {
+        return false;
+      }
     }
     return true;
   };
@@ -266,7 +269,8 @@ void UntangleSelfIntersections(TriangleMesh& mesh, RepairReport& report)
     }
     if (round > 0)
     {
-      const std::vector<std::int64_t> current = region;
+      // add() grows `region`: walk a copy.
+      const std::vector<std::int64_t> current = region; // NOLINT(performance-unnecessary-copy-initialization)
       for (std::int64_t p : current)
       {
         for (std::int64_t q : neighbours[p])
@@ -446,29 +450,24 @@ std::vector<std::int64_t> ClusterNearPoints(const Points& points, const Triangle
     }
     return i;
   };
-  using Cell = std::array<std::int64_t, 3>;
-  struct CellHash
-  {
-    size_t operator()(const Cell& c) const
-    {
-      return static_cast<size_t>(c[0]) * 73856093u ^ static_cast<size_t>(c[1]) * 19349663u ^
-        static_cast<size_t>(c[2]) * 83492791u;
-    }
-  };
-  std::unordered_map<Cell, std::vector<std::int64_t>, CellHash> grid;
-  auto cellOf = [&](std::int64_t i) {
-    Cell c;
+  // Cells counted from the lowest corner: their indices stay small whatever the coordinates.
+  const Eigen::RowVector3d corner =
+    points.rows() > 0 ? Eigen::RowVector3d(points.colwise().minCoeff()) : Eigen::RowVector3d::Zero();
+  auto cellOf = [&](std::int64_t i, long offset) {
+    std::array<long, 3> c;
     for (int k = 0; k < 3; ++k)
     {
-      c[k] = static_cast<std::int64_t>(std::floor(points(i, k) / tolerance));
+      c[k] = static_cast<long>(std::floor((points(i, k) - corner[k]) / tolerance)) + offset;
     }
     return c;
   };
+  std::unordered_map<std::uint64_t, std::vector<std::int64_t>> grid;
   for (std::int64_t i = 0; i < pointCount; ++i)
   {
     if (used[i])
     {
-      grid[cellOf(i)].push_back(i);
+      const std::array<long, 3> c = cellOf(i, 0);
+      grid[GridCellKey(c[0], c[1], c[2])].push_back(i);
     }
   }
   for (std::int64_t i = 0; i < pointCount; ++i)
@@ -477,25 +476,21 @@ std::vector<std::int64_t> ClusterNearPoints(const Points& points, const Triangle
     {
       continue;
     }
-    const Cell c = cellOf(i);
-    for (std::int64_t dx = -1; dx <= 1; ++dx)
-      for (std::int64_t dy = -1; dy <= 1; ++dy)
-        for (std::int64_t dz = -1; dz <= 1; ++dz)
+    ForEachGridCell(cellOf(i, -1), cellOf(i, 1), [&](std::uint64_t cell) {
+      const auto found = grid.find(cell);
+      if (found == grid.end())
+      {
+        return;
+      }
+      for (std::int64_t j : found->second)
+      {
+        if (j > i && (points.row(i) - points.row(j)).squaredNorm() < tolerance * tolerance)
         {
-          const auto found = grid.find({ c[0] + dx, c[1] + dy, c[2] + dz });
-          if (found == grid.end())
-          {
-            continue;
-          }
-          for (std::int64_t j : found->second)
-          {
-            if (j > i && (points.row(i) - points.row(j)).squaredNorm() < tolerance * tolerance)
-            {
-              const std::int64_t a = find(i), b = find(j);
-              root[std::max(a, b)] = std::min(a, b);
-            }
-          }
+          const std::int64_t a = find(i), b = find(j);
+          root[std::max(a, b)] = std::min(a, b);
         }
+      }
+    });
   }
   for (std::int64_t i = 0; i < pointCount; ++i)
   {
@@ -507,8 +502,8 @@ std::vector<std::int64_t> ClusterNearPoints(const Points& points, const Triangle
 /// Merges points closer than `tolerance` (`representative`: each input point's surviving twin, the
 /// lowest index of its cluster; the merged points at other coordinates are added to
 /// report.pointsToEnclose) and drops degenerate, duplicate and back-to-back triangles.
-std::vector<Triangle> MergeAndDeduplicate(const TriangleMesh& surface, double tolerance,
-  std::vector<std::int64_t>& representative, RepairReport& report)
+std::vector<Triangle> MergeAndDeduplicate(
+  const TriangleMesh& surface, double tolerance, std::vector<std::int64_t>& representative, RepairReport& report)
 {
   const auto pointCount = static_cast<std::int64_t>(surface.points.rows());
   representative = ClusterNearPoints(surface.points, surface.triangles, tolerance);
@@ -715,8 +710,8 @@ Pairing PairTrianglesAtPinches(
 /// Points whose triangles form several fans (pinches) get one copy per extra
 /// fan; the point and its copies move `separation` into their own lobes, and
 /// where the point was is kept in report.pointsToEnclose.
-void SplitPinchedPoints(Points& points, std::vector<Triangle>& triangles, const EdgeMap& edges,
-  const Pairing& pairing, const Points& original, double separation, RepairReport& report)
+void SplitPinchedPoints(Points& points, std::vector<Triangle>& triangles, const EdgeMap& edges, const Pairing& pairing,
+  const Points& original, double separation, RepairReport& report)
 {
   // Neighbour of triangle t across its edge k, or -1 where the edge is cut.
   auto neighbour = [&](int t, int k) {
@@ -789,8 +784,9 @@ void SplitPinchedPoints(Points& points, std::vector<Triangle>& triangles, const 
     for (const auto& [t, fan] : fanOf)
     {
       const Triangle& tri = triangles[t];
-      split.fanNormal[fan] += (points.row(tri[1]) - points.row(tri[0])).transpose().cross(
-        (points.row(tri[2]) - points.row(tri[0])).transpose());
+      split.fanNormal[fan] += (points.row(tri[1]) - points.row(tri[0]))
+                                .transpose()
+                                .cross((points.row(tri[2]) - points.row(tri[0])).transpose());
       split.fanOfTriangle.emplace_back(t, fan);
     }
     splits.push_back(std::move(split));
@@ -816,7 +812,6 @@ void SplitPinchedPoints(Points& points, std::vector<Triangle>& triangles, const 
       }
     }
   }
-
 }
 
 /// The mesh on the points its triangles use; input points that it no longer

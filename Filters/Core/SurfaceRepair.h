@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Making a scanned closed surface usable: what is safe to repair is repaired
 // and counted, what cannot be used is refused.
 #pragma once
@@ -11,9 +12,9 @@ namespace md
 struct RepairReport
 {
   std::int64_t unusedPointsRemoved = 0;
-  std::int64_t duplicatePointsMerged = 0;     ///< points closer than mergeTolerance to another
-  std::int64_t nearDuplicatePointsMerged = 0; ///< of them, those not at the same coordinates
-  double mergeTolerance = 0;                  ///< 1e-5 of the surface's size
+  std::int64_t duplicatePointsMerged = 0;      ///< points closer than mergeTolerance to another
+  std::int64_t nearDuplicatePointsMerged = 0;  ///< of them, those not at the same coordinates
+  double mergeTolerance = 0;                   ///< 1e-5 of the surface's size
   std::int64_t degenerateTrianglesRemoved = 0; ///< triangles repeating a point
   std::int64_t duplicateTrianglesRemoved = 0;
   std::int64_t finTrianglesRemoved = 0;        ///< back-to-back pairs on the same points
@@ -32,8 +33,8 @@ struct RepairReport
 
   bool Changed() const
   {
-    return unusedPointsRemoved || duplicatePointsMerged || degenerateTrianglesRemoved ||
-      duplicateTrianglesRemoved || finTrianglesRemoved || trianglesReoriented || nonManifoldEdgesSplit || pointsDuplicatedAtPinches ||
+    return unusedPointsRemoved || duplicatePointsMerged || degenerateTrianglesRemoved || duplicateTrianglesRemoved ||
+      finTrianglesRemoved || trianglesReoriented || nonManifoldEdgesSplit || pointsDuplicatedAtPinches ||
       selfIntersectionsUntangled || selfIntersectionsLeft || enclosedPiecesRemoved;
   }
   /// One line naming every repair made, e.g. "removed 10 unused points, ...".

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "TriangleIntersection.h"
 
 #include <algorithm>
@@ -72,8 +73,7 @@ bool TrianglesIntersect(const std::array<Vec3, 3>& x, const std::array<int, 3>& 
     const Vec3& xb = x[(sharedX + 2) % 3];
     const Vec3& ya = y[(sharedY + 1) % 3];
     const Vec3& yb = y[(sharedY + 2) % 3];
-    return SegmentHitsTriangle(xa, xb, y[0], y[1], y[2], -eps) ||
-      SegmentHitsTriangle(ya, yb, x[0], x[1], x[2], -eps);
+    return SegmentHitsTriangle(xa, xb, y[0], y[1], y[2], -eps) || SegmentHitsTriangle(ya, yb, x[0], x[1], x[2], -eps);
   }
   for (int i = 0; i < 3; ++i)
   {
@@ -85,7 +85,6 @@ bool TrianglesIntersect(const std::array<Vec3, 3>& x, const std::array<int, 3>& 
   }
   return false;
 }
-
 
 std::vector<std::pair<int, int>> FindSelfIntersections(const Points& points, const Triangles& triangles)
 {
@@ -101,7 +100,9 @@ std::vector<std::pair<int, int>> FindSelfIntersections(const Points& points, con
     edgeSum += (points.row(triangles(t, 0)) - points.row(triangles(t, 1))).norm();
   }
   const double cell = std::max(2.0 * edgeSum / m, 1e-300);
-  auto index = [cell](double x) { return static_cast<long>(std::floor(x / cell)); };
+  auto index = [cell](double x) {
+    return static_cast<long>(std::floor(x / cell));
+  };
   std::unordered_map<std::uint64_t, std::vector<int>> grid;
   std::vector<std::array<Vec3, 3>> corners(static_cast<size_t>(m));
   std::vector<std::array<int, 3>> ids(static_cast<size_t>(m));
@@ -115,10 +116,9 @@ std::vector<std::pair<int, int>> FindSelfIntersections(const Points& points, con
     }
     low[t] = corners[t][0].cwiseMin(corners[t][1]).cwiseMin(corners[t][2]);
     high[t] = corners[t][0].cwiseMax(corners[t][1]).cwiseMax(corners[t][2]);
-    for (long i = index(low[t][0]); i <= index(high[t][0]); ++i)
-      for (long j = index(low[t][1]); j <= index(high[t][1]); ++j)
-        for (long k = index(low[t][2]); k <= index(high[t][2]); ++k)
-          grid[GridCellKey(i, j, k)].push_back(t);
+    ForEachGridCell({ index(low[t][0]), index(low[t][1]), index(low[t][2]) },
+      { index(high[t][0]), index(high[t][1]), index(high[t][2]) },
+      [&](std::uint64_t cell) { grid[cell].push_back(t); });
   }
   // Cells in parallel, each thread collecting its own pairs; sorted after, so
   // the result does not depend on the threads.

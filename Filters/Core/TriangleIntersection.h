@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Intersection tests between triangles of one mesh (shared corners allowed).
 #pragma once
 
@@ -27,6 +28,7 @@ bool TrianglesIntersect(const std::array<Eigen::Vector3d, 3>& x, const std::arra
   const std::array<Eigen::Vector3d, 3>& y, const std::array<int, 3>& fy);
 }
 
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -37,6 +39,34 @@ inline std::uint64_t GridCellKey(long i, long j, long k)
 {
   return (static_cast<std::uint64_t>(i & 0x1fffff) << 42) | (static_cast<std::uint64_t>(j & 0x1fffff) << 21) |
     static_cast<std::uint64_t>(k & 0x1fffff);
+}
+
+/// Visits GridCellKey(i, j, k) of every cell from `low` to `high` (inclusive), i slowest. A
+/// visitor that returns bool stops the walk by returning false; the walk then returns false.
+template<typename Visit>
+bool ForEachGridCell(const std::array<long, 3>& low, const std::array<long, 3>& high, Visit&& visit)
+{
+  for (long i = low[0]; i <= high[0]; ++i)
+  {
+    for (long j = low[1]; j <= high[1]; ++j)
+    {
+      for (long k = low[2]; k <= high[2]; ++k)
+      {
+        if constexpr (std::is_same_v<decltype(visit(std::uint64_t{})), bool>)
+        {
+          if (!visit(GridCellKey(i, j, k)))
+          {
+            return false;
+          }
+        }
+        else
+        {
+          visit(GridCellKey(i, j, k));
+        }
+      }
+    }
+  }
+  return true;
 }
 
 /// Every pair (s < t) of triangles of the mesh that intersect other than at

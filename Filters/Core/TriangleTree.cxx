@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "TriangleTree.h"
 
 #include "MeshChecks.h"
@@ -172,7 +173,7 @@ void TriangleTree::UpdateBoxes()
   }
 }
 
-template <typename Visit>
+template<typename Visit>
 void TriangleTree::ForTrianglesNearSegment(
   const Eigen::Vector3d& from, const Eigen::Vector3d& direction, const double& limit, Visit&& visit) const
 {
@@ -207,7 +208,8 @@ std::optional<TriangleTree::Hit> TriangleTree::FirstHit(const Eigen::Vector3d& f
   double limit = 1.0;
   this->ForTrianglesNearSegment(from, direction, limit, [&](Eigen::Index t) {
     double t01, u, v;
-    if (IntersectLineTriangle(from, direction, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2), 0.0, t01, u, v) &&
+    if (IntersectLineTriangle(
+          from, direction, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2), 0.0, t01, u, v) &&
       t01 >= 0 && t01 <= limit)
     {
       limit = t01;
@@ -328,8 +330,7 @@ TriangleTree::Closest TriangleTree::ClosestPoint(const Eigen::Vector3d& p) const
       // Nearer child last, so it is visited first.
       const Node& left = this->Nodes[node.left];
       const Node& right = this->Nodes[node.right];
-      const bool leftNearer =
-        BoxDistanceSquared(p, left.low, left.high) < BoxDistanceSquared(p, right.low, right.high);
+      const bool leftNearer = BoxDistanceSquared(p, left.low, left.high) < BoxDistanceSquared(p, right.low, right.high);
       stack.Push(leftNearer ? node.right : node.left);
       stack.Push(leftNearer ? node.left : node.right);
       continue;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A bounding-volume hierarchy over the triangles of a closed surface, for the
 // queries intersection handling needs against obstacles (bones, other muscles):
 // first hit along a segment, inside or outside, closest point.
@@ -19,7 +20,7 @@ public:
 
   struct Hit
   {
-    double t = 0;              ///< fraction of the segment, in [0, 1]
+    double t = 0; ///< fraction of the segment, in [0, 1]
     Eigen::Index triangle = -1;
     Eigen::Vector3d point;
   };
@@ -94,7 +95,7 @@ private:
   int SegmentCrossings(const Eigen::Vector3d& from, const Eigen::Vector3d& d, double edgeTolerance, bool& grazed) const;
   /// Calls visit(triangle) for every triangle whose leaf box the segment
   /// from + t direction, t in [0, limit], meets.
-  template <typename Visit>
+  template<typename Visit>
   void ForTrianglesNearSegment(
     const Eigen::Vector3d& from, const Eigen::Vector3d& direction, const double& limit, Visit&& visit) const;
 

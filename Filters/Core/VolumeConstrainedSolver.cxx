@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "VolumeConstrainedSolver.h"
 
 #include <cmath>
@@ -135,16 +136,8 @@ Points VolumeConstrainedSolver::Step(const Points& x, const Points& targets, dou
   return this->Step(x, targets, volume - targetVolume, gradient, alpha);
 }
 
-Points VolumeConstrainedSolver::StepWithOriginalSignError(
-  const Points& x, const Points& targets, double targetVolume, double alpha) const
-{
-  Points gradient;
-  const double volume = EnclosedVolume(x, this->Faces, &gradient);
-  return this->Step(x, targets, volume - targetVolume, gradient, alpha, -1.0);
-}
-
-Points VolumeConstrainedSolver::Step(const Points& x, const Points& targets, double volumeError,
-  const Points& gradient, double alpha, double sign) const
+Points VolumeConstrainedSolver::Step(
+  const Points& x, const Points& targets, double volumeError, const Points& gradient, double alpha) const
 {
   const Points residual = this->Rows * x - targets;
   const Points pulled = this->Rows.transpose() * residual; // L^T r
@@ -157,7 +150,7 @@ Points VolumeConstrainedSolver::Step(const Points& x, const Points& targets, dou
   const Eigen::MatrixXd aGradient = this->Normal.solve(Eigen::MatrixXd(gradient));
   const double jaj = (gradient.array() * aGradient.array()).sum();
   const double jalr = (gradient.array() * aPulled.array()).sum();
-  const double lambda = (volumeError / alpha - sign * jalr) / jaj;
+  const double lambda = (volumeError / alpha - jalr) / jaj;
   return x - alpha * (aPulled + lambda * aGradient);
 }
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The numerical core of the muscle deformation (Kellnhofer & Kohout, after
 // Huang et al. 2006): least squares |L X - b|^2 on the hull points X with the
 // enclosed volume held, by Gauss-Newton steps with a Lagrange multiplier.
@@ -43,18 +44,11 @@ public:
   /// settles at an error proportional to alpha.)
   Points Step(const Points& x, const Points& targets, double targetVolume, double alpha) const;
 
-  /// The same step with that sign error, kept only to show the difference.
-  Points StepWithOriginalSignError(const Points& x, const Points& targets, double targetVolume, double alpha) const;
-
   /// The step with the volume measured by the caller (the fine phase measures
   /// it on the full mesh): c = V - V0 and J = dV/dX. An empty J means no
-  /// volume constraint (lambda = 0). `sign` = -1 reproduces the original's
-  /// error (for the tests that show it); leave it at 1.
-  Points Step(const Points& x, const Points& targets, double volumeError, const Points& volumeGradient,
-    double alpha, double sign = 1.0) const;
-
-  /// The hull's triangles the volume is measured on.
-  const Triangles& HullTriangles() const { return this->Faces; }
+  /// volume constraint (lambda = 0).
+  Points Step(
+    const Points& x, const Points& targets, double volumeError, const Points& volumeGradient, double alpha) const;
 
   SparseMatrix Rows;
   Triangles Faces;
@@ -63,6 +57,6 @@ public:
 
 private:
   void AddToNormal(const Eigen::MatrixXd& rows); ///< NormalMatrix += rows^T rows, then Factor
-  void Factor(); ///< Normal from NormalMatrix; throws InputError when singular
+  void Factor();                                 ///< Normal from NormalMatrix; throws InputError when singular
 };
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // One rest-pose -> current-pose pass of the muscle deformation
 // (Filters/Core/MuscleDeformer.h) on the phantom and, when present, the LHDL
 // right hip at hip flexion 30 and 60 degrees and adduction -40 and 40: per

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Hull decimation and mean value coordinates on every muscle at hand: the
 // phantom's and, when present, those of ../shared/data/lhdl_hip_r and
 // ../shared/data/vhf_right. Prints figures; asserts nothing (see the tests).
@@ -10,11 +11,10 @@
 #include "RealData.h"
 #include "SurfaceRepair.h"
 
-
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -70,12 +70,13 @@ void Measure(const std::string& name, const md::TriangleMesh& muscle, int target
   const std::int64_t outside = md::CountOutside(hull, md::UsedPoints(muscle), 1e-9 * size);
   const md::EdgeReport edges = md::CheckEdges(hull.triangles);
   const std::int64_t intersections = md::CountSelfIntersections(hull);
-  const double ratio = md::SignedVolume(hull.points, hull.triangles) / md::SignedVolume(muscle.points, muscle.triangles);
-  std::printf("%-34s %6ld %6ld | %4ld %4ld %s | %8.3f %8.3f | %6.3f | %7ld %4s %4ld | %7.3f %9.2e %8.1e\n", name.c_str(),
-    static_cast<long>(muscle.points.rows()), static_cast<long>(muscle.triangles.rows()),
-    static_cast<long>(hull.points.rows()), static_cast<long>(hull.triangles.rows()),
-    result.reachedTarget ? "  " : "!!", repairTime, hullTime, ratio, static_cast<long>(outside),
-    edges.IsClosedOrientedManifold() ? "yes" : "NO", static_cast<long>(intersections), mvcTime, mvcError, sumError);
+  const double ratio =
+    md::SignedVolume(hull.points, hull.triangles) / md::SignedVolume(muscle.points, muscle.triangles);
+  std::printf("%-34s %6ld %6ld | %4ld %4ld %s | %8.3f %8.3f | %6.3f | %7ld %4s %4ld | %7.3f %9.2e %8.1e\n",
+    name.c_str(), static_cast<long>(muscle.points.rows()), static_cast<long>(muscle.triangles.rows()),
+    static_cast<long>(hull.points.rows()), static_cast<long>(hull.triangles.rows()), result.reachedTarget ? "  " : "!!",
+    repairTime, hullTime, ratio, static_cast<long>(outside), edges.IsClosedOrientedManifold() ? "yes" : "NO",
+    static_cast<long>(intersections), mvcTime, mvcError, sumError);
   if (result.pointsBumpedIn > 0 || result.pointsLeftOutside > 0)
   {
     std::printf("%-34s   points bumped into the hull: %d, left outside: %ld\n", "", result.pointsBumpedIn,
@@ -97,9 +98,8 @@ int main(int argc, char** argv)
               "repair and hull times are the median of 3 runs.\n"
               "The original implementation (progressive hulls, Cholt 2012) needed \"easily a minute\" per hull.\n\n",
     target);
-  std::printf("%-34s %6s %6s | %4s %4s %2s | %8s %8s | %6s | %7s %4s %4s | %7s %9s %8s\n", "muscle", "points",
-    "tris", "hull", "tris", "", "repair s", "hull s", "V/V0", "outside", "mfld", "self", "MVC s",
-    "MVC err", "sum err");
+  std::printf("%-34s %6s %6s | %4s %4s %2s | %8s %8s | %6s | %7s %4s %4s | %7s %9s %8s\n", "muscle", "points", "tris",
+    "hull", "tris", "", "repair s", "hull s", "V/V0", "outside", "mfld", "self", "MVC s", "MVC err", "sum err");
   const md::Phantom phantom = md::BuildPhantom(md::PhantomParameters{});
   for (const md::PhantomMuscle& muscle : phantom.muscles)
   {
@@ -126,7 +126,8 @@ int main(int argc, char** argv)
     std::printf("\n%d real-data muscles not found under %s: skipped\n", missing, data.c_str());
   }
   std::printf("\nV/V0: hull volume / muscle volume. outside: muscle points (those its triangles use) outside the\n"
-              "hull, every point tested, tolerance 1e-9 of the muscle's size. mfld: closed, manifold, oriented. self: intersecting triangle\n"
+              "hull, every point tested, tolerance 1e-9 of the muscle's size. mfld: closed, manifold, oriented. self: "
+              "intersecting triangle\n"
               "pairs of the hull. MVC err: largest |sum w_j h_j - x| over the muscle's points / muscle size.\n");
   return 0;
 }

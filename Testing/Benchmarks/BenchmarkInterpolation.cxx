@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The whole interpolation method (Filters/Core/InterpolatedDeformation.h) on
 // the phantom (30 degrees of flexion unless told) and, when present, the LHDL right hip at
 // hip flexion 60 degrees: the one-pass method (one step, then the static
@@ -7,7 +8,8 @@
 // in total: hull time, per-step time, total, and every quality measure.
 // Prints figures; asserts nothing (see the tests).
 //
-//   BenchmarkInterpolation [data folder] [number of steps] [phantom flexion] [all|one-pass|refit|rebuild|refit-paper-step]
+//   BenchmarkInterpolation [data folder] [number of steps] [phantom flexion]
+//   [all|one-pass|refit|rebuild|refit-paper-step]
 //                          [LHDL motion] [frame]      (default hip_flexion 35: 60 degrees of flexion)
 //                          [perturbation]  (-1: none, the default; 0: inputs rounded to float; s > 0: rounded
 //                                           after a seeded random move of 1e-7 of each coordinate)
@@ -75,8 +77,8 @@ void Run(const MotionCase& c, const char* label, int steps, md::HullMode mode, d
     std::printf("  %-18s", c.muscles[m].name.c_str());
     for (int j = 1; j <= r.numberOfSteps; ++j)
     {
-      std::printf(" %7.3f (%lld)", r.measures[j][m].stepStaticShift,
-        static_cast<long long>(r.measures[j][m].sharpEdgeCount));
+      std::printf(
+        " %7.3f (%lld)", r.measures[j][m].stepStaticShift, static_cast<long long>(r.measures[j][m].sharpEdgeCount));
     }
     std::printf("\n");
   }
@@ -118,7 +120,8 @@ int main(int argc, char* argv[])
   const std::string folder = argc > 1 ? argv[1] : "";
   const int steps = argc > 2 ? std::atoi(argv[2]) : 4;
   std::printf("Columns (final step): hull time (rest hull + per-step refit or rebuild), volume change %%, new\n"
-              "penetration of bones and other muscles, count and deepest (mm), the same of bones only, largest static shift over the steps (mm), new sharp edges\n"
+              "penetration of bones and other muscles, count and deepest (mm), the same of bones only, largest static "
+              "shift over the steps (mm), new sharp edges\n"
               "(> 60 deg), flipped triangles, iterations, converged in every step, points frozen in bones\n"
               "(summed over steps).\n");
   const std::string runs = argc > 4 ? argv[4] : "all";

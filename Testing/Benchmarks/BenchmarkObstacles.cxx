@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Obstacle queries (the bounding-volume hierarchy of Filters/Core/TriangleTree.h)
 // on the phantom's femur and, when present, the LHDL bones: build time,
 // inside tests and first hits per second. Prints figures; asserts nothing.
@@ -28,7 +29,8 @@ void Measure(const std::string& name, const md::TriangleMesh& bone)
   std::mt19937 generator(1);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   auto random = [&]() {
-    return Eigen::Vector3d(low + (high - low).cwiseProduct(Eigen::Vector3d(unit(generator), unit(generator), unit(generator))));
+    return Eigen::Vector3d(
+      low + (high - low).cwiseProduct(Eigen::Vector3d(unit(generator), unit(generator), unit(generator))));
   };
   constexpr int queries = 20000;
   std::vector<Eigen::Vector3d> points(queries);
@@ -51,7 +53,8 @@ void Measure(const std::string& name, const md::TriangleMesh& bone)
     hits += tree.FirstHit(p, p + step * (random() - p).normalized()) ? 1 : 0;
   }
   const double hitTime = Seconds(start);
-  std::printf("%-28s %7ld | build %7.1f ms | inside %6.2f us each (%5.1f %% in) | first hit %6.2f us each (%4.1f %% hit)\n",
+  std::printf(
+    "%-28s %7ld | build %7.1f ms | inside %6.2f us each (%5.1f %% in) | first hit %6.2f us each (%4.1f %% hit)\n",
     name.c_str(), static_cast<long>(bone.triangles.rows()), 1e3 * build, 1e6 * insideTime / queries,
     100.0 * inside / queries, 1e6 * hitTime / queries, 100.0 * hits / queries);
 }
@@ -78,7 +81,8 @@ int main(int argc, char** argv)
   }
   if (missing > 0)
   {
-    std::printf("\n%d LHDL bones not found: skipped (pass the data folder or set MUSCLEDEFORMATION_DATA_DIR)\n", missing);
+    std::printf(
+      "\n%d LHDL bones not found: skipped (pass the data folder or set MUSCLEDEFORMATION_DATA_DIR)\n", missing);
   }
   return 0;
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // OpenSim models: loading and updating to a new time, in the core and through the reader
 // (vtkOpenSimModelReader, as ParaView runs it), on gait2392 (23 coordinates, 92 muscles, 20
 // meshes) and the other models of ../shared/data/opensim. Prints figures; asserts nothing.
@@ -116,7 +117,8 @@ int main(int argc, char** argv)
     const std::string model = RealDataFile(c.model, folder), motion = RealDataFile(c.motion, folder);
     if (model.empty() || motion.empty())
     {
-      std::printf("%-16s skipped: %s not found (give the data folder or set MUSCLEDEFORMATION_DATA_DIR)\n", c.label, c.model);
+      std::printf(
+        "%-16s skipped: %s not found (give the data folder or set MUSCLEDEFORMATION_DATA_DIR)\n", c.label, c.model);
       continue;
     }
     Measure(c.label, model, motion);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // How cost grows with the muscle's size: the VHF gluteus maximus (24,220 points) and the same
 // surface subdivided once (96,874) and twice (387,490) at its edges' midpoints. For each: the
 // repair and hull, the mean value coordinates of the muscle in its hull, and one deformation
@@ -101,7 +102,8 @@ md::MatchedLine ActionLine(const md::TriangleMesh& muscle)
 
 int main(int argc, char** argv)
 {
-  const std::string file = RealDataFile("vhf_right/VHF_Right_Muscle_GluteusMaximus_smooth.stl", argc > 1 ? argv[1] : "");
+  const std::string file =
+    RealDataFile("vhf_right/VHF_Right_Muscle_GluteusMaximus_smooth.stl", argc > 1 ? argv[1] : "");
   if (file.empty())
   {
     std::printf("skipped: vhf_right/VHF_Right_Muscle_GluteusMaximus_smooth.stl not found (give the data folder)\n");
@@ -110,7 +112,8 @@ int main(int argc, char** argv)
   md::TriangleMesh muscle = ReadSurface(file);
   double previous[3] = { 0, 0, 0 };
   Eigen::Index previousPoints = 0;
-  std::printf("points    repair+hull s   weights s   one pass s  iterations  dV %%        (exponents against the size before)\n");
+  std::printf(
+    "points    repair+hull s   weights s   one pass s  iterations  dV %%        (exponents against the size before)\n");
   for (int level = 0; level < 3; ++level)
   {
     if (level > 0)
@@ -133,8 +136,8 @@ int main(int argc, char** argv)
     if (level > 0)
     {
       const double ratio = std::log(static_cast<double>(muscle.points.rows()) / previousPoints);
-      std::printf("   (%.2f, %.2f, %.2f)", std::log(now[0] / previous[0]) / ratio, std::log(now[1] / previous[1]) / ratio,
-        std::log(now[2] / previous[2]) / ratio);
+      std::printf("   (%.2f, %.2f, %.2f)", std::log(now[0] / previous[0]) / ratio,
+        std::log(now[1] / previous[1]) / ratio, std::log(now[2] / previous[2]) / ratio);
     }
     std::printf("\n");
     std::copy(now, now + 3, previous);

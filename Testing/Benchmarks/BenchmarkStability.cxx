@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // How much the method's output moves when its input moves by rounding noise or
 // when the hull's resolution changes (issue 13): the largest and the RMS
 // distance between corresponding points of the output surfaces, per muscle, of
@@ -61,9 +62,9 @@ Output Run(const MotionCase& c, const Method& method, int hullPoints, md::RestMa
 
 struct Distance
 {
-  double largest = 0;  ///< over all muscles and points
+  double largest = 0;                 ///< over all muscles and points
   double rmsLow = 1e300, rmsHigh = 0; ///< the per-muscle RMS, min-max
-  std::string worst;   ///< the muscle of the largest
+  std::string worst;                  ///< the muscle of the largest
 };
 
 Distance Between(const MotionCase& c, const Output& a, const Output& b)
@@ -88,7 +89,8 @@ void Print(const std::string& method, const std::string& variation, const Output
 {
   if (!run.failure.empty())
   {
-    std::printf("  %-28s %-26s FAILED (%.1f s): %s\n", method.c_str(), variation.c_str(), run.seconds, run.failure.c_str());
+    std::printf(
+      "  %-28s %-26s FAILED (%.1f s): %s\n", method.c_str(), variation.c_str(), run.seconds, run.failure.c_str());
     return;
   }
   std::printf("  %-28s %-26s %9.4f %9.4f-%-9.4f %-18s %5.1f\n", method.c_str(), variation.c_str(), d->largest,
@@ -114,7 +116,8 @@ struct Spread
   std::string Text() const
   {
     char text[160];
-    std::snprintf(text, sizeof text, "largest %.4f mm, RMS up to %.4f mm, %d of %d runs failed", largest, rms, failed, runs);
+    std::snprintf(
+      text, sizeof text, "largest %.4f mm, RMS up to %.4f mm, %d of %d runs failed", largest, rms, failed, runs);
     return text;
   }
 };
@@ -165,9 +168,9 @@ void Study(const MotionCase& exact, const std::vector<Method>& methods, int seed
       const Distance d = runs[i].failure.empty() ? Between(exact, runs[0], runs[i]) : Distance{};
       Print(method.label, inputs[i].label, runs[i], &d);
       const std::string& label = inputs[i].label;
-      (label.find("split") != std::string::npos ? split
+      (label.find("split") != std::string::npos     ? split
           : label.find("1e-7") != std::string::npos ? noise
-                                                     : hulls)
+                                                    : hulls)
         .Add(!runs[i].failure.empty(), d);
     }
     // Every pair among the hull sizes 200..400 (250 is the exact run).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Seconds of MuscleDeformation through pvpython, as a user meets them, at three muscle sizes.
 
     pvpython Testing/Benchmarks/benchmark_filter_scaling.py [data folder] [levels, e.g. 2 or 0,1,2]

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Seconds of InterpolatedMuscleDeformation through pvpython as a GUI user changes its settings.
 
     pvpython Testing/Benchmarks/benchmark_method_settings.py [data folder]

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The inputs of the interpolation method (InterpolatedDeformation.h) for the
 // phantom, with its action lines matched as ActionLineMatching does (the LHDL
 // right hip: LhdlMotion in RealData.h). Shared by the tests and the benchmark.

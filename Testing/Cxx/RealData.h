@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Finding and reading the real data sets (../shared/data) for tests and benchmarks.
 #pragma once
 
@@ -61,7 +62,6 @@ inline md::TriangleMesh ReadSurface(const std::string& path)
   std::copy(connectivity->GetPointer(0), connectivity->GetPointer(0) + mesh.triangles.size(), mesh.triangles.data());
   return mesh;
 }
-
 
 /// The comma-separated fields of one line.
 inline std::vector<std::string> SplitCsvLine(const std::string& line)
@@ -225,7 +225,8 @@ inline bool LoadLhdlCase(const std::string& motion, int frameIndex, LhdlCase& ou
           currentPoints.push_back(pair.second);
         }
       }
-      md::Points r(static_cast<Eigen::Index>(restPoints.size()), 3), c(static_cast<Eigen::Index>(currentPoints.size()), 3);
+      md::Points r(static_cast<Eigen::Index>(restPoints.size()), 3),
+        c(static_cast<Eigen::Index>(currentPoints.size()), 3);
       for (size_t k = 0; k < restPoints.size(); ++k)
       {
         r.row(static_cast<Eigen::Index>(k)) = restPoints[k];

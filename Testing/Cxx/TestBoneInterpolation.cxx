@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "BoneInterpolation.h"
 
 #include <gtest/gtest.h>
@@ -180,8 +181,7 @@ TEST(BoneInterpolation, RejectsUnusableInput)
   withNaN(4, 0) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(md::PoseInterpolator(rest, fewer, md::InterpolationMode::Linear), md::InputError);
   EXPECT_THROW(md::PoseInterpolator(rest, withNaN, md::InterpolationMode::Rigid), md::InputError);
-  EXPECT_THROW(md::PoseInterpolator(Points(0, 3), Points(0, 3), md::InterpolationMode::Rigid),
-    md::InputError);
+  EXPECT_THROW(md::PoseInterpolator(Points(0, 3), Points(0, 3), md::InterpolationMode::Rigid), md::InputError);
   const md::PoseInterpolator ok(rest, rest, md::InterpolationMode::Rigid);
   EXPECT_THROW(ok.AtStep(0, 0), md::InputError);
 }

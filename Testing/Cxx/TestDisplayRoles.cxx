@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The cell array Role that the filters write, which the plugin's colour map turns into bone,
 // muscle, action-line and hull colours (issue: bones and muscles shared colours by port).
 #include "vtkActionLineMatching.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "FilterTestUtilities.h"
 
 #include "vtkActionLineMatching.h"
@@ -6,8 +7,8 @@
 
 #include <vtkCellData.h>
 #include <vtkDataArray.h>
-#include <vtkMath.h>
 #include <vtkFieldData.h>
+#include <vtkMath.h>
 #include <vtkPointData.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkTrivialProducer.h>
@@ -77,8 +78,8 @@ TEST(ActionLineMatching, PairsBlocksByNameAndCarriesTheCurrentPosition)
   auto* linesRest = vtkMultiBlockDataSet::SafeDownCast(phantom->GetOutputDataObject(3));
   auto* linesCurrent = vtkMultiBlockDataSet::SafeDownCast(phantom->GetOutputDataObject(4));
   // The current pose lists the muscles in another order: pairing is by name.
-  auto reordered = MakeBlocks({ { "RectusFemoris", Block(linesCurrent, 2) },
-    { "Iliopsoas", Block(linesCurrent, 0) }, { "GluteusMaximus", Block(linesCurrent, 1) } });
+  auto reordered = MakeBlocks({ { "RectusFemoris", Block(linesCurrent, 2) }, { "Iliopsoas", Block(linesCurrent, 0) },
+    { "GluteusMaximus", Block(linesCurrent, 1) } });
   vtkNew<vtkActionLineMatching> matching;
   matching->SetInputData(0, linesRest);
   matching->SetInputData(1, reordered);
@@ -160,19 +161,16 @@ TEST(ActionLineMatching, BadInputGivesAClearErrorAndNoOutput)
   const double nan = std::numeric_limits<double>::quiet_NaN();
   auto good = MakePolylines({ { 0, 0, 0, 1, 0, 0, 1, 2, 0 } });
   std::vector<Case> cases = {
-    { "different numbers of polylines", good,
-      MakePolylines({ { 0, 0, 0, 1, 0, 0 }, { 0, 0, 0, 1, 1, 1 } }),
+    { "different numbers of polylines", good, MakePolylines({ { 0, 0, 0, 1, 0, 0 }, { 0, 0, 0, 1, 1, 1 } }),
       "Input has 1 polyline(s) but CurrentPose has 2" },
     { "zero-length line", good, MakePolylines({ { 1, 1, 1, 1, 1, 1 } }), "zero length" },
     { "single point", MakePolylines({ { 1, 1, 1 } }), good, "at least two points" },
     { "NaN", good, MakePolylines({ { 0, 0, 0, nan, 0, 0 } }), "NaN" },
     { "empty input", vtkSmartPointer<vtkPolyData>::New(), good, "Input has no polylines" },
-    { "unmatched block name",
-      MakeBlocks({ { "Iliacus", good }, { "Psoas", good } }),
+    { "unmatched block name", MakeBlocks({ { "Iliacus", good }, { "Psoas", good } }),
       MakeBlocks({ { "Iliacus", good }, { "Gluteus", good } }),
       "Input block 'Psoas' has no block of the same name in CurrentPose" },
-    { "different block counts",
-      MakeBlocks({ { "A", good }, { "", good } }), MakeBlocks({ { "A", good } }),
+    { "different block counts", MakeBlocks({ { "A", good }, { "", good } }), MakeBlocks({ { "A", good } }),
       "Input has 2 block(s) but CurrentPose has 1" },
   };
   for (const Case& c : cases)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The answer must not depend on where the data sits or on its units: every filter that computes
 // geometry gets the phantom as it is, moved far from the origin, and scaled (as if in metres, or
 // in units 1e10 times smaller), and must give the same result moved and scaled the same way:
@@ -204,7 +205,7 @@ using MakeFilter = std::function<vtkSmartPointer<vtkAlgorithm>(const Place&, con
 
 /// Runs `make(inputs placed by p, p)` for every placement of `placements` and compares with the
 /// phantom's own place.
-template <size_t N>
+template<size_t N>
 void ExpectIndependentOfPlacement(const Placement (&placements)[N], const MakeFilter& make,
   const std::vector<const char*>& lengths, const std::vector<const char*>& unitless)
 {
@@ -295,7 +296,8 @@ TEST(FrameIndependence, APureTranslationIsReproducedWhereverTheModelSitsAndWhate
     method->SetInputDataObject(0, muscles);
     const vtkSmartPointer<vtkDataObject> bonesRest = Placed(phantom.port[vtkMusculoskeletalPhantom::BONES_REST], &p);
     const vtkSmartPointer<vtkDataObject> bonesCurrent = Placed(bonesMoved, &p);
-    const vtkSmartPointer<vtkDataObject> linesRest = Placed(phantom.port[vtkMusculoskeletalPhantom::ACTION_LINES_REST], &p);
+    const vtkSmartPointer<vtkDataObject> linesRest =
+      Placed(phantom.port[vtkMusculoskeletalPhantom::ACTION_LINES_REST], &p);
     const vtkSmartPointer<vtkDataObject> linesCurrent = Placed(currentLines, &p);
     method->SetInputDataObject(1, bonesRest);
     method->SetInputDataObject(2, bonesCurrent);
@@ -305,7 +307,8 @@ TEST(FrameIndependence, APureTranslationIsReproducedWhereverTheModelSitsAndWhate
     method->SetConvergenceTolerance(0.01 * p.scale);
     method->SetHullTargetNumberOfPoints(100);
     method->Update();
-    EXPECT_LE(TranslationError(muscles, method->GetOutputDataObject(0), t), p.tolerance) << "InterpolatedMuscleDeformation";
+    EXPECT_LE(TranslationError(muscles, method->GetOutputDataObject(0), t), p.tolerance)
+      << "InterpolatedMuscleDeformation";
   }
 }
 

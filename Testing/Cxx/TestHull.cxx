@@ -1,11 +1,12 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "ConvexProjection.h"
 #include "MeanValueCoordinates.h"
 #include "MeshChecks.h"
 #include "Phantom.h"
-#include "TestMeshes.h"
 #include "ProgressiveHull.h"
 #include "RealData.h"
 #include "SurfaceRepair.h"
+#include "TestMeshes.h"
 #include "TriangleIntersection.h"
 
 #include <gtest/gtest.h>
@@ -58,7 +59,8 @@ Eigen::RowVectorXd ReferenceMeanValueCoordinates(const TriangleMesh& cage, const
     double c[3], s[3];
     for (int i = 0; i < 3; ++i)
     {
-      c[i] = 2 * std::sin(h) * std::sin(h - theta[i]) / (std::sin(theta[(i + 1) % 3]) * std::sin(theta[(i + 2) % 3])) - 1;
+      c[i] =
+        2 * std::sin(h) * std::sin(h - theta[i]) / (std::sin(theta[(i + 1) % 3]) * std::sin(theta[(i + 2) % 3])) - 1;
       s[i] = sign * std::sqrt(1 - c[i] * c[i]);
     }
     for (int i = 0; i < 3; ++i)
@@ -87,8 +89,8 @@ TEST(ConvexProjection, ProjectsOntoABoxAndItsFacesEdgesAndCorners)
   }
   const Eigen::Vector3d start(0.5, 0.5, 0.5);
   const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> cases = {
-    { { 0.3, 0.4, 0.5 }, { 0.3, 0.4, 0.5 } }, // inside: itself
-    { { 2.0, 0.5, 0.5 }, { 1.0, 0.5, 0.5 } }, // a face
+    { { 0.3, 0.4, 0.5 }, { 0.3, 0.4, 0.5 } },  // inside: itself
+    { { 2.0, 0.5, 0.5 }, { 1.0, 0.5, 0.5 } },  // a face
     { { 2.0, 0.5, -3.0 }, { 1.0, 0.5, 0.0 } }, // an edge
     { { -1.0, 5.0, 9.0 }, { 0.0, 1.0, 1.0 } }, // a corner
   };
@@ -172,9 +174,9 @@ TEST(SurfaceRepair, RemovesBackToBackFinsAndDuplicateTriangles)
   TriangleMesh box = Box({ 0, 0, 0 }, { 1, 1, 1 });
   const Eigen::Index n = box.triangles.rows();
   box.triangles.conservativeResize(n + 3, 3);
-  box.triangles.row(n) = box.triangles.row(0);                                            // a copy
-  box.triangles.row(n + 1) << 0, 5, 6;                                                    // a fin ...
-  box.triangles.row(n + 2) << 0, 6, 5;                                                    // ... both sides
+  box.triangles.row(n) = box.triangles.row(0); // a copy
+  box.triangles.row(n + 1) << 0, 5, 6;         // a fin ...
+  box.triangles.row(n + 2) << 0, 6, 5;         // ... both sides
   md::RepairReport report;
   const TriangleMesh clean = md::RepairClosedSurface(box, report);
   EXPECT_EQ(report.duplicateTrianglesRemoved, 1);
@@ -304,8 +306,8 @@ TEST(ProgressiveHull, EnclosesEveryPhantomMuscleWithAClosedManifoldHull)
     EXPECT_TRUE(md::CheckEdges(hull.triangles).IsClosedOrientedManifold()) << muscle.name;
     EXPECT_EQ(md::CountSelfIntersections(hull), 0) << muscle.name;
     EXPECT_EQ(md::CountOutside(hull, muscle.rest.points, 1e-9 * Size(muscle.rest.points)), 0) << muscle.name;
-    const double ratio = md::SignedVolume(hull.points, hull.triangles) /
-      md::SignedVolume(muscle.rest.points, muscle.rest.triangles);
+    const double ratio =
+      md::SignedVolume(hull.points, hull.triangles) / md::SignedVolume(muscle.rest.points, muscle.rest.triangles);
     EXPECT_GE(ratio, 1.0) << muscle.name;
     EXPECT_LT(ratio, 1.1) << muscle.name;
   }
@@ -323,8 +325,8 @@ TEST(ProgressiveHull, WorksTheSameInMetresAndMillimetres)
     EXPECT_TRUE(md::CheckEdges(result.hull.triangles).IsClosedOrientedManifold());
     EXPECT_EQ(md::CountSelfIntersections(result.hull), 0);
     EXPECT_EQ(md::CountOutside(result.hull, muscle->points, 1e-9 * Size(muscle->points)), 0);
-    const double ratio = md::SignedVolume(result.hull.points, result.hull.triangles) /
-      md::SignedVolume(muscle->points, muscle->triangles);
+    const double ratio =
+      md::SignedVolume(result.hull.points, result.hull.triangles) / md::SignedVolume(muscle->points, muscle->triangles);
     EXPECT_NEAR(ratio, 1.03, 0.02);
   }
 }
@@ -391,11 +393,11 @@ TEST(MeanValueCoordinates, ReproduceLinearFunctionsEverywhereIncludingOnAndNearT
   const Eigen::Vector3d faceNormal = Eigen::Vector3d(1, 1, 1).normalized();
   const Eigen::Vector3d edgeMiddle = 0.5 * (cage.points.row(0) + cage.points.row(2)).transpose();
   std::vector<Eigen::Vector3d> points = {
-    Eigen::Vector3d::Zero(), Eigen::Vector3d(0.2, -0.1, 0.3), // inside
+    Eigen::Vector3d::Zero(), Eigen::Vector3d(0.2, -0.1, 0.3),                   // inside
     faceCentre, faceCentre + 1e-9 * faceNormal, faceCentre - 1e-9 * faceNormal, // on and near a face
-    faceCentre + 1e-13 * faceNormal, edgeMiddle, edgeMiddle * (1 - 1e-10), // on and near an edge
-    Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(1 - 1e-10, 1e-11, 0), // on and near a cage point
-    Eigen::Vector3d(2, 1, -1), Eigen::Vector3d(0.7, 0.7, 0.0),      // outside
+    faceCentre + 1e-13 * faceNormal, edgeMiddle, edgeMiddle * (1 - 1e-10),      // on and near an edge
+    Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(1 - 1e-10, 1e-11, 0),             // on and near a cage point
+    Eigen::Vector3d(2, 1, -1), Eigen::Vector3d(0.7, 0.7, 0.0),                  // outside
   };
   for (const Eigen::Vector3d& x : points)
   {
@@ -475,10 +477,14 @@ TEST(ProgressiveHull, ACancelledBuildStopsWithCancelledAndAnUncancelledOneIsUnch
   parameters.targetNumberOfPoints = 60;
   const md::HullResult plain = md::BuildProgressiveHull(sphere, parameters);
   int asked = 0;
-  parameters.cancelled = [&asked] { return ++asked >= 3; };
+  parameters.cancelled = [&asked] {
+    return ++asked >= 3;
+  };
   EXPECT_THROW(md::BuildProgressiveHull(sphere, parameters), md::Cancelled);
   EXPECT_EQ(asked, 3); // it stopped when told, not at the end
-  parameters.cancelled = [] { return false; };
+  parameters.cancelled = [] {
+    return false;
+  };
   const md::HullResult asked_never = md::BuildProgressiveHull(sphere, parameters);
   EXPECT_EQ(asked_never.hull.points, plain.hull.points);
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The interpolation method on the phantom: the hull refit, a motion of zero
 // length, bad input, and the paper's failure case (a bone swallowing part of
 // a muscle in one step) reproduced by the one-pass method and fixed by the
@@ -112,10 +113,7 @@ TEST(InterpolatedDeformation, OneBadMuscleDoesNotTakeTheOthersDown)
   };
   const std::vector<Fault> faults{
     { 1, [](md::MuscleMotion& m) { m.lines.clear(); }, "no action line" },
-    { 0,
-      [](md::MuscleMotion& m) {
-        m.lines[0].current.conservativeResize(m.lines[0].current.rows() - 1, 3);
-      },
+    { 0, [](md::MuscleMotion& m) { m.lines[0].current.conservativeResize(m.lines[0].current.rows() - 1, 3); },
       "not matched" },
     { 2,
       [](md::MuscleMotion& m) { // a hole: no hull can enclose it

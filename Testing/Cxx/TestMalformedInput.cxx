@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Malformed input through every filter: cells that refer to points a block does not have, and
 // point arrays shorter than the points. Each must be refused with a message naming the input and
 // the block, never read past an array's end (these crashed ParaView before).
@@ -18,8 +19,8 @@
 #include <vtkAOSDataArrayTemplate.h>
 #include <vtkCellArray.h>
 #include <vtkDoubleArray.h>
-#include <vtkPointData.h>
 #include <vtkFieldData.h>
+#include <vtkPointData.h>
 #include <vtkTable.h>
 
 #include <gtest/gtest.h>
@@ -68,7 +69,10 @@ struct Phantom
 {
   vtkNew<vtkMusculoskeletalPhantom> source;
   vtkNew<vtkActionLineMatching> matching;
-  vtkMultiBlockDataSet* Output(int port) { return vtkMultiBlockDataSet::SafeDownCast(this->source->GetOutputDataObject(port)); }
+  vtkMultiBlockDataSet* Output(int port)
+  {
+    return vtkMultiBlockDataSet::SafeDownCast(this->source->GetOutputDataObject(port));
+  }
   Phantom()
   {
     this->source->SetResolution(12);
@@ -107,7 +111,9 @@ TEST(MalformedInput, OutOfRangePointIdsAreRefusedByEveryFilter)
     f->SetInputDataObject(0, phantom.BadLines(vtkMusculoskeletalPhantom::ACTION_LINES_REST));
     f->SetInputDataObject(1, phantom.Output(vtkMusculoskeletalPhantom::ACTION_LINES_CURRENT));
     const std::string text = Refusal(f);
-    EXPECT_NE(text.find("Input block 'Iliopsoas' has a line cell that " + far + ", but it has 3 points"), std::string::npos) << text;
+    EXPECT_NE(
+      text.find("Input block 'Iliopsoas' has a line cell that " + far + ", but it has 3 points"), std::string::npos)
+      << text;
   }
   {
     vtkNew<vtkBoneInterpolation> f;
@@ -127,7 +133,8 @@ TEST(MalformedInput, OutOfRangePointIdsAreRefusedByEveryFilter)
     f->SetInputDataObject(1, phantom.Matched());
     f->AddInputDataObject(2, phantom.BadMeshes(vtkMusculoskeletalPhantom::BONES_CURRENT));
     const std::string text = Refusal(f);
-    EXPECT_NE(text.find("Obstacles connection 1 block 'Pelvis' has a polygon cell that " + far), std::string::npos) << text;
+    EXPECT_NE(text.find("Obstacles connection 1 block 'Pelvis' has a polygon cell that " + far), std::string::npos)
+      << text;
   }
   {
     // A CurrentPosition array shorter than the points of its lines.
@@ -193,7 +200,8 @@ TEST(MalformedInput, ABoneEmptyInOnePoseIsAnError)
   f->SetInputDataObject(3, phantom.Output(vtkMusculoskeletalPhantom::ACTION_LINES_REST));
   f->SetInputDataObject(4, phantom.Output(vtkMusculoskeletalPhantom::ACTION_LINES_CURRENT));
   const std::string text = Refusal(f);
-  EXPECT_NE(text.find("BonesCurrent block 'Femur' is empty but BonesRest block 'Femur' is not"), std::string::npos) << text;
+  EXPECT_NE(text.find("BonesCurrent block 'Femur' is empty but BonesRest block 'Femur' is not"), std::string::npos)
+    << text;
 }
 
 TEST(MalformedInput, IntersectionResolveReportsItsOwnVolumeChange)
@@ -237,7 +245,9 @@ TEST(MalformedInput, IntersectionResolveReportsItsOwnVolumeChange)
         mesh->GetPoint(ids[0], a);
         mesh->GetPoint(ids[1], p);
         mesh->GetPoint(ids[2], c);
-        sum += (a[0] * (p[1] * c[2] - p[2] * c[1]) - a[1] * (p[0] * c[2] - p[2] * c[0]) + a[2] * (p[0] * c[1] - p[1] * c[0])) / 6;
+        sum += (a[0] * (p[1] * c[2] - p[2] * c[1]) - a[1] * (p[0] * c[2] - p[2] * c[0]) +
+                 a[2] * (p[0] * c[1] - p[1] * c[0])) /
+          6;
       }
       return sum;
     };
@@ -410,6 +420,7 @@ TEST(MalformedInput, EveryFailureOfTheCoreBecomesAnErrorMessageNotACrash)
     EXPECT_TRUE(messages.Contains(c.message)) << messages.Text();
   }
   int result = 1;
-  EXPECT_TRUE(mdvtk::CallCore(filter, "", [] {}, result));
+  EXPECT_TRUE(mdvtk::CallCore(
+    filter, "", [] {}, result));
   EXPECT_EQ(result, 1);
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "MeshChecks.h"
 #include "Phantom.h"
 
@@ -107,8 +108,8 @@ TEST(Phantom, FlexionMovesTheFemurAboutTheHipCentreIntoTheRectusFemoris)
   parameters.flexionDegrees = 0;
   const md::Phantom straight = md::BuildPhantom(parameters);
   EXPECT_TRUE(straight.bones[1].currentPoints.isApprox(straight.bones[1].rest.points, 1e-12));
-  EXPECT_EQ(md::CountInside(straight.bones[1].currentPoints, straight.bones[1].rest.triangles,
-              straight.muscles[2].rest.points),
+  EXPECT_EQ(
+    md::CountInside(straight.bones[1].currentPoints, straight.bones[1].rest.triangles, straight.muscles[2].rest.points),
     0);
 }
 
@@ -137,8 +138,7 @@ TEST(Phantom, ConditionalViaPointChangesTheCurrentActionLine)
     for (const Points& line : muscle.actionLinesRest)
     {
       const Points interior = line.middleRows(1, line.rows() - 2);
-      EXPECT_EQ(md::CountInside(muscle.rest.points, muscle.rest.triangles, interior), interior.rows())
-        << muscle.name;
+      EXPECT_EQ(md::CountInside(muscle.rest.points, muscle.rest.triangles, interior), interior.rows()) << muscle.name;
     }
   }
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The one-pass filter as a pipeline: what it keeps between runs. A muscle's hull and mean value
 // coordinates depend on its rest-pose surface and the hull size only; a new pose must not
 // rebuild them (at 97k points the hull is most of a pass's time), and a kept hull must give
@@ -103,7 +104,8 @@ struct PhantomPipeline
   {
     this->phantom->SetResolution(12);
     this->matching->SetInputConnection(0, this->phantom->GetOutputPort(vtkMusculoskeletalPhantom::ACTION_LINES_REST));
-    this->matching->SetInputConnection(1, this->phantom->GetOutputPort(vtkMusculoskeletalPhantom::ACTION_LINES_CURRENT));
+    this->matching->SetInputConnection(
+      1, this->phantom->GetOutputPort(vtkMusculoskeletalPhantom::ACTION_LINES_CURRENT));
   }
   void Connect(vtkMuscleDeformation* f)
   {
@@ -161,7 +163,8 @@ TEST(MuscleDeformationFilter, HullsAreKeptAcrossPosesAndSettingsThatDoNotTouchTh
   f->SetInputDataObject(0, muscles);
   f->Update();
   EXPECT_EQ(f->GetHullBuildCount(), 7);
-  EXPECT_NE(vtkPolyData::SafeDownCast(vtkMultiBlockDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetBlock(1)), nullptr);
+  EXPECT_NE(
+    vtkPolyData::SafeDownCast(vtkMultiBlockDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetBlock(1)), nullptr);
 }
 
 TEST(InterpolatedMuscleDeformationFilter, RestHullsAreKeptAcrossSettingsThatDoNotTouchThem)
@@ -327,8 +330,8 @@ TEST(InterpolatedMuscleDeformationFilter, OutputsTheBonesAndActionLinesOfTheSame
     }
   }
   // At the last step: the bones in the current pose and the lines at their current positions.
-  EXPECT_EQ(LargestDifference(
-              f->GetOutputDataObject(1), pipeline.phantom->GetOutputDataObject(vtkMusculoskeletalPhantom::BONES_CURRENT)),
+  EXPECT_EQ(LargestDifference(f->GetOutputDataObject(1),
+              pipeline.phantom->GetOutputDataObject(vtkMusculoskeletalPhantom::BONES_CURRENT)),
     0.0);
   pipeline.matching->Update();
   EXPECT_LT(LargestDifference(f->GetOutputDataObject(2), pipeline.matching->GetOutputDataObject(1)), 1e-9);

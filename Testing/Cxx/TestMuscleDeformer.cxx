@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The one-pass muscle deformation (Filters/Core/MuscleDeformer.h) on the
 // phantom and on small constructed cases.
 #include "ActionLineMatching.h"
@@ -69,7 +70,7 @@ TEST(MuscleDeformer, PhantomAt60DegreesConvergesWithVolumeKeptAndNothingFlipped)
     const md::DeformationResult& r = results[m];
     SCOPED_TRACE(c.muscles[m].name);
     EXPECT_TRUE(r.converged);
-    EXPECT_LE(r.iterations, 200);
+    EXPECT_LE(r.iterations, 100); // the cap is 200; the corrected step takes 5-50
     EXPECT_LT(std::abs(r.volumeChangePercent), 0.05);
     EXPECT_EQ(r.flippedTriangles, 0);
     EXPECT_TRUE(r.points.allFinite());

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // OpenSim model reading and forward kinematics: functions, joints, paths, motions, bad input,
 // and OpenSim's own computed muscle lengths as the external oracle (skipped without the data).
 #include "OpenSimKinematics.h"
@@ -125,7 +126,9 @@ const char* kSmallModel = R"(<?xml version="1.0"?>
 TEST(OpenSimFunction, SimmSplineReproducesCubicsAndExtendsLinearly)
 {
   // OpenSim's end conditions match the third derivative of the end cubics: a cubic is exact.
-  auto cubic = [](double x) { return 0.3 * x * x * x - x * x + 2 * x - 1; };
+  auto cubic = [](double x) {
+    return 0.3 * x * x * x - x * x + 2 * x - 1;
+  };
   std::vector<double> x = { -2, -1.2, -0.1, 0.5, 1.7, 3 }, y;
   for (double v : x)
   {
@@ -137,7 +140,9 @@ TEST(OpenSimFunction, SimmSplineReproducesCubicsAndExtendsLinearly)
     EXPECT_NEAR(spline(v), cubic(v), 1e-12) << v;
   }
   // Outside the knots: straight on with the end slopes.
-  auto slope = [](double x) { return 0.9 * x * x - 2 * x + 2; };
+  auto slope = [](double x) {
+    return 0.9 * x * x - 2 * x + 2;
+  };
   EXPECT_NEAR(spline(4), cubic(3) + slope(3), 1e-12);
   EXPECT_NEAR(spline(-3), cubic(-2) - slope(-2), 1e-12);
   // A natural spline is not the same: its second derivative vanishes at the ends.
@@ -152,8 +157,10 @@ TEST(OpenSimFunction, SimmSplineReproducesCubicsAndExtendsLinearly)
 
 TEST(OpenSimFunction, SimmSplineIsSmoothThroughUnevenKnots)
 {
-  const std::vector<double> x = { -2.0944, -1.74533, -1.39626, -1.0472, -0.698132, -0.349066, -0.174533, 0.197344, 0.337395, 0.490178, 1.52146, 2.0944 };
-  const std::vector<double> y = { -0.0032, 0.00179, 0.00411, 0.0041, 0.00212, -0.001, -0.0031, -0.005227, -0.005435, -0.005574, -0.005435, -0.00525 };
+  const std::vector<double> x = { -2.0944, -1.74533, -1.39626, -1.0472, -0.698132, -0.349066, -0.174533, 0.197344,
+    0.337395, 0.490178, 1.52146, 2.0944 };
+  const std::vector<double> y = { -0.0032, 0.00179, 0.00411, 0.0041, 0.00212, -0.001, -0.0031, -0.005227, -0.005435,
+    -0.005574, -0.005435, -0.00525 };
   const Function f = Function::SimmSpline(x, y);
   for (size_t i = 0; i < x.size(); ++i)
   {
@@ -182,8 +189,14 @@ TEST(OpenSimFunction, OtherKinds)
   EXPECT_DOUBLE_EQ(pl(2), 2.5);
   EXPECT_DOUBLE_EQ(pl(5), 4);
   EXPECT_DOUBLE_EQ(pl(-1), -2);
-  EXPECT_NE(ExpectInputError([] { Function::SimmSpline({ 0, 0, 1 }, { 1, 2, 3 }); }).find("do not increase"), std::string::npos);
-  EXPECT_NE(ExpectInputError([] { Function::SimmSpline({ 0, 1 }, { 1 }); }).find("2 x values but 1"), std::string::npos);
+  EXPECT_NE(ExpectInputError([] {
+    Function::SimmSpline({ 0, 0, 1 }, { 1, 2, 3 });
+  }).find("do not increase"),
+    std::string::npos);
+  EXPECT_NE(ExpectInputError([] {
+    Function::SimmSpline({ 0, 1 }, { 1 });
+  }).find("2 x values but 1"),
+    std::string::npos);
 }
 
 TEST(OpenSimModel, JointsComposeAsSimbody)
@@ -202,7 +215,9 @@ TEST(OpenSimModel, JointsComposeAsSimbody)
   ASSERT_EQ(model.wrapObjects.size(), 1u);
 
   std::vector<double> q = DefaultCoordinates(model);
-  auto set = [&](const char* name, double v) { q[model.FindCoordinate(name)] = v; };
+  auto set = [&](const char* name, double v) {
+    q[model.FindCoordinate(name)] = v;
+  };
   set("rx", 0.1);
   set("ry", -0.2);
   set("rz", 0.3);
@@ -262,7 +277,9 @@ TEST(OpenSimModel, JointsComposeAsSimbody)
   g = PathAt(model, path, q, poses2);
   ASSERT_EQ(g.points.rows(), 2);
   EXPECT_EQ(g.pointIndex, (std::vector<int>{ 0, 2 }));
-  EXPECT_LT((g.points.row(1).transpose() - poses2[model.FindBody("tibia")].Apply(Eigen::Vector3d(-0.1, -0.2, 0))).norm(), 1e-14);
+  EXPECT_LT(
+    (g.points.row(1).transpose() - poses2[model.FindBody("tibia")].Apply(Eigen::Vector3d(-0.1, -0.2, 0))).norm(),
+    1e-14);
 }
 
 TEST(OpenSimModel, WrapSurfacesAreClosedAndOutward)
@@ -293,7 +310,8 @@ TEST(OpenSimModel, WrapSurfacesAreClosedAndOutward)
 
 TEST(OpenSimModel, BadInputIsNamed)
 {
-  std::string e = ExpectInputError([] { ParseModel("<OpenSimDocument Version=\"40000\"><Model><BodySet>", "bad.osim"); });
+  std::string e =
+    ExpectInputError([] { ParseModel("<OpenSimDocument Version=\"40000\"><Model><BodySet>", "bad.osim"); });
   EXPECT_NE(e.find("bad.osim"), std::string::npos) << e;
   EXPECT_NE(e.find("malformed XML"), std::string::npos) << e;
 
@@ -347,7 +365,8 @@ TEST(OpenSimMotion, ReadsAndMapsColumns)
   SetCoordinates(model, "flex=90, tx=2;knee_angle=-45", true, q);
   EXPECT_NEAR(q[model.FindCoordinate("flex")], M_PI / 2, 1e-15);
   EXPECT_DOUBLE_EQ(q[model.FindCoordinate("tx")], 2);
-  EXPECT_NE(ExpectInputError([&] { SetCoordinates(model, "elbow=3", true, q); }).find("'elbow' is not a coordinate"), std::string::npos);
+  EXPECT_NE(ExpectInputError([&] { SetCoordinates(model, "elbow=3", true, q); }).find("'elbow' is not a coordinate"),
+    std::string::npos);
 }
 
 TEST(OpenSimMotion, BadMotionsAreNamed)
@@ -380,8 +399,8 @@ struct LengthComparison
   std::map<std::string, std::vector<double>> difference; ///< ours - OpenSim's, per frame
 };
 
-LengthComparison CompareLengths(const std::string& folder, const std::string& modelFile,
-  const std::string& motionFile, const std::string& lengthsFile)
+LengthComparison CompareLengths(const std::string& folder, const std::string& modelFile, const std::string& motionFile,
+  const std::string& lengthsFile)
 {
   const Model model = ReadModel(folder + "/" + modelFile);
   MotionOptions options;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The OpenSim reader as a VTK filter, without data: time steps, which frame a request gets, what
 // is read again when (counters, not timers).
 #include "FilterTestUtilities.h"
@@ -63,7 +64,8 @@ double UpdateAndLength(vtkOpenSimModelReader* reader, int port, double time)
 TEST(OpenSimModelReader, FramesFollowTheRequestedTimeAndTheModelIsReadOnce)
 {
   const std::string model = Write("knee.osim", kModel);
-  const std::string motion = Write("knee.mot", "knee\nversion=1\ninDegrees=yes\nendheader\ntime angle\n0 0\n1 90\n2 180\n");
+  const std::string motion =
+    Write("knee.mot", "knee\nversion=1\ninDegrees=yes\nendheader\ntime angle\n0 0\n1 90\n2 180\n");
   vtkNew<vtkOpenSimModelReader> reader;
   reader->SetFileName(model.c_str());
   reader->SetMotionFileName(motion.c_str());
@@ -84,7 +86,8 @@ TEST(OpenSimModelReader, FramesFollowTheRequestedTimeAndTheModelIsReadOnce)
   EXPECT_DOUBLE_EQ(Field(reader->GetOutputDataObject(vtkOpenSimModelReader::BODY_TRANSFORMS), "Time"), 1.0);
   EXPECT_NEAR(Field(reader->GetOutputDataObject(vtkOpenSimModelReader::BODY_TRANSFORMS), "angle"), 90.0, 1e-12);
   // Scrubbing, a new motion and a new rest pose: the model file is not read again.
-  reader->SetMotionFileName(Write("knee2.mot", "knee\nversion=1\ninDegrees=yes\nendheader\ntime angle\n0 45\n").c_str());
+  reader->SetMotionFileName(
+    Write("knee2.mot", "knee\nversion=1\ninDegrees=yes\nendheader\ntime angle\n0 45\n").c_str());
   reader->SetRestPoseCoordinates("angle=10");
   EXPECT_NEAR(UpdateAndLength(reader, 1, 0.0), length(45), 1e-12);
   EXPECT_EQ(reader->GetModelReadCount(), 1);
@@ -105,10 +108,12 @@ TEST(OpenSimModelReader, TheRestPoseCanComeFromAMotionFilesFirstRow)
 {
   vtkNew<vtkOpenSimModelReader> reader;
   reader->SetFileName(Write("knee.osim", kModel).c_str());
-  reader->SetRestPoseFileName(Write("static.mot", "static\nversion=1\ninDegrees=yes\nendheader\ntime angle\n0 90\n1 0\n").c_str());
+  reader->SetRestPoseFileName(
+    Write("static.mot", "static\nversion=1\ninDegrees=yes\nendheader\ntime angle\n0 90\n1 0\n").c_str());
   reader->Update();
   // The rest pose (90 degrees, the first row): rest and current outputs agree without a motion.
-  auto* rest = vtkMultiBlockDataSet::SafeDownCast(reader->GetOutputDataObject(vtkOpenSimModelReader::MUSCLE_PATHS_REST));
+  auto* rest =
+    vtkMultiBlockDataSet::SafeDownCast(reader->GetOutputDataObject(vtkOpenSimModelReader::MUSCLE_PATHS_REST));
   EXPECT_NEAR(Field(rest->GetBlock(0), "PathLength"), std::hypot(1.0, 1.0), 1e-12);
   // Coordinates given by value override the file's.
   reader->SetRestPoseCoordinates("angle=0");

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The one-pass deformation of the four LHDL hip muscles (lhdl_hip_r) at hip
 // flexion 30 and 60 degrees and adduction -40 and 40 degrees, all muscles
 // together, obstacles right iliac bone, sacrum and femur in the current pose;
@@ -13,8 +14,8 @@
 #include "vtkMuscleDeformation.h"
 
 #include <vtkFieldData.h>
-#include <vtkPointData.h>
 #include <vtkMultiBlockDataSet.h>
+#include <vtkPointData.h>
 
 #include <gtest/gtest.h>
 
@@ -117,12 +118,12 @@ TEST_P(RealDeformation, EveryMuscleConvergesKeepsItsVolumeAndNothingFlips)
     const md::DeformationResult& r = results[m];
     SCOPED_TRACE(muscles[m].name);
     std::cout << "[ measured ] " << GetParam().motion << " frame " << GetParam().frame << " (flexion "
-              << pose.frame.hipFlexion << ", adduction " << pose.frame.hipAdduction << ") " << muscles[m].name
-              << ": " << r.iterations << " iterations, volume change " << r.volumeChangePercent << " %, "
-              << r.flippedTriangles << " flipped, action-line samples inside " << r.restSamplesInside
-              << " (rest) / " << r.currentSamplesInside << " (deformed)\n";
+              << pose.frame.hipFlexion << ", adduction " << pose.frame.hipAdduction << ") " << muscles[m].name << ": "
+              << r.iterations << " iterations, volume change " << r.volumeChangePercent << " %, " << r.flippedTriangles
+              << " flipped, action-line samples inside " << r.restSamplesInside << " (rest) / "
+              << r.currentSamplesInside << " (deformed)\n";
     EXPECT_TRUE(r.converged);
-    EXPECT_LE(r.iterations, 200);
+    EXPECT_LE(r.iterations, 100); // the cap is 200; the corrected step takes 5-50
     EXPECT_LE(std::abs(r.volumeChangePercent), 0.05);
     EXPECT_EQ(r.flippedTriangles, 0);
     EXPECT_TRUE(r.points.allFinite());
@@ -131,8 +132,8 @@ TEST_P(RealDeformation, EveryMuscleConvergesKeepsItsVolumeAndNothingFlips)
 }
 
 INSTANTIATE_TEST_SUITE_P(Lhdl, RealDeformation,
-  ::testing::Values(Pose{ "hip_flexion", 20 }, Pose{ "hip_flexion", 35 }, Pose{ "hip_adduction", 0 },
-    Pose{ "hip_adduction", 40 }),
+  ::testing::Values(
+    Pose{ "hip_flexion", 20 }, Pose{ "hip_flexion", 35 }, Pose{ "hip_adduction", 0 }, Pose{ "hip_adduction", 40 }),
   [](const ::testing::TestParamInfo<Pose>& info) {
     return std::string(info.param.motion) + "_" + std::to_string(info.param.frame);
   });

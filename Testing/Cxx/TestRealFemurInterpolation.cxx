@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Bone interpolation of the real LHDL femur through a 60 degree hip flexion.
 // Reads ../shared/data/lhdl_hip_r (MUSCLEDEFORMATION_DATA_DIR); skipped, and
 // reported as skipped by ctest, when the data is absent.
@@ -176,10 +177,10 @@ TEST_F(RealFemur, LinearShrinksTheBoneAsPredicted)
         }
       }
     }
-    std::cout << "[ measured ] Linear step " << step << "/" << Steps << ": predicted shrink factor "
-              << f << " (" << 100 * (1 - f) << " %), smallest measured distance ratio "
-              << smallestRatio << ", femur length " << restLength << " -> " << length
-              << " mm, largest deviation from the prediction " << worstPrediction << "\n";
+    std::cout << "[ measured ] Linear step " << step << "/" << Steps << ": predicted shrink factor " << f << " ("
+              << 100 * (1 - f) << " %), smallest measured distance ratio " << smallestRatio << ", femur length "
+              << restLength << " -> " << length << " mm, largest deviation from the prediction " << worstPrediction
+              << "\n";
     EXPECT_LT(worstPrediction, 1e-5);
     EXPECT_NEAR(smallestRatio, f, 0.01);
     EXPECT_LT(length, restLength * (1 - 0.5 * (1 - f)));

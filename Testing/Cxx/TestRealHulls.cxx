@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Hulls and mean value coordinates of every real muscle: ../shared/data
 // (MUSCLEDEFORMATION_DATA_DIR), lhdl_hip_r and vhf_right. Skipped, and
 // reported as skipped by ctest, when the data is absent.

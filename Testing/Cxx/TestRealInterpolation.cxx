@@ -1,11 +1,12 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The interpolation method on the LHDL right hip, hip flexion 60 degrees
 // (frame 35), four muscles together, obstacles iliac bone, sacrum and femur:
 // the one-pass method, the interpolation with the hull refitted (N = 4) and
 // with the hull rebuilt before every step (the paper), judged by the measures
 // of docs/DESIGN.md. Skipped when ../shared/data is absent.
 #include "InterpolatedDeformation.h"
-#include "RealData.h"
 #include "ProgressiveHull.h"
+#include "RealData.h"
 
 #include <gtest/gtest.h>
 
@@ -13,8 +14,8 @@ namespace
 {
 /// The method with its own deformation step (bones push the muscle), or
 /// with `contactWeight` 0 the paper's step.
-md::InterpolationResult RunMethod(const MotionCase& c, int steps, md::HullMode mode,
-  double contactWeight = md::StepDeformationDefaults().contactWeight)
+md::InterpolationResult RunMethod(
+  const MotionCase& c, int steps, md::HullMode mode, double contactWeight = md::StepDeformationDefaults().contactWeight)
 {
   md::InterpolationParameters parameters;
   parameters.numberOfSteps = steps;
@@ -113,7 +114,9 @@ TEST(RealInterpolation, InputsMovedBy1e7StillGiveSoundMuscles)
   {
     GTEST_SKIP() << "LHDL data not found (set MUSCLEDEFORMATION_DATA_DIR)";
   }
-  auto span = [](const md::Points& p) { return (p.colwise().maxCoeff() - p.colwise().minCoeff()).norm(); };
+  auto span = [](const md::Points& p) {
+    return (p.colwise().maxCoeff() - p.colwise().minCoeff()).norm();
+  };
   for (int seed : { 1, 2, 4 })
   {
     SCOPED_TRACE("seed " + std::to_string(seed));
@@ -165,8 +168,7 @@ TEST(RealInterpolation, OnePassWithBonesPushingReportsTheFoldsItLeft)
     current.push_back(md::TriangleMesh{ b.current, b.rest.triangles });
   }
   const std::vector<md::Obstacle> bones = md::BuildObstacles(names, current);
-  const std::vector<md::DeformationResult> results =
-    md::DeformMuscles(toDeform, bones, md::StepDeformationDefaults());
+  const std::vector<md::DeformationResult> results = md::DeformMuscles(toDeform, bones, md::StepDeformationDefaults());
   std::int64_t left = 0;
   for (size_t m = 0; m < results.size(); ++m)
   {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Static intersection resolution and the quality measures it is judged by.
 #include "MeshChecks.h"
 #include "MuscleDeformer.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "MeshChecks.h"
 #include "Phantom.h"
 #include "TriangleTree.h"
@@ -110,9 +111,9 @@ TEST(TriangleTree, FirstHitCrossingsAndClosestPointAgreeWithBruteForce)
     double nearest = std::numeric_limits<double>::max();
     for (Eigen::Index t = 0; t < femur.triangles.rows(); ++t)
     {
-      nearest = std::min(nearest, md::PointTriangleDistance(from, femur.points.row(femur.triangles(t, 0)).transpose(),
-                                    femur.points.row(femur.triangles(t, 1)).transpose(),
-                                    femur.points.row(femur.triangles(t, 2)).transpose()));
+      nearest = std::min(nearest,
+        md::PointTriangleDistance(from, femur.points.row(femur.triangles(t, 0)).transpose(),
+          femur.points.row(femur.triangles(t, 1)).transpose(), femur.points.row(femur.triangles(t, 2)).transpose()));
     }
     const md::TriangleTree::Closest closest = tree.ClosestPoint(from);
     EXPECT_NEAR(closest.distance, nearest, 1e-9);
@@ -144,8 +145,10 @@ TEST(TriangleTree, RefitAnswersLikeATreeBuiltOnTheMovedPoints)
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (int q = 0; q < 500; ++q)
   {
-    const Eigen::Vector3d p = low + (high - low).cwiseProduct(Eigen::Vector3d(unit(generator), unit(generator), unit(generator)));
-    const Eigen::Vector3d to = low + (high - low).cwiseProduct(Eigen::Vector3d(unit(generator), unit(generator), unit(generator)));
+    const Eigen::Vector3d p =
+      low + (high - low).cwiseProduct(Eigen::Vector3d(unit(generator), unit(generator), unit(generator)));
+    const Eigen::Vector3d to =
+      low + (high - low).cwiseProduct(Eigen::Vector3d(unit(generator), unit(generator), unit(generator)));
     EXPECT_EQ(refitted.Inside(p), rebuilt.Inside(p));
     EXPECT_NEAR(refitted.ClosestPoint(p).distance, rebuilt.ClosestPoint(p).distance, 1e-9);
     const auto a = refitted.FirstHit(p, to), b = rebuilt.FirstHit(p, to);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "Phantom.h"
 #include "ProgressiveHull.h"
 #include "VolumeConstrainedSolver.h"
@@ -95,10 +96,30 @@ TEST(EnclosedVolume, GradientMatchesFiniteDifferences)
       Points plus = hull.points, minus = hull.points;
       plus(i, c) += h;
       minus(i, c) -= h;
-      const double difference = (md::EnclosedVolume(plus, hull.triangles) - md::EnclosedVolume(minus, hull.triangles)) / (2 * h);
+      const double difference =
+        (md::EnclosedVolume(plus, hull.triangles) - md::EnclosedVolume(minus, hull.triangles)) / (2 * h);
       EXPECT_NEAR(gradient(i, c), difference, 1e-6 * std::abs(difference) + 1e-9);
     }
   }
+}
+
+namespace
+{
+/// The original implementation's step, written out here to show its error: the J A L^T r term of
+/// lambda with the wrong sign (VolumeConstrainedSolver::Step is the corrected one).
+Points OriginalStep(
+  const md::VolumeConstrainedSolver& solver, const Points& x, const Points& targets, double targetVolume, double alpha)
+{
+  Points gradient;
+  const double volume = md::EnclosedVolume(x, solver.Faces, &gradient);
+  const Eigen::MatrixXd aPulled =
+    solver.Normal.solve(Eigen::MatrixXd(solver.Rows.transpose() * (solver.Rows * x - targets)));
+  const Eigen::MatrixXd aGradient = solver.Normal.solve(Eigen::MatrixXd(gradient));
+  const double jaj = (gradient.array() * aGradient.array()).sum();
+  const double jalr = (gradient.array() * aPulled.array()).sum();
+  const double lambda = ((volume - targetVolume) / alpha + jalr) / jaj;
+  return x - alpha * (aPulled + lambda * aGradient);
+}
 }
 
 TEST(VolumeConstrainedSolver, VolumeConvergesToTheRestVolumeWhereTheOriginalFormulaMisses)
@@ -113,12 +134,12 @@ TEST(VolumeConstrainedSolver, VolumeConvergesToTheRestVolumeWhereTheOriginalForm
     for (int iteration = 0; iteration < 400; ++iteration)
     {
       corrected = solver.Step(corrected, problem.targets, restVolume, alpha);
-      original = solver.StepWithOriginalSignError(original, problem.targets, restVolume, alpha);
+      original = OriginalStep(solver, original, problem.targets, restVolume, alpha);
     }
     const double correctedError = std::abs(md::EnclosedVolume(corrected, hull.triangles) / restVolume - 1);
     const double originalError = std::abs(md::EnclosedVolume(original, hull.triangles) / restVolume - 1);
-    std::cout << "[ measured ] step length " << alpha << ": volume error " << 100 * correctedError
-              << " % (corrected), " << 100 * originalError << " % (original sign)\n";
+    std::cout << "[ measured ] step length " << alpha << ": volume error " << 100 * correctedError << " % (corrected), "
+              << 100 * originalError << " % (original sign)\n";
     EXPECT_LT(correctedError, 1e-8) << "alpha " << alpha;
     EXPECT_GT(originalError, 1e-3) << "alpha " << alpha;
     // The anchors did move: the muscle was stretched, at constant volume.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The defaults a user sees in ParaView (ServerManagerXML) and the ones a C++ or VTK user gets
 // (the filters' constructors) are written twice: this test holds them to each other, through
 // each filter's PrintSelf. (HullTargetNumberOfPoints once had a minimum of 4 in one and 8 in the
@@ -27,7 +28,7 @@
 
 namespace
 {
-template <typename T>
+template<typename T>
 vtkSmartPointer<vtkObject> Make()
 {
   return vtkSmartPointer<T>::New();

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Seeded random malformed input through every filter of the plugin (pvpython).
 
     pvpython Testing/Python/fuzz_filters.py SEED COUNT

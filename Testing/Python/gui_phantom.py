@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Run inside the real ParaView GUI by test_gui.py (paraview --test-script=... --exit).
 
 Builds the phantom pipeline as a GUI user would (the plugin loaded by PV_PLUGIN_PATH, as the

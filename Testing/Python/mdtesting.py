@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Shared set-up of the pvpython tests: paths, the plugin, captured VTK messages, skipping."""
 import os
 import shutil

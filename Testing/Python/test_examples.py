@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The example scripts run as a user runs them, and write what they promise."""
 import glob
 import json

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The fuzz campaign of Testing/Python/fuzz_filters.py in the suite: seeded random malformed input
 through every filter, in a child pvpython so that a crash is caught and named, not fatal."""
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The real ParaView GUI, as the README tells a user to start it, driving the phantom pipeline.
 
 Starts `paraview` (under the display with_display.sh provides) with the plugin found through

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Rendered views of the phantom compared with committed baselines (made with Mesa llvmpipe).
 
 Set MUSCLEDEFORMATION_UPDATE_BASELINES=1 to write new baselines after a deliberate change.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The interpolation method and the static intersection resolution as a pvpython user drives them."""
 import unittest
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The LHDL example on the real right-hip data; skipped (exit 77) when the data is absent."""
 import glob
 import json

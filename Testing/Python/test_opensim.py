@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """OpenSimModelReader, MoveWithBodies and ActionLineGrouping as a pvpython user drives them: a
 small model written here, bad input, and (when the data is present) OpenSim's own muscle lengths,
 gait2392 played through, and the LHDL hip from its own OpenSim files."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The plugin as a pvpython user drives it: proxies, documentation, pipelines, time steps, errors."""
 import os
 import unittest

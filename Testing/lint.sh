@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
+# The project's hygiene checks, run by the test suite (ctest -R Lint):
+#   lint.sh format <source dir>               every C++ file as .clang-format says
+#   lint.sh spdx <source dir>                 every source file names its licence (SPDX)
+#   lint.sh tidy <source dir> <build dir>     .clang-tidy's checks on the algorithm core
+# Exits 77 (ctest: skipped) when the tool it needs is not installed.
+set -euo pipefail
+check=$1
+source_dir=$2
+cd "$source_dir"
+cxx_files() { git ls-files '*.h' '*.cxx' 2>/dev/null || find Filters Plugin Testing -name '*.h' -o -name '*.cxx'; }
+
+case "$check" in
+  format)
+    command -v clang-format >/dev/null || { echo "clang-format is not installed: skipped"; exit 77; }
+    cxx_files | xargs clang-format --dry-run --Werror
+    echo "every C++ file is formatted as .clang-format says"
+    ;;
+  spdx)
+    missing=0
+    for f in $(git ls-files '*.h' '*.cxx' '*.py' '*.sh' '*.xml' '*CMakeLists.txt' .ci/run); do
+      if ! head -n 3 "$f" | grep -q "SPDX-License-Identifier: BSD-3-Clause"; then
+        echo "$f: no SPDX-License-Identifier line at its top"
+        missing=1
+      fi
+    done
+    [ "$missing" -eq 0 ] && echo "every source file names its licence"
+    exit "$missing"
+    ;;
+  tidy)
+    build_dir=$3
+    command -v clang-tidy >/dev/null || { echo "clang-tidy is not installed: skipped"; exit 77; }
+    [ -f "$build_dir/compile_commands.json" ] || { echo "no $build_dir/compile_commands.json" >&2; exit 1; }
+    git ls-files 'Filters/Core/*.cxx' | xargs -P "$(nproc)" -n 1 clang-tidy -p "$build_dir" --quiet
+    echo "clang-tidy finds nothing in the algorithm core"
+    ;;
+  *)
+    echo "unknown check '$check': format, spdx or tidy" >&2
+    exit 2
+    ;;
+esac
