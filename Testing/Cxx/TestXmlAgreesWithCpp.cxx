@@ -18,13 +18,16 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
 #include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace
 {
@@ -81,9 +84,20 @@ std::string Printed(vtkObject* object, const std::string& name)
 TEST(ServerManagerXml, EveryNumericDefaultIsTheConstructorsDefault)
 {
   int compared = 0;
-  for (const char* file : { "MuscleDeformation.xml", "OpenSimModelReader.xml", "OpenSimAttachment.xml" })
+  std::vector<std::string> files;
+  for (const auto& file :
+    std::filesystem::directory_iterator(std::string(MUSCLEDEFORMATION_SOURCE_DIR) + "/ServerManagerXML"))
   {
-    std::ifstream in(std::string(MUSCLEDEFORMATION_SOURCE_DIR) + "/ServerManagerXML/" + file);
+    if (file.path().extension() == ".xml")
+    {
+      files.push_back(file.path().string());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  ASSERT_EQ(files.size(), 10u) << "one file per proxy";
+  for (const std::string& file : files)
+  {
+    std::ifstream in(file);
     ASSERT_TRUE(in) << file;
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     static const std::regex proxy(R"re(<SourceProxy([^>]*)>([\s\S]*?)</SourceProxy>)re");

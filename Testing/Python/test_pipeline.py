@@ -74,7 +74,7 @@ class ServerManagerXML(unittest.TestCase):
 
     def test_hulls_are_shown_as_a_wireframe_around_their_muscle(self):
         folder = os.path.join(mdtesting.SOURCE_DIR, "ServerManagerXML")
-        root = ElementTree.parse(os.path.join(folder, "MuscleDeformation.xml")).getroot()
+        root = ElementTree.parse(os.path.join(folder, "HullDecimation.xml")).getroot()
         hints = root.find("./ProxyGroup/SourceProxy[@name='HullDecimation']/Hints")
         self.assertEqual(hints.find("RepresentationType").get("type"), "Wireframe")
         self.assertEqual(hints.find("Visibility").get("replace_input"), "0")
