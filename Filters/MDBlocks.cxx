@@ -345,9 +345,6 @@ bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::funct
   return false;
 }
 
-const char* const FailedArrayName = "DeformationFailed";
-const char* const FailureMessageArrayName = "FailureMessage";
-
 vtkSmartPointer<vtkPolyData> FailedMuscle(vtkPolyData* input, const std::string& message)
 {
   auto output = vtkSmartPointer<vtkPolyData>::New();

@@ -68,6 +68,14 @@ enum class Role : unsigned char
 constexpr int MuscleShades = 8;
 constexpr const char* RoleArrayName = "Role";
 
+/// Names of the arrays that more than one filter writes or reads (users' scripts rely on them).
+constexpr const char* CurrentPositionArrayName = "CurrentPosition"; ///< the matched action lines' current pose
+constexpr const char* DisplacementArrayName = "Displacement";       ///< from the rest pose, per point
+constexpr const char* StaticShiftArrayName = "StaticShift";         ///< the static resolution's move, per point
+constexpr const char* VolumeChangeArrayName = "VolumeChangePercent";
+constexpr const char* FailedArrayName = "DeformationFailed"; ///< field data of a muscle not processed
+constexpr const char* FailureMessageArrayName = "FailureMessage";
+
 /// Writes `role` as the cell array Role of every polydata leaf of `data` (in leaf order: muscle
 /// k gets shade k modulo MuscleShades), the active cell scalars unless the leaf has other active
 /// scalars. Role::AsGiven leaves `data` as it is.
@@ -111,11 +119,6 @@ std::function<void(double)> ProgressOrCancel(vtkAlgorithm* filter, double offset
 /// user stopped the run), for a filter that goes on with its other muscles.
 bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::function<void()>& work, int& result,
   std::string* reported = nullptr);
-
-/// Field data of a muscle's output block that could not be processed: DeformationFailed 1, and
-/// why in FailureMessage. The other muscles of the input are processed and output as usual.
-extern const char* const FailedArrayName;
-extern const char* const FailureMessageArrayName;
 
 /// The output block of a muscle that could not be processed: no geometry (nothing silently
 /// wrong to show), the input block's field data, and DeformationFailed / FailureMessage.

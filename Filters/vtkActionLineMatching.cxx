@@ -156,7 +156,7 @@ int vtkActionLineMatching::RequestData(
     vtkSmartPointer<vtkPolyData> currentOut = currentBuilder.Build(current.data);
     // CurrentPosition: the matched CP point of every RP point, in the same order.
     auto currentPosition = vtkSmartPointer<vtkDoubleArray>::New();
-    currentPosition->SetName("CurrentPosition");
+    currentPosition->SetName(mdvtk::CurrentPositionArrayName);
     currentPosition->SetNumberOfComponents(3);
     currentPosition->SetNumberOfTuples(restOut->GetNumberOfPoints());
     double* out = currentPosition->GetPointer(0);

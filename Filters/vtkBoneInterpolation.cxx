@@ -123,7 +123,7 @@ bool vtkBoneInterpolation::ReadPoses(vtkDataObject* restInput, vtkDataObject* cu
     }
     else
     {
-      vtkDataArray* position = rest.data->GetPointData()->GetArray("CurrentPosition");
+      vtkDataArray* position = rest.data->GetPointData()->GetArray(mdvtk::CurrentPositionArrayName);
       if (!position || position->GetNumberOfComponents() != 3)
       {
         vtkErrorMacro(<< "CurrentPose is not connected and " << rest.label

@@ -491,10 +491,10 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     auto output = vtkSmartPointer<vtkPolyData>::New();
     output->ShallowCopy(muscles[b].data);
     output->SetPoints(mdvtk::ToVtkPoints(points));
-    output->GetPointData()->AddArray(mdvtk::ToVtkArray("Displacement", points - rest));
+    output->GetPointData()->AddArray(mdvtk::ToVtkArray(mdvtk::DisplacementArrayName, points - rest));
     // No static move at step 0: zeros.
-    output->GetPointData()->AddArray(mdvtk::ToVtkArray(
-      "StaticShift", s.staticShift.rows() ? s.staticShift : md::Points(md::Points::Zero(points.rows(), 3))));
+    output->GetPointData()->AddArray(mdvtk::ToVtkArray(mdvtk::StaticShiftArrayName,
+      s.staticShift.rows() ? s.staticShift : md::Points(md::Points::Zero(points.rows(), 3))));
     double hullSeconds = r.restHullSeconds[m];
     for (int j = 1; j <= step; ++j)
     {
@@ -513,7 +513,7 @@ int vtkInterpolatedMuscleDeformation::RequestData(
       columns[measureIndex].second.resize(names.size() - 1, std::nan("")); // the failed rows before
       columns[measureIndex++].second.push_back(static_cast<double>(value));
     };
-    measure("VolumeChangePercent", s.volumeChangePercent);
+    measure(mdvtk::VolumeChangeArrayName, s.volumeChangePercent);
     measure("NewPenetrationCount", s.newPenetrationCount);
     measure("MaxNewPenetrationDepth", s.maxNewPenetrationDepth);
     measure("NewBonePenetrationCount", s.newBonePenetrationCount);

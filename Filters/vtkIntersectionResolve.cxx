@@ -234,7 +234,7 @@ int vtkIntersectionResolve::RequestData(
     auto output = vtkSmartPointer<vtkPolyData>::New();
     output->ShallowCopy(leaves[b].data);
     output->SetPoints(mdvtk::ToVtkPoints(points));
-    output->GetPointData()->AddArray(mdvtk::ToVtkArray("StaticShift", shifts));
+    output->GetPointData()->AddArray(mdvtk::ToVtkArray(mdvtk::StaticShiftArrayName, shifts));
     // Field data describes this output only: the upstream measures (a deformation's volume
     // change, iterations, ...) no longer hold once points have moved.
     vtkNew<vtkFieldData> fieldData;
@@ -242,7 +242,7 @@ int vtkIntersectionResolve::RequestData(
     const md::TriangleMesh& reference = restGiven ? deformableRest[k] : deformable[k];
     const double referenceVolume = md::SignedVolume(reference.points, reference.triangles);
     const double volume = md::SignedVolume(resolved.points[k], deformable[k].triangles);
-    mdvtk::AddFieldValue(fieldData, "VolumeChangePercent", 100.0 * (volume - referenceVolume) / referenceVolume);
+    mdvtk::AddFieldValue(fieldData, mdvtk::VolumeChangeArrayName, 100.0 * (volume - referenceVolume) / referenceVolume);
     mdvtk::AddFieldValue(fieldData, "PenetratingPointCount", r.penetratingPoints);
     mdvtk::AddFieldValue(fieldData, "PenetratingGroupCount", r.groups);
     mdvtk::AddFieldValue(fieldData, "MaxPenetrationDepth", frame.LengthToWorld(r.maxDepth));

@@ -46,7 +46,7 @@ bool ReadMatchedLines(
     error = leaf.label + " has no polylines: each muscle needs its action lines";
     return false;
   }
-  vtkDataArray* current = data->GetPointData()->GetArray("CurrentPosition");
+  vtkDataArray* current = data->GetPointData()->GetArray(mdvtk::CurrentPositionArrayName);
   if (!current || current->GetNumberOfComponents() != 3)
   {
     error = leaf.label + " has no point array CurrentPosition (3 components): connect output 0 of ActionLineMatching";
@@ -406,10 +406,10 @@ int vtkMuscleDeformation::RequestData(
     auto output = vtkSmartPointer<vtkPolyData>::New();
     output->ShallowCopy(muscles[b].data);
     output->SetPoints(mdvtk::ToVtkPoints(points));
-    output->GetPointData()->AddArray(mdvtk::ToVtkArray("Displacement", displacement));
+    output->GetPointData()->AddArray(mdvtk::ToVtkArray(mdvtk::DisplacementArrayName, displacement));
     vtkNew<vtkFieldData> fieldData;
     fieldData->DeepCopy(muscles[b].data->GetFieldData());
-    mdvtk::AddFieldValue(fieldData, "VolumeChangePercent", r.volumeChangePercent);
+    mdvtk::AddFieldValue(fieldData, mdvtk::VolumeChangeArrayName, r.volumeChangePercent);
     mdvtk::AddFieldValue(fieldData, "NumberOfIterations", r.iterations);
     mdvtk::AddFieldValue(fieldData, "CoarseIterations", r.coarseIterations);
     mdvtk::AddFieldValue(fieldData, "Converged", r.converged ? 1 : 0);
