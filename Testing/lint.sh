@@ -9,7 +9,11 @@ set -euo pipefail
 check=$1
 source_dir=$2
 cd "$source_dir"
-cxx_files() { git ls-files '*.h' '*.cxx' 2>/dev/null || find Filters Plugin Testing -name '*.h' -o -name '*.cxx'; }
+# The project's files: tracked or new (not ignored), that exist (a deletion may not be staged yet).
+project_files() {
+  git ls-files --cached --others --exclude-standard "$@" | sort -u | while read -r f; do [ -f "$f" ] && echo "$f"; done
+}
+cxx_files() { project_files '*.h' '*.cxx'; }
 
 case "$check" in
   format)
@@ -19,7 +23,7 @@ case "$check" in
     ;;
   spdx)
     missing=0
-    for f in $(git ls-files '*.h' '*.cxx' '*.py' '*.sh' '*.xml' '*CMakeLists.txt' .ci/run); do
+    for f in $(project_files '*.h' '*.cxx' '*.py' '*.sh' '*.xml' '*CMakeLists.txt' .ci/run); do
       if ! head -n 3 "$f" | grep -q "SPDX-License-Identifier: BSD-3-Clause"; then
         echo "$f: no SPDX-License-Identifier line at its top"
         missing=1
@@ -32,7 +36,7 @@ case "$check" in
     build_dir=$3
     command -v clang-tidy >/dev/null || { echo "clang-tidy is not installed: skipped"; exit 77; }
     [ -f "$build_dir/compile_commands.json" ] || { echo "no $build_dir/compile_commands.json" >&2; exit 1; }
-    git ls-files 'Filters/Core/*.cxx' | xargs -P "$(nproc)" -n 1 clang-tidy -p "$build_dir" --quiet
+    project_files 'Filters/Core/*.cxx' | xargs -P "$(nproc)" -n 1 clang-tidy -p "$build_dir" --quiet
     echo "clang-tidy finds nothing in the algorithm core"
     ;;
   *)
