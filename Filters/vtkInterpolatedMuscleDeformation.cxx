@@ -289,11 +289,9 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     }
     std::vector<md::Points> worldMuscles; // the rest pose as given: step 0 shows it exactly
     std::vector<const md::Points*> restPoints;
-    std::map<size_t, size_t> blockIndex; // block -> its entry in worldMuscles
-    for (size_t m = 0; m < motions.size(); ++m)
+    for (const md::MuscleMotion& motion : motions)
     {
-      worldMuscles.push_back(motions[m].muscle.points);
-      blockIndex[cache.blockOf[m]] = m;
+      worldMuscles.push_back(motion.muscle.points);
     }
     for (const md::Points& points : worldMuscles)
     {
@@ -307,6 +305,7 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     }
     std::vector<md::MuscleMotion> matched; // the muscles whose lines could be matched
     std::vector<size_t> matchedBlocks;
+    std::vector<const md::Points*> matchedRest;
     for (size_t m = 0; m < motions.size(); ++m)
     {
       md::MuscleMotion& motion = motions[m];
@@ -372,6 +371,7 @@ int vtkInterpolatedMuscleDeformation::RequestData(
       cache.lineLeaf.push_back(restLinesOf[b]);
       matched.push_back(std::move(motion));
       matchedBlocks.push_back(b);
+      matchedRest.push_back(&worldMuscles[m]);
     }
 
     md::InterpolationParameters parameters;
@@ -387,21 +387,18 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     parameters.deformation.contactWeight = this->BoneContactWeight;
     parameters.hull.targetNumberOfPoints = this->HullTargetNumberOfPoints;
     parameters.hull.cancelled = mdvtk::AbortRequested(this);
+    if (matched.empty() && !cache.failedBlocks.empty())
+    {
+      cache = Cache{};
+      return 0; // every muscle failed, each said why (no muscle at all is the core's error)
+    }
     motions = std::move(matched);
     cache.blockOf = std::move(matchedBlocks);
-    restPoints.clear();
-    for (size_t b : cache.blockOf)
-    {
-      restPoints.push_back(&worldMuscles[blockIndex.at(b)]);
-    }
+    restPoints = std::move(matchedRest);
     int result = 1;
     if (!mdvtk::CallCore(
           this, "",
           [&] {
-            if (motions.empty())
-            {
-              throw md::InputError("no muscle could be deformed (see the errors above)");
-            }
             cache.result = md::DeformByInterpolation(
               motions, bones, parameters, mdvtk::ProgressOrCancel(this), this->KeptRest.get());
           },
@@ -464,10 +461,7 @@ int vtkInterpolatedMuscleDeformation::RequestData(
   std::map<size_t, size_t> muscleOfBlock;
   for (size_t m = 0; m < cache.blockOf.size(); ++m)
   {
-    if (r.failures[m].empty())
-    {
-      muscleOfBlock[cache.blockOf[m]] = m;
-    }
+    muscleOfBlock[cache.blockOf[m]] = m; // failedBlocks has the core's failures too: they go first
   }
   for (size_t b = 0; b < muscles.size(); ++b)
   {

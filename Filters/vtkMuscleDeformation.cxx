@@ -278,7 +278,6 @@ int vtkMuscleDeformation::RequestData(
         {
           failMuscle(
             m, hullLeaf.label + " is not a closed, outward-oriented manifold surface: build it with HullDecimation");
-          entry = KeptMuscle{};
           continue;
         }
         const std::int64_t outside = md::CountPointsOutsideHull(hulls[b], surfaces[b], frame.rounding);
@@ -289,21 +288,20 @@ int vtkMuscleDeformation::RequestData(
               std::to_string(md::UsedPoints(surfaces[b]).rows()) +
               " muscle points are outside it, where mean value coordinates extrapolate; build the "
               "hull with HullDecimation or leave Hull empty");
-          entry = KeptMuscle{};
           continue;
         }
         entry.hull = hulls[b];
       }
-      else
-      {
-        md::HullParameters parameters;
-        parameters.targetNumberOfPoints = this->HullTargetNumberOfPoints;
-        parameters.cancelled = mdvtk::AbortRequested(this);
-        int result = 1;
-        std::string failure;
-        if (!mdvtk::CallCore(
-              this, leaf.label + ": ",
-              [&] {
+      md::HullParameters parameters;
+      parameters.targetNumberOfPoints = this->HullTargetNumberOfPoints;
+      parameters.cancelled = mdvtk::AbortRequested(this);
+      int result = 1;
+      std::string failure;
+      if (!mdvtk::CallCore(
+            this, leaf.label + ": ",
+            [&] {
+              if (!hullGiven)
+              {
                 const md::MuscleHull built = md::BuildMuscleHull(surfaces[b], parameters);
                 ++this->HullBuildCount;
                 entry.hull = built.result.hull;
@@ -311,22 +309,9 @@ int vtkMuscleDeformation::RequestData(
                 {
                   entry.repairs = built.report.Describe();
                 }
-              },
-              result, &failure))
-        {
-          if (failure.empty())
-          {
-            return result; // stopped by the user
-          }
-          failures[m] = failure; // reported
-          entry = KeptMuscle{};
-          continue;
-        }
-      }
-      int result = 1;
-      std::string failure;
-      if (!mdvtk::CallCore(
-            this, leaf.label + ": ", [&] { entry.weights = md::MeanValueCoordinates(entry.hull, surfaces[b].points); },
+              }
+              entry.weights = md::MeanValueCoordinates(entry.hull, surfaces[b].points);
+            },
             result, &failure))
       {
         if (failure.empty())
@@ -334,7 +319,7 @@ int vtkMuscleDeformation::RequestData(
           return result; // stopped by the user
         }
         failures[m] = failure; // reported
-        entry = KeptMuscle{};
+        entry = KeptMuscle{};  // a hull without its weights is not kept
         continue;
       }
       entry.surface = surfaces[b];

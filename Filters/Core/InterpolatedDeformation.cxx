@@ -129,20 +129,9 @@ std::string ProblemOf(const MuscleMotion& m)
   return {};
 }
 
-void Validate(const std::vector<MuscleMotion>& muscles, const std::vector<BoneMotion>& bones)
+/// The bones concern every muscle (the muscles' own input is ProblemOf's, checked before).
+void ValidateBones(const std::vector<BoneMotion>& bones)
 {
-  if (muscles.empty())
-  {
-    throw InputError("there is no muscle to deform");
-  }
-  for (size_t i = 0; i < muscles.size(); ++i)
-  {
-    const std::string problem = ProblemOf(muscles[i]);
-    if (!problem.empty())
-    {
-      throw OfMuscle(InputError(problem), i);
-    }
-  }
   for (const BoneMotion& b : bones)
   {
     if (b.rest.points.rows() != b.current.rows())
@@ -243,7 +232,7 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       progress(fraction);
     }
   };
-  Validate(muscles, bones);
+  ValidateBones(bones);
   const size_t count = muscles.size();
   InterpolationResult result;
   const int steps = ResolveNumberOfSteps(bones, parameters);
@@ -648,23 +637,21 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
       return some;
     }
     // Back to the order of all muscles; a failed one has no points and default measures.
-    InterpolationResult all = some;
-    all.restHullSeconds.assign(count, 0.0);
-    for (size_t j = 0; j < some.points.size(); ++j)
-    {
-      all.points[j].assign(count, Points(0, 3));
-      all.measures[j].assign(count, MuscleStepMeasures{});
+    auto spread = [&](auto& perActive, auto empty) {
+      std::vector<decltype(empty)> perMuscle(count, empty);
       for (size_t k = 0; k < active.size(); ++k)
       {
-        all.points[j][active[k]] = std::move(some.points[j][k]);
-        all.measures[j][active[k]] = std::move(some.measures[j][k]);
+        perMuscle[active[k]] = std::move(perActive[k]);
       }
-    }
-    for (size_t k = 0; k < active.size(); ++k)
+      perActive = std::move(perMuscle);
+    };
+    for (size_t j = 0; j < some.points.size(); ++j)
     {
-      all.restHullSeconds[active[k]] = some.restHullSeconds[k];
+      spread(some.points[j], Points(0, 3));
+      spread(some.measures[j], MuscleStepMeasures{});
     }
-    return all;
+    spread(some.restHullSeconds, 0.0);
+    return some;
   });
   result.failures = std::move(failures);
   return result;
