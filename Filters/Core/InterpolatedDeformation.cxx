@@ -393,6 +393,28 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   const OverlapMasks restOverlap = FindOverlaps(current, fixedObstacles(obstacles));
   const std::vector<FixedObstacle> fixed = fixedObstacles(obstacles);
 
+  // The full-mesh energies (rest pose only), kept for every step.
+  std::vector<std::unique_ptr<SurfaceEnergy>> energies(count);
+  if (parameters.settleOnSurface)
+  {
+    for (size_t m = 0; m < count; ++m)
+    {
+      std::vector<Points> restLines;
+      for (const PoseInterpolator& line : lineMotions[m])
+      {
+        restLines.push_back(line.AtStep(0, steps));
+      }
+      try
+      {
+        energies[m] = std::make_unique<SurfaceEnergy>(muscles[m].muscle, restLines, parameters.settle);
+      }
+      catch (const InputError& e)
+      {
+        throw OfMuscle(InputError("muscle '" + muscles[m].name + "': " + e.what()), m);
+      }
+    }
+  }
+
   DeformationParameters stepParameters = parameters.deformation;
   stepParameters.measureSamplesInside = false; // not part of the method's measures
   // Contact rows leave the rest pose's overlap with each bone alone.
@@ -480,6 +502,21 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
         }
       }
     }
+    std::vector<SettleReport> settled(count);
+    if (parameters.settleOnSurface)
+    {
+      std::vector<const SurfaceEnergy*> energyPointers(count);
+      std::vector<std::vector<MatchedLine>> wholeMotion(count); // rest pose -> this step
+      for (size_t m = 0; m < count; ++m)
+      {
+        energyPointers[m] = energies[m].get();
+        for (const PoseInterpolator& line : lineMotions[m])
+        {
+          wholeMotion[m].push_back({ line.AtStep(0, steps), line.AtStep(j, steps) });
+        }
+      }
+      settled = SettleMuscles(next, energyPointers, wholeMotion, restVolumes, fixed, &restOverlap, parameters.settle);
+    }
     StaticResolveResult resolved = ResolveStaticIntersections(next, fixed, &restOverlap, parameters.staticResolve);
     // The volume is given back over the whole surface, except at the overlap
     // the rest pose has (which stays where it is); a point against an obstacle
@@ -533,7 +570,9 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       s.iterations = previous[m].iterations + s.stepIterations;
       s.converged = previous[m].converged && deformed[m].converged;
       s.pointsFrozenInObstacles = deformed[m].verticesFrozen;
-      s.deformationSeconds = deformed[m].seconds;
+      s.settleIterations = settled[m].iterations;
+      s.settled = previous[m].settled && (!parameters.settleOnSurface || settled[m].converged);
+      s.deformationSeconds = deformed[m].seconds + settled[m].seconds;
       s.staticShift = std::move(resolved.shift[m]);
       stepPoints[m] = next[m].points;
     }

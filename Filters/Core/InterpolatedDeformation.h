@@ -22,6 +22,7 @@
 #include "MuscleDeformer.h"
 #include "ProgressiveHull.h"
 #include "StaticIntersections.h"
+#include "SurfaceSettle.h"
 
 #include <functional>
 #include <string>
@@ -96,6 +97,10 @@ struct InterpolationParameters
   int detailRelaxation = 2;
   StaticResolveParameters staticResolve;
   DeformationParameters deformation = StepDeformationDefaults();
+  /// Each step's answer settled on the full mesh (SurfaceSettle), the hull-based pass its
+  /// starting guess; false: the hull-based pass's answer (the paper's, hull-dependent).
+  bool settleOnSurface = false;
+  SettleParameters settle;
   HullParameters hull;
 };
 
@@ -116,6 +121,8 @@ struct MuscleStepMeasures
   int iterations = 0;                       ///< steps 1..j
   bool converged = true;                    ///< every step so far
   std::int64_t pointsFrozenInObstacles = 0; ///< this step
+  int settleIterations = 0;                 ///< this step's full-mesh iterations
+  bool settled = true;                      ///< every step's full-mesh settle so far converged
   double hullSeconds = 0;                   ///< this step's hull work: refit, or rebuild and mapping
   double deformationSeconds = 0;            ///< this step's deformation and static resolution (its share)
   Points staticShift;                       ///< this step's static move, per point

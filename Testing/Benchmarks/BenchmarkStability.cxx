@@ -11,7 +11,7 @@
 // present, the LHDL hip in four poses. Prints figures; asserts nothing.
 //
 //   BenchmarkStability [data folder] [case: all|phantom|flexion30|flexion60|adduction-40|adduction40]
-//                      [seeds (3)] [methods: all|one-pass|N (1, 4, 8)]
+//                      [seeds (3)] [methods: all|one-pass|N (1, 4, 8)|settle]
 #include "RealData.h"
 
 #include <chrono>
@@ -29,6 +29,7 @@ struct Method
   std::string label;
   int steps;
   double contactWeight;
+  bool settleOnSurface = false;
 };
 
 /// The last step's points of every muscle, or `failure` set.
@@ -45,6 +46,7 @@ Output Run(const MotionCase& c, const Method& method, int hullPoints, md::RestMa
   parameters.numberOfSteps = method.steps;
   parameters.deformation.contactWeight = method.contactWeight;
   parameters.hull.targetNumberOfPoints = hullPoints;
+  parameters.settleOnSurface = method.settleOnSurface;
   Output out;
   const auto start = std::chrono::steady_clock::now();
   try
@@ -216,9 +218,14 @@ int main(int argc, char* argv[])
       methods.push_back({ "interpolation N = " + std::to_string(n), n, md::StepDeformationDefaults().contactWeight });
     }
   }
+  if (methodsArg == "settle") // experimental: each step settled on the full mesh (SurfaceSettle.h)
+  {
+    methods.push_back(
+      { "interpolation N = 4, settled on the full mesh", 4, md::StepDeformationDefaults().contactWeight, true });
+  }
   if (methods.empty())
   {
-    std::fprintf(stderr, "unknown methods '%s': all, one-pass, 1, 4 or 8\n", methodsArg.c_str());
+    std::fprintf(stderr, "unknown methods '%s': all, one-pass, 1, 4, 8 or settle\n", methodsArg.c_str());
     return 2;
   }
   std::printf("Distances (mm) between corresponding points of the last step's muscles, per variation against the\n"

@@ -1,0 +1,141 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The full-mesh energy and its settle (SurfaceSettle.h): the rest pose is its
+// own minimum, a rigid motion of the action line moves the muscle rigidly, and
+// the answer (without contact) depends neither on the starting guess nor on the
+// hull that gave it.
+#include "InterpolatedDeformation.h"
+#include "SurfaceSettle.h"
+#include "TestMeshes.h"
+#include "VolumeConstrainedSolver.h"
+
+#include <gtest/gtest.h>
+
+namespace
+{
+/// An ellipsoid muscle (x half-axis 30, y and z 12) along the x axis, and its
+/// action line through it: three points, the second at the centre.
+struct Spindle
+{
+  md::TriangleMesh muscle;
+  md::Points line;
+  Spindle()
+  {
+    muscle = Sphere(Eigen::Vector3d::Zero(), 1, 3);
+    muscle.points.col(0) *= 30;
+    muscle.points.rightCols(2) *= 12;
+    line.resize(3, 3);
+    line << -36, 0, 0, 0, 0, 0, 36, 0, 0;
+  }
+  double Size() const { return (muscle.points.colwise().maxCoeff() - muscle.points.colwise().minCoeff()).norm(); }
+};
+
+/// The line bent at its middle point: the second segment turned by `degrees` about z.
+md::Points Bent(const md::Points& line, double degrees)
+{
+  md::Points bent = line;
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(degrees * EIGEN_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  bent.row(2) = (turn * (line.row(2) - line.row(1)).transpose()).transpose() + line.row(1);
+  return bent;
+}
+
+/// Settles one muscle from `start` towards the pose the lines describe.
+md::Points Settle(const Spindle& s, const md::SurfaceEnergy& energy, const md::Points& current, const md::Points& start,
+  md::SettleReport* report = nullptr)
+{
+  std::vector<md::TriangleMesh> meshes{ { start, s.muscle.triangles } };
+  const double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
+  const std::vector<md::SettleReport> reports = md::SettleMuscles(
+    meshes, { &energy }, { { { s.line, current } } }, { volume }, {}, nullptr, md::SettleParameters());
+  if (report)
+  {
+    *report = reports[0];
+  }
+  return meshes[0].points;
+}
+}
+
+TEST(SurfaceSettle, TheRestPoseIsItsOwnMinimum)
+{
+  const Spindle s;
+  const md::SurfaceEnergy energy(s.muscle, { s.line }, md::SettleParameters());
+  // Of the 21 samples (10 a segment, 3.6 apart from x = -36), the 17 within |x| < 30 are inside.
+  EXPECT_EQ(energy.SampleCount(), 17);
+  // From a start bulged on one side, it goes back to the rest pose.
+  md::Points start = s.muscle.points;
+  for (Eigen::Index i = 0; i < start.rows(); ++i)
+  {
+    start(i, 1) += 2.0 * std::exp(-std::pow(start(i, 0) / 10, 2));
+  }
+  md::SettleReport report;
+  const md::Points settled = Settle(s, energy, s.line, start, &report);
+  EXPECT_TRUE(report.converged);
+  EXPECT_LE(report.iterations, 10);
+  EXPECT_LT((settled - s.muscle.points).cwiseAbs().maxCoeff(), 1e-6 * s.Size());
+}
+
+TEST(SurfaceSettle, ARigidMotionOfTheLineMovesTheMuscleRigidly)
+{
+  const Spindle s;
+  const md::SurfaceEnergy energy(s.muscle, { s.line }, md::SettleParameters());
+  // A turn about an axis across the line (so the line's turn is that turn) and a shift.
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.6, Eigen::Vector3d(0, 1, 1).normalized()).toRotationMatrix();
+  const Eigen::RowVector3d shift(5, -3, 8);
+  auto moved = [&](const md::Points& p) {
+    md::Points out = p * turn.transpose();
+    out.rowwise() += shift;
+    return out;
+  };
+  md::SettleReport report;
+  const md::Points settled = Settle(s, energy, moved(s.line), s.muscle.points, &report);
+  EXPECT_TRUE(report.converged);
+  EXPECT_LT((settled - moved(s.muscle.points)).cwiseAbs().maxCoeff(), 1e-6 * s.Size());
+}
+
+TEST(SurfaceSettle, TheAnswerDoesNotDependOnTheStartingGuess)
+{
+  const Spindle s;
+  const md::SurfaceEnergy energy(s.muscle, { s.line }, md::SettleParameters());
+  const md::Points current = Bent(s.line, 40);
+  md::SettleReport fromRest, fromShifted;
+  const md::Points a = Settle(s, energy, current, s.muscle.points, &fromRest);
+  md::Points shifted = s.muscle.points;
+  shifted.rowwise() += Eigen::RowVector3d(3, 4, -2);
+  const md::Points b = Settle(s, energy, current, shifted, &fromShifted);
+  ASSERT_TRUE(fromRest.converged);
+  ASSERT_TRUE(fromShifted.converged);
+  EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 1e-6 * s.Size());
+  // The bend is followed (the far end went round) and the volume held.
+  EXPECT_GT(a.col(1).maxCoeff(), 15);
+  const double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
+  EXPECT_NEAR(md::EnclosedVolume(a, s.muscle.triangles), volume, 1e-8 * volume);
+}
+
+TEST(SurfaceSettle, ThroughTheMethodTheAnswerDoesNotDependOnTheHull)
+{
+  // The interpolation method with each step settled on the full mesh: hulls of 60 and 150
+  // points (different cages, different starting guesses) give the same muscle; without the
+  // settle they do not.
+  const Spindle s;
+  md::MuscleMotion motion{ "spindle", s.muscle, { { s.line, Bent(s.line, 40) } } };
+  auto run = [&](int hullPoints, bool settle) {
+    md::InterpolationParameters parameters;
+    parameters.numberOfSteps = 2;
+    parameters.hull.targetNumberOfPoints = hullPoints;
+    parameters.settleOnSurface = settle;
+    const md::InterpolationResult result = md::DeformByInterpolation({ motion }, {}, parameters);
+    EXPECT_TRUE(result.measures.back()[0].settled);
+    return result.points.back()[0];
+  };
+  const double settledApart = (run(60, true) - run(150, true)).rowwise().norm().maxCoeff();
+  const double hullApart = (run(60, false) - run(150, false)).rowwise().norm().maxCoeff();
+  EXPECT_LT(settledApart, 1e-5 * s.Size());
+  EXPECT_GT(hullApart, 100 * settledApart);
+}
+
+TEST(SurfaceSettle, AMuscleNoActionLinePassesThroughIsRefused)
+{
+  const Spindle s;
+  md::Points away = s.line;
+  away.col(1).array() += 100;
+  EXPECT_THROW(md::SurfaceEnergy(s.muscle, { away }, md::SettleParameters()), md::InputError);
+}
