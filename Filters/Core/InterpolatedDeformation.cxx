@@ -395,18 +395,18 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
 
   // The full-mesh energies (rest pose only), kept for every step.
   std::vector<std::unique_ptr<SurfaceEnergy>> energies(count);
+  std::vector<std::vector<Points>> restLines(count); // the matched lines at step 0
   if (parameters.settleOnSurface)
   {
     for (size_t m = 0; m < count; ++m)
     {
-      std::vector<Points> restLines;
       for (const PoseInterpolator& line : lineMotions[m])
       {
-        restLines.push_back(line.AtStep(0, steps));
+        restLines[m].push_back(line.AtStep(0, steps));
       }
       try
       {
-        energies[m] = std::make_unique<SurfaceEnergy>(muscles[m].muscle, restLines, parameters.settle);
+        energies[m] = std::make_unique<SurfaceEnergy>(muscles[m].muscle, restLines[m], parameters.settle);
       }
       catch (const InputError& e)
       {
@@ -510,9 +510,9 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       for (size_t m = 0; m < count; ++m)
       {
         energyPointers[m] = energies[m].get();
-        for (const PoseInterpolator& line : lineMotions[m])
+        for (size_t l = 0; l < lineMotions[m].size(); ++l)
         {
-          wholeMotion[m].push_back({ line.AtStep(0, steps), line.AtStep(j, steps) });
+          wholeMotion[m].push_back({ restLines[m][l], lineMotions[m][l].AtStep(j, steps) });
         }
       }
       settled = SettleMuscles(next, energyPointers, wholeMotion, restVolumes, fixed, &restOverlap, parameters.settle);

@@ -51,6 +51,12 @@ double PointTriangleDistance(
 /// and farther than `tolerance` from every triangle. Every point is tested.
 std::int64_t CountOutside(const TriangleMesh& surface, const Points& points, double tolerance);
 
+/// The diagonal of the points' bounding box (0 for no points): the size tolerances are relative to.
+inline double BoxDiagonal(const Points& points)
+{
+  return points.rows() ? (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm() : 0.0;
+}
+
 /// Per point, whether a triangle uses it (mesh files may carry other points).
 std::vector<char> UsedMask(const TriangleMesh& mesh);
 

@@ -30,18 +30,6 @@ constexpr int maximumUnfoldings = 8;
 /// torn apart (its volume is held): the phase stops there.
 constexpr double maximumGrowth = 1.5;
 
-double Diagonal(const Points& points)
-{
-  return (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
-}
-
-/// Just outside a surface: `offset` beyond its point `closest` nearest to p,
-/// p being inside (closest.distance > 0), on the way out.
-Eigen::Vector3d JustOutside(const TriangleTree::Closest& closest, const Eigen::Vector3d& p, double offset)
-{
-  return closest.point + (offset / closest.distance) * (closest.point - p);
-}
-
 /// Stacks the Laplacian rows, the dense action-line rows, one row per
 /// anchored point (its position) and, with followWeight > 0, one row of that
 /// weight per hull point (its position).
@@ -185,7 +173,7 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
 {
   const MuscleToDeform& m = *s.input;
   const TriangleMesh& hull = *m.hull;
-  s.size = Diagonal(m.muscle->points);
+  s.size = BoxDiagonal(m.muscle->points);
   const MeanValueCoordinateCalculator coordinates(hull);
   if (m.weights && (m.weights->rows() != m.muscle->points.rows() || m.weights->cols() != hull.points.rows()))
   {
@@ -459,7 +447,7 @@ void PushOffBones(MuscleState& s, const std::vector<Obstacle>& bones, const Defo
 /// maximumGrowth it is being torn apart.
 double Growth(const MuscleState& s)
 {
-  return Diagonal(s.points) / s.size;
+  return BoxDiagonal(s.points) / s.size;
 }
 
 /// Moves every point of `s` from `points` to `candidate`, except where an
@@ -846,7 +834,7 @@ std::vector<std::string> LimitActionLinePoints(std::vector<MatchedLine>& lines, 
       return out;
     };
     // Deviations below rounding of the line's size: the points lie on the kept line.
-    const double negligible = 1e-12 * Diagonal(line.rest);
+    const double negligible = 1e-12 * BoxDiagonal(line.rest);
     std::vector<char> keep(static_cast<size_t>(n), 0);
     keep.front() = keep.back() = 1;
     Eigen::Index kept = 2;

@@ -13,11 +13,6 @@ namespace md
 {
 namespace
 {
-double Diagonal(const Points& points)
-{
-  return points.rows() ? (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm() : 0.0;
-}
-
 /// The obstacles of mesh m: the fixed ones, then the other meshes (null for itself).
 struct ObstacleSet
 {
@@ -48,12 +43,6 @@ struct ObstacleSet
   }
 };
 
-bool Marked(const OverlapMasks* masks, size_t m, size_t o, Eigen::Index i)
-{
-  return masks && m < masks->size() && o < (*masks)[m].size() && !(*masks)[m][o].empty() &&
-    (*masks)[m][o][static_cast<size_t>(i)];
-}
-
 /// For each point of mesh m: the obstacle it is deepest inside, a bone
 /// before any muscle (-1: none, or only where `existing` marks it), the depth
 /// and the nearest surface point.
@@ -82,7 +71,7 @@ Deepest FindDeepest(
     for (size_t o = 0; o < set.all.size(); ++o)
     {
       const TriangleTree* tree = set.For(m, o, fixedCount);
-      if (!tree || Marked(existing, m, o, i) || !tree->InBounds(p) || !tree->Inside(p))
+      if (!tree || InOverlap(existing, m, o, i) || !tree->InBounds(p) || !tree->Inside(p))
       {
         continue;
       }
@@ -204,6 +193,12 @@ void SmoothPrints(const Points& points, const std::vector<std::vector<std::int64
 }
 }
 
+bool InOverlap(const OverlapMasks* masks, size_t m, size_t o, Eigen::Index i)
+{
+  return masks && m < masks->size() && o < (*masks)[m].size() && !(*masks)[m][o].empty() &&
+    (*masks)[m][o][static_cast<size_t>(i)];
+}
+
 OverlapMasks FindOverlaps(const std::vector<TriangleMesh>& meshes, const std::vector<FixedObstacle>& fixed)
 {
   const ObstacleSet set(meshes, fixed);
@@ -269,7 +264,7 @@ StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& 
     const TriangleMesh& mesh = meshes[m];
     const Eigen::Index n = mesh.points.rows();
     const Deepest d = FindDeepest(mesh, m, set, fixed.size(), existing);
-    const double backOff = 1e-5 * Diagonal(mesh.points);
+    const double backOff = 1e-5 * BoxDiagonal(mesh.points);
     Points shift = Points::Zero(n, 3);
     // Of each penetrating point: the obstacle's outward normal where it goes
     // out (the tangent plane there is the half-space it must reach), and its
@@ -297,7 +292,7 @@ StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& 
         continue;
       }
       const double share = o < fixed.size() ? 1.0 : parameters.deformableShare;
-      const double reach = 2 * Diagonal(tree->Mesh().points);
+      const double reach = 2 * BoxDiagonal(tree->Mesh().points);
       int groups = 0;
       const std::vector<int> group = Components(mesh.triangles, n, groups, &member);
       report.groups += groups;
@@ -410,7 +405,7 @@ StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& 
       const Eigen::Vector3d to = p + shift.row(i).transpose();
       for (size_t o = 0; o < fixed.size(); ++o)
       {
-        if (d.obstacle[i] == static_cast<int>(o) || Marked(existing, m, o, i))
+        if (d.obstacle[i] == static_cast<int>(o) || InOverlap(existing, m, o, i))
         {
           continue; // leaving this one, or inside it in the rest pose
         }
@@ -485,7 +480,7 @@ std::vector<double> RestoreVolumes(std::vector<TriangleMesh>& meshes, const std:
     {
       moving[i] = share(i) > 0;
     }
-    const double backOff = 1e-6 * Diagonal(mesh.points);
+    const double backOff = 1e-6 * BoxDiagonal(mesh.points);
     for (int iteration = 0; iteration < 4; ++iteration)
     {
       Points gradient;

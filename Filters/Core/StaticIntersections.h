@@ -25,6 +25,9 @@ struct FixedObstacle
 /// mesh's own entry is empty). Used for the overlap a rest pose already has.
 using OverlapMasks = std::vector<std::vector<std::vector<char>>>;
 
+/// Whether `masks` (may be null) marks point i of mesh m as inside obstacle o.
+bool InOverlap(const OverlapMasks* masks, size_t m, size_t o, Eigen::Index i);
+
 /// Which points of each mesh (those its triangles use) lie inside each
 /// obstacle (see OverlapMasks), from trees of the meshes as they are.
 OverlapMasks FindOverlaps(const std::vector<TriangleMesh>& meshes, const std::vector<FixedObstacle>& fixed);

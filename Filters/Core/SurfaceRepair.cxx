@@ -32,13 +32,6 @@ std::uint64_t EdgeKey(std::int64_t a, std::int64_t b)
 /// their size).
 constexpr double kMergeTolerance = 1e-5;
 
-/// The diagonal of the bounding box of the points the triangles use.
-double UsedBoundingBoxDiagonal(const TriangleMesh& surface)
-{
-  const Points used = UsedPoints(surface);
-  return used.rows() > 0 ? (used.colwise().maxCoeff() - used.colwise().minCoeff()).norm() : 0.0;
-}
-
 struct TriangleHash
 {
   size_t operator()(const Triangle& t) const
@@ -949,7 +942,7 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
       }
     }
   }
-  const double size = UsedBoundingBoxDiagonal(surface);
+  const double size = BoxDiagonal(UsedPoints(surface));
   report.mergeTolerance = kMergeTolerance * size;
   std::vector<std::int64_t> representative;
   std::vector<Triangle> triangles = MergeAndDeduplicate(surface, report.mergeTolerance, representative, report);

@@ -6,20 +6,18 @@
 #include "TriangleTree.h"
 #include "VolumeConstrainedSolver.h"
 
+#include <Eigen/SparseCholesky>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 namespace md
 {
 namespace
 {
 using Clock = std::chrono::steady_clock;
-
-double BoxDiagonal(const Points& points)
-{
-  return points.rows() ? (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm() : 0.0;
-}
 
 /// Barycentric coordinates of q (on the triangle's plane) in triangle t of `mesh`.
 Eigen::Vector3d Barycentric(const TriangleMesh& mesh, Eigen::Index t, const Eigen::Vector3d& q)
@@ -82,16 +80,17 @@ RowEntries ChordRow(const TriangleTree& tree, const Eigen::Vector3d& p, double r
 Eigen::Vector3d ContactTarget(
   const TriangleTree& tree, const TriangleTree::Closest& closest, const Eigen::Vector3d& p, bool inside, double offset)
 {
-  Eigen::Vector3d outward = closest.distance > 0
-    ? Eigen::Vector3d((inside ? 1.0 : -1.0) * (closest.point - p) / closest.distance)
-    : tree.Normal(closest.triangle);
-  return closest.point + offset * outward;
+  if (!(closest.distance > 0))
+  {
+    return closest.point + offset * tree.Normal(closest.triangle);
+  }
+  return inside ? JustOutside(closest, p, offset) : closest.point + (offset / closest.distance) * (p - closest.point);
 }
 }
 
 SurfaceEnergy::SurfaceEnergy(
   const TriangleMesh& rest, const std::vector<Points>& restLines, const SettleParameters& parameters)
-  : RestMesh(rest)
+  : RestPoints(rest.points)
   , SamplesPerSegment(std::max(1, parameters.samplesPerSegment))
 {
   const Eigen::Index n = rest.points.rows();
@@ -171,11 +170,11 @@ SurfaceEnergy::SurfaceEnergy(
 
 Points SurfaceEnergy::RightHandSide(const std::vector<MatchedLine>& lines) const
 {
-  const Eigen::Index n = this->RestMesh.points.rows();
+  const Eigen::Index n = this->RestPoints.rows();
   Points targets(this->Rows.rows(), 3);
   for (Eigen::Index i = 0; i < n; ++i)
   {
-    const Eigen::Vector3d p = this->RestMesh.points.row(i).transpose();
+    const Eigen::Vector3d p = this->RestPoints.row(i).transpose();
     const NearestSegment nearest(p, lines);
     targets.row(i) = this->ShapeWeight * (nearest.Rotation() * this->Delta.row(i).transpose()).transpose();
     targets.row(n + this->SampleCount() + i) =
@@ -219,10 +218,6 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
   std::vector<SettleReport> reports(count);
   const double contact = parameters.contactWeight * parameters.contactWeight;
   const double share = std::clamp(parameters.muscleShare, 0.0, 1.0);
-  auto allowed = [&](size_t m, size_t o, Eigen::Index i) {
-    return restOverlap && m < restOverlap->size() && o < (*restOverlap)[m].size() && !(*restOverlap)[m][o].empty() &&
-      (*restOverlap)[m][o][static_cast<size_t>(i)];
-  };
   auto seconds = [](Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
   };
@@ -283,7 +278,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
         }
         for (size_t o = 0; o < bones.size() + count && !held[i]; ++o)
         {
-          if ((o >= bones.size() && o - bones.size() == m) || allowed(m, o, i))
+          if ((o >= bones.size() && o - bones.size() == m) || InOverlap(restOverlap, m, o, i))
           {
             continue;
           }
@@ -322,23 +317,23 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
         state.factorised = true;
       }
       state.held = std::move(held);
-      state.targets = targets;
+      state.targets = std::move(targets);
       Points rhs = state.base;
       for (Eigen::Index i = 0; i < n; ++i)
       {
         if (state.held[i])
         {
-          rhs.row(i) += contact * targets.row(i);
+          rhs.row(i) += contact * state.targets.row(i);
         }
       }
       // The volume held by a Lagrange multiplier on its linearisation at x.
       Points gradient;
       const double volume = EnclosedVolume(x, meshes[m].triangles, &gradient);
-      const Eigen::MatrixXd free = state.solver.solve(Eigen::MatrixXd(rhs));
-      const Eigen::MatrixXd along = state.solver.solve(Eigen::MatrixXd(gradient));
       const Eigen::MatrixXd g = gradient;
+      const Eigen::MatrixXd free = state.solver.solve(Eigen::MatrixXd(rhs));
+      const Eigen::MatrixXd along = state.solver.solve(g);
       const double rate = (g.array() * along.array()).sum();
-      const double linear = volume + (g.array() * (free - Eigen::MatrixXd(x)).array()).sum() - volumes[m];
+      const double linear = volume + (g.array() * (free - x).array()).sum() - volumes[m];
       next[m] = free - (rate > 0 ? linear / rate : 0.0) * along;
       if (!next[m].allFinite())
       {

@@ -15,19 +15,15 @@
 #include "StaticIntersections.h"
 #include "VolumeConstrainedSolver.h"
 
-#include <Eigen/SparseCholesky>
-
-#include <memory>
 #include <vector>
 
 namespace md
 {
 struct SettleParameters
 {
-  /// Contact rows: a point inside a bone (or another muscle) is pulled to the
-  /// surface by a row of this weight (a point's Laplacian row weighs about 1;
-  /// see SurfaceEnergy). Stiff enough that what is left inside at the
-  /// minimum is a small fraction of a millimetre.
+  /// Contact rows: a point inside a bone (or another muscle) is pulled just
+  /// outside by a row of this weight (a point's Laplacian row weighs about 1;
+  /// see SurfaceEnergy).
   double contactWeight = 4;
   /// Of an overlap between two muscles, the share each side moves out.
   double muscleShare = 0.5;
@@ -53,7 +49,7 @@ struct SettleParameters
 /// action-line sample inside the rest muscle written as a fixed combination of
 /// the surface points where chords through it along the three axes meet the
 /// surface: a sparse row that reproduces the sample exactly in the rest pose),
-/// the follow rows, and the symbolic factorisation of their normal matrix.
+/// the follow rows, and their normal matrix.
 class SurfaceEnergy
 {
 public:
@@ -68,13 +64,12 @@ public:
   /// Rows^T Rows.
   const SparseMatrix& NormalMatrix() const { return this->Normal; }
 
-  const TriangleMesh& Rest() const { return this->RestMesh; }
   const std::vector<char>& Used() const { return this->PointUsed; }
   Eigen::Index SampleCount() const { return static_cast<Eigen::Index>(this->SampleIndex.size()); }
   double Size() const { return this->Span; }
 
 private:
-  TriangleMesh RestMesh;
+  Points RestPoints;
   double Span = 0;
   int SamplesPerSegment = 10;
   std::vector<char> PointUsed;

@@ -104,4 +104,11 @@ private:
   std::vector<Eigen::Index> Order;
   double Size = 0;
 };
+
+/// Just outside a surface: `offset` beyond its point `closest` nearest to p,
+/// p being inside (closest.distance > 0), on the way out.
+inline Eigen::Vector3d JustOutside(const TriangleTree::Closest& closest, const Eigen::Vector3d& p, double offset)
+{
+  return closest.point + (offset / closest.distance) * (closest.point - p);
+}
 }

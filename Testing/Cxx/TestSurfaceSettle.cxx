@@ -123,7 +123,10 @@ TEST(SurfaceSettle, ThroughTheMethodTheAnswerDoesNotDependOnTheHull)
     parameters.hull.targetNumberOfPoints = hullPoints;
     parameters.settleOnSurface = settle;
     const md::InterpolationResult result = md::DeformByInterpolation({ motion }, {}, parameters);
-    EXPECT_TRUE(result.measures.back()[0].settled);
+    if (settle)
+    {
+      EXPECT_TRUE(result.measures.back()[0].settled);
+    }
     return result.points.back()[0];
   };
   const double settledApart = (run(60, true) - run(150, true)).rowwise().norm().maxCoeff();
