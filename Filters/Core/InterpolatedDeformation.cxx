@@ -412,6 +412,10 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       {
         throw OfMuscle(InputError("muscle '" + muscles[m].name + "': " + e.what()), m);
       }
+      catch (const ComputationError& e)
+      {
+        throw OfMuscle(ComputationError("muscle '" + muscles[m].name + "': " + e.what()), m);
+      }
     }
   }
 

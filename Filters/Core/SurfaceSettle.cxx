@@ -11,7 +11,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <memory>
+#include <optional>
+#include <set>
+#include <tuple>
 
 namespace md
 {
@@ -72,19 +76,6 @@ RowEntries ChordRow(const TriangleTree& tree, const Eigen::Vector3d& p, double r
     entry.second /= chords;
   }
   return entries;
-}
-
-/// Where a contact row pulls p: `offset` outside the surface whose point
-/// nearest to p is `closest`, p being inside or (within the band a contact
-/// is kept in) outside.
-Eigen::Vector3d ContactTarget(
-  const TriangleTree& tree, const TriangleTree::Closest& closest, const Eigen::Vector3d& p, bool inside, double offset)
-{
-  if (!(closest.distance > 0))
-  {
-    return closest.point + offset * tree.Normal(closest.triangle);
-  }
-  return inside ? JustOutside(closest, p, offset) : closest.point + (offset / closest.distance) * (p - closest.point);
 }
 }
 
@@ -166,6 +157,46 @@ SurfaceEnergy::SurfaceEnergy(
   this->Rows.resize(followStart + n, n);
   this->Rows.setFromTriplets(entries.begin(), entries.end());
   this->Normal = SparseMatrix(this->Rows.transpose() * this->Rows);
+  this->Factor.compute(this->Normal);
+  if (this->Factor.info() != Eigen::Success)
+  {
+    throw ComputationError("its full-mesh system could not be factorised");
+  }
+}
+
+Points SurfaceEnergy::Solve(const Points& rhs) const
+{
+  return this->Factor.solve(Eigen::MatrixXd(rhs));
+}
+
+void SurfaceEnergy::Prepare(const std::vector<Eigen::Index>& points) const
+{
+  std::vector<Eigen::Index> missing;
+  for (const Eigen::Index p : points)
+  {
+    if (this->Columns.find(p) == this->Columns.end())
+    {
+      missing.push_back(p);
+    }
+  }
+  std::sort(missing.begin(), missing.end());
+  missing.erase(std::unique(missing.begin(), missing.end()), missing.end());
+  std::vector<Eigen::VectorXd> solved(missing.size());
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int k = 0; k < static_cast<int>(missing.size()); ++k)
+  {
+    solved[k] = this->Factor.solve(Eigen::VectorXd::Unit(this->Normal.rows(), missing[k]));
+  }
+  for (size_t k = 0; k < missing.size(); ++k)
+  {
+    this->Columns.emplace(missing[k], std::move(solved[k]));
+  }
+}
+
+const Eigen::VectorXd& SurfaceEnergy::InverseColumn(Eigen::Index point) const
+{
+  this->Prepare({ point });
+  return this->Columns.at(point);
 }
 
 Points SurfaceEnergy::RightHandSide(const std::vector<MatchedLine>& lines) const
@@ -191,16 +222,141 @@ Points SurfaceEnergy::RightHandSide(const std::vector<MatchedLine>& lines) const
 
 namespace
 {
-/// One muscle through the settle.
-struct SettleState
+/// One point of a constraint's combination: `coefficient` times point
+/// `point` of muscle `muscle`.
+struct Term
 {
-  Points base;            // right-hand side without contact
-  std::vector<char> held; // points with a contact row
-  Points targets;         // where those rows pull
-  Eigen::SimplicialLDLT<SparseMatrix> solver;
-  bool factorised = false;
-  double seconds = 0;
+  size_t muscle;
+  Eigen::Index point;
+  double coefficient;
+  const Eigen::VectorXd* column = nullptr; // the energy's inverse at `point`, once known
 };
+
+/// A contact linearised at the current points: normal . (sum of the terms'
+/// points) >= target, with the normal the direction from the muscle's point
+/// to the point of one triangle of the obstacle nearest to it (outwards). A
+/// point is outside an obstacle by the offset when it is that far from every
+/// triangle, so a contact is kept per triangle: a point in a valley of a bone
+/// is held by both its sides at once. Against a bone the sum is the muscle's
+/// point alone; against another muscle it is the muscle's point less the
+/// triangle's point (its corners, barycentric), so that both give way.
+struct Contact
+{
+  size_t muscle = 0;
+  Eigen::Index point = 0;
+  size_t obstacle = 0; // bones first, then muscles
+  Eigen::Index triangle = 0;
+  std::vector<Term> terms;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  double target = 0;
+  bool violated = false; // inside the obstacle or nearer than the offset now
+};
+
+using PointKey = std::tuple<size_t, Eigen::Index, size_t>;          // muscle, point, obstacle
+using HeldContacts = std::map<PointKey, std::vector<Eigen::Index>>; // their triangles
+
+/// The contact of p (point i of muscle m, `inside` obstacle o or not, its
+/// constraint `violated` or not) with `triangle` of the obstacle, linearised
+/// at the current points.
+Contact Linearise(size_t m, Eigen::Index i, size_t o, Eigen::Index triangle, const Eigen::Vector3d& p, bool inside,
+  bool violated, const TriangleTree& tree, size_t bones, double offset)
+{
+  const TriangleMesh& mesh = tree.Mesh();
+  auto corner = [&](int k) {
+    return Eigen::Vector3d(mesh.points.row(mesh.triangles(triangle, k)).transpose());
+  };
+  const Eigen::Vector3d q = ClosestPointOnTriangle(p, corner(0), corner(1), corner(2));
+  const double distance = (p - q).norm();
+  Contact c;
+  c.muscle = m;
+  c.point = i;
+  c.obstacle = o;
+  c.triangle = triangle;
+  c.violated = violated;
+  c.normal = distance > 0 ? Eigen::Vector3d((inside ? -1.0 : 1.0) * (p - q) / distance) : tree.Normal(triangle);
+  c.terms.push_back({ m, i, 1.0 });
+  if (o < bones)
+  {
+    c.target = c.normal.dot(q) + offset;
+  }
+  else
+  {
+    const Eigen::Vector3d weights = Barycentric(mesh, triangle, q);
+    for (int k = 0; k < 3; ++k)
+    {
+      c.terms.push_back({ o - bones, mesh.triangles(triangle, k), -weights(k) });
+    }
+    c.target = offset;
+  }
+  return c;
+}
+}
+
+/// The multipliers of the dual system `system` y = `rhs` whose first slack.size() rows are
+/// contacts (inequalities: a multiplier pushes or is zero) and the rest equalities (the
+/// volumes), by a primal-dual active set from `active` (left as found): an active contact whose
+/// multiplier pulls lets go; an inactive one joins when its residual (a_j . x - target at
+/// the new points) is below -slack[j].
+Eigen::VectorXd SolveActiveSet(const Eigen::MatrixXd& system, const Eigen::VectorXd& rhs,
+  const std::vector<double>& slack, std::vector<char>& active)
+{
+  const Eigen::Index size = system.rows(), nc = static_cast<Eigen::Index>(slack.size());
+  Eigen::VectorXd multipliers = Eigen::VectorXd::Zero(size);
+  for (int round = 0; round < 100; ++round)
+  {
+    std::vector<Eigen::Index> on;
+    for (Eigen::Index k = 0; k < size; ++k)
+    {
+      if (active[k])
+      {
+        on.push_back(k);
+      }
+    }
+    const Eigen::Index a = static_cast<Eigen::Index>(on.size());
+    Eigen::MatrixXd reduced(a, a);
+    Eigen::VectorXd right(a);
+    for (Eigen::Index r = 0; r < a; ++r)
+    {
+      right(r) = rhs(on[r]);
+      for (Eigen::Index c = 0; c < a; ++c)
+      {
+        reduced(r, c) = system(on[r], on[c]);
+      }
+    }
+    // Two contacts that push a point the same way make the system singular: a nudge on
+    // the diagonal picks the smallest multipliers, and refinement takes the nudge's error
+    // out of the rest.
+    Eigen::MatrixXd nudged = reduced;
+    nudged.diagonal() += 1e-12 * reduced.diagonal().cwiseAbs();
+    const Eigen::LDLT<Eigen::MatrixXd> factor(nudged);
+    Eigen::VectorXd solved = factor.solve(right);
+    for (int refine = 0; refine < 3; ++refine)
+    {
+      solved += factor.solve(right - reduced * solved);
+    }
+    multipliers.setZero();
+    for (Eigen::Index r = 0; r < a; ++r)
+    {
+      multipliers(on[r]) = solved(r);
+    }
+    const Eigen::VectorXd residual = system * multipliers - rhs; // a_j . x - target, at the new x
+    bool changed = false;
+    for (Eigen::Index j = 0; j < nc; ++j)
+    {
+      const bool want = active[j] ? multipliers(j) > 0 : residual(j) < -slack[static_cast<size_t>(j)];
+      if (want != static_cast<bool>(active[j]))
+      {
+        active[j] = want;
+        changed = true;
+      }
+    }
+    if (!changed)
+    {
+      break;
+    }
+  }
+
+  return multipliers;
 }
 
 std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
@@ -208,32 +364,37 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
   const std::vector<double>& volumes, const std::vector<FixedObstacle>& bones, const OverlapMasks* restOverlap,
   const SettleParameters& parameters)
 {
-  // Contact: a point inside an obstacle (or held by a row and still within a small offset
-  // of its surface) gets a row pulling it just outside. The row's target is taken where the
-  // point would go without it (its position moved back by the row's pull through its own
-  // stiffness), so that a point in contact slides along the surface as the energy wants
-  // instead of being held where it first touched; a row whose point the energy pulls away
-  // lets go. The matrix is factorised again only when the set of rows changes.
+  // Sequential quadratic programming: at each iteration the volume and the obstacles' surfaces
+  // are linearised at the current points, and the quadratic energy is minimised exactly under
+  // those linear constraints. With the energy's matrix K fixed, the minimum is
+  //   x = K^-1 (b + sum_j lambda_j a_j + mu g),
+  // and the multipliers solve a small dense system S (S_jl = a_j . K^-1 a_l) on the active
+  // contacts: a contact is active while its multiplier pushes (lambda > 0), and one not active
+  // joins when its point would be inside (a primal-dual active set). S needs K^-1 only at the
+  // points in contact: columns of the inverse, kept by the energy for the whole motion.
+  const auto start = Clock::now();
   const size_t count = meshes.size();
+  const size_t obstacles = bones.size() + count;
   std::vector<SettleReport> reports(count);
-  const double contact = parameters.contactWeight * parameters.contactWeight;
-  const double share = std::clamp(parameters.muscleShare, 0.0, 1.0);
-  auto seconds = [](Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-  };
-  std::vector<SettleState> states(count);
+  std::vector<Points> free(count); // the minimum without contact and volume
   for (size_t m = 0; m < count; ++m)
   {
-    const auto start = Clock::now();
-    SettleState& state = states[m];
-    state.base = energies[m]->RightHandSide(lines[m]);
-    state.solver.analyzePattern(energies[m]->NormalMatrix());
-    state.held.assign(static_cast<size_t>(meshes[m].points.rows()), 0);
-    state.targets = Points::Zero(meshes[m].points.rows(), 3);
-    state.seconds += seconds(start);
+    free[m] = energies[m]->Solve(energies[m]->RightHandSide(lines[m]));
   }
   std::vector<std::unique_ptr<TriangleTree>> trees(count);
-  for (int iteration = 0; iteration < parameters.maximumIterations; ++iteration)
+  HeldContacts held; // the contacts active at the last iteration
+  // Which obstacles each point was inside at the last iteration (at the start: as if it were
+  // inside them all, so that a point inside at the start goes out the nearest way) and where it was.
+  std::vector<std::vector<char>> wasInside(count);
+  std::vector<Points> previous(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    wasInside[m].assign(static_cast<size_t>(meshes[m].points.rows()) * obstacles, 1);
+    previous[m] = meshes[m].points;
+  }
+  bool settled = false;
+  int iteration = 0;
+  for (; iteration < parameters.maximumIterations && !settled; ++iteration)
   {
 #pragma omp parallel for schedule(dynamic, 1)
     for (int m = 0; m < static_cast<int>(count); ++m)
@@ -250,33 +411,24 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
     auto obstacle = [&](size_t o) -> const TriangleTree& {
       return o < bones.size() ? *bones[o].tree : *trees[o - bones.size()];
     };
-    bool settled = true;
-    std::vector<Points> next(count);
+
+    // The contacts: every point inside an obstacle, and those held before.
+    std::vector<Contact> contacts;
     for (size_t m = 0; m < count; ++m)
     {
-      const auto start = Clock::now();
-      SettleState& state = states[m];
-      const SurfaceEnergy& energy = *energies[m];
-      const SparseMatrix& normal = energy.NormalMatrix();
       const Points& x = meshes[m].points;
-      const Eigen::Index n = x.rows();
-      const double offset = 1e-3 * energy.Size();
-      std::vector<char> held(static_cast<size_t>(n), 0);
-      Points targets = Points::Zero(n, 3);
+      const double offset = parameters.contactOffset * energies[m]->Size();
+      std::vector<std::vector<Contact>> found(static_cast<size_t>(x.rows()));
+      std::vector<char> inNow(static_cast<size_t>(x.rows()) * obstacles, 0);
 #pragma omp parallel for schedule(dynamic, 256)
-      for (Eigen::Index i = 0; i < n; ++i)
+      for (Eigen::Index i = 0; i < x.rows(); ++i)
       {
-        if (!energy.Used()[i])
+        if (!energies[m]->Used()[i])
         {
           continue;
         }
-        Eigen::Vector3d p = x.row(i).transpose();
-        if (state.held[i])
-        {
-          // Where the point would be without its row.
-          p -= contact * (state.targets.row(i).transpose() - p) / normal.coeff(i, i);
-        }
-        for (size_t o = 0; o < bones.size() + count && !held[i]; ++o)
+        const Eigen::Vector3d p = x.row(i).transpose();
+        for (size_t o = 0; o < obstacles; ++o)
         {
           if ((o >= bones.size() && o - bones.size() == m) || InOverlap(restOverlap, m, o, i))
           {
@@ -284,87 +436,184 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
           }
           const TriangleTree& tree = obstacle(o);
           const bool inside = tree.InBounds(p) && tree.Inside(p);
-          if (!inside && !state.held[i])
+          const auto before = held.find({ m, i, o });
+          // Outside, a point closer than the offset breaks its constraint too.
+          const TriangleTree::Closest near = inside ? TriangleTree::Closest() : tree.ClosestPoint(p, offset);
+          if (!inside && near.triangle < 0 && before == held.end())
           {
             continue;
           }
-          const TriangleTree::Closest closest = tree.ClosestPoint(p);
-          if (!inside && closest.distance >= offset)
+          // A point that went in during the last iteration is held by the triangle it went in
+          // through: the nearest may be on the far side of a thin bone.
+          const size_t flag = static_cast<size_t>(i) * obstacles + o;
+          std::optional<TriangleTree::Hit> wayIn;
+          if (inside && !wasInside[m][flag])
           {
-            continue; // the energy pulls it away: the row lets go
+            wayIn = tree.FirstHit(previous[m].row(i).transpose(), p);
           }
-          const Eigen::Vector3d target = ContactTarget(tree, closest, p, inside, offset);
-          targets.row(i) = (o < bones.size() ? target : Eigen::Vector3d(p + share * (target - p))).transpose();
-          held[i] = 1;
-        }
-      }
-      const bool sameRows = held == state.held;
-      if (!sameRows || !state.factorised)
-      {
-        SparseMatrix system = normal;
-        for (Eigen::Index i = 0; i < n; ++i)
-        {
-          if (held[i])
+          inNow[flag] = inside;
+          std::vector<Eigen::Index> triangles{ wayIn ? wayIn->triangle
+              : near.triangle >= 0                   ? near.triangle
+                                                     : tree.ClosestPoint(p).triangle };
+          if (before != held.end())
           {
-            system.coeffRef(i, i) += contact;
+            triangles.insert(triangles.end(), before->second.begin(), before->second.end());
+          }
+          std::sort(triangles.begin(), triangles.end());
+          triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
+          for (const Eigen::Index t : triangles)
+          {
+            found[i].push_back(
+              Linearise(m, i, o, t, p, inside, inside || near.triangle >= 0, tree, bones.size(), offset));
           }
         }
-        state.solver.factorize(system);
-        if (state.solver.info() != Eigen::Success)
-        {
-          throw OfMuscle(ComputationError("the full-mesh system of a muscle could not be factorised"), m);
-        }
-        state.factorised = true;
       }
-      state.held = std::move(held);
-      state.targets = std::move(targets);
-      Points rhs = state.base;
-      for (Eigen::Index i = 0; i < n; ++i)
+      wasInside[m] = std::move(inNow);
+      for (auto& list : found)
       {
-        if (state.held[i])
+        for (Contact& c : list)
         {
-          rhs.row(i) += contact * state.targets.row(i);
+          contacts.push_back(std::move(c));
         }
       }
-      // The volume held by a Lagrange multiplier on its linearisation at x.
-      Points gradient;
-      const double volume = EnclosedVolume(x, meshes[m].triangles, &gradient);
-      const Eigen::MatrixXd g = gradient;
-      const Eigen::MatrixXd free = state.solver.solve(Eigen::MatrixXd(rhs));
-      const Eigen::MatrixXd along = state.solver.solve(g);
-      const double rate = (g.array() * along.array()).sum();
-      const double linear = volume + (g.array() * (free - x).array()).sum() - volumes[m];
-      next[m] = free - (rate > 0 ? linear / rate : 0.0) * along;
+    }
+
+    // The inverse's columns at every point a contact names, and the volume's direction.
+    std::vector<std::vector<Eigen::Index>> needed(count);
+    for (const Contact& c : contacts)
+    {
+      for (const Term& t : c.terms)
+      {
+        needed[t.muscle].push_back(t.point);
+      }
+    }
+    const Eigen::Index nc = static_cast<Eigen::Index>(contacts.size());
+    const Eigen::Index size = nc + static_cast<Eigen::Index>(count);
+    std::vector<Points> gradients(count), along(count);
+    Eigen::VectorXd rhs(size);
+    std::vector<double> volumeNow(count);
+    for (size_t m = 0; m < count; ++m)
+    {
+      energies[m]->Prepare(needed[m]);
+      volumeNow[m] = EnclosedVolume(meshes[m].points, meshes[m].triangles, &gradients[m]);
+      along[m] = energies[m]->Solve(gradients[m]);
+      // g . x_new = V - V(x) + g . x, the volume's linearisation at x.
+      rhs(nc + static_cast<Eigen::Index>(m)) = volumes[m] - volumeNow[m] +
+        (gradients[m].array() * meshes[m].points.array()).sum() - (gradients[m].array() * free[m].array()).sum();
+    }
+    for (Contact& c : contacts)
+    {
+      for (Term& t : c.terms)
+      {
+        t.column = &energies[t.muscle]->InverseColumn(t.point);
+      }
+    }
+    auto inverse = [](const Term& a, const Term& b) {
+      return a.muscle == b.muscle ? (*a.column)(b.point) : 0.0;
+    };
+    Eigen::MatrixXd system = Eigen::MatrixXd::Zero(size, size);
+    for (Eigen::Index j = 0; j < nc; ++j)
+    {
+      const Contact& a = contacts[static_cast<size_t>(j)];
+      double value = 0;
+      for (const Term& t : a.terms)
+      {
+        value += t.coefficient * a.normal.dot(free[t.muscle].row(t.point).transpose());
+        system(j, nc + static_cast<Eigen::Index>(t.muscle)) +=
+          t.coefficient * a.normal.dot(along[t.muscle].row(t.point).transpose());
+      }
+      rhs(j) = a.target - value;
+      for (Eigen::Index l = 0; l <= j; ++l)
+      {
+        const Contact& b = contacts[static_cast<size_t>(l)];
+        double sum = 0;
+        for (const Term& s : a.terms)
+        {
+          for (const Term& t : b.terms)
+          {
+            sum += s.coefficient * t.coefficient * inverse(s, t);
+          }
+        }
+        system(j, l) = system(l, j) = sum * a.normal.dot(b.normal);
+      }
+    }
+    for (size_t m = 0; m < count; ++m)
+    {
+      const Eigen::Index v = nc + static_cast<Eigen::Index>(m);
+      system.row(v).head(nc) = system.col(v).head(nc).transpose();
+      system(v, v) = (gradients[m].array() * along[m].array()).sum();
+    }
+
+    // The active set: the multipliers of the active contacts and volumes, the inactive
+    // contacts' points where they would go; a contact whose multiplier pulls lets go, one whose
+    // point would be inside joins.
+    std::vector<char> active(static_cast<size_t>(size), 1);
+    for (Eigen::Index j = 0; j < nc; ++j)
+    {
+      const Contact& c = contacts[static_cast<size_t>(j)];
+      const auto before = held.find({ c.muscle, c.point, c.obstacle });
+      active[j] = c.violated ||
+        (before != held.end() &&
+          std::find(before->second.begin(), before->second.end(), c.triangle) != before->second.end());
+    }
+    std::vector<double> slack(static_cast<size_t>(nc));
+    for (Eigen::Index j = 0; j < nc; ++j)
+    {
+      slack[j] = 1e-3 * parameters.tolerance * energies[contacts[static_cast<size_t>(j)].muscle]->Size();
+    }
+    const Eigen::VectorXd multipliers = SolveActiveSet(system, rhs, slack, active);
+
+    // The new points.
+    HeldContacts nowHeld;
+    std::vector<Points> next(count);
+    for (size_t m = 0; m < count; ++m)
+    {
+      next[m] = free[m] + multipliers(nc + static_cast<Eigen::Index>(m)) * along[m];
+    }
+    std::vector<std::int64_t> inContact(count, 0);
+    for (Eigen::Index j = 0; j < nc; ++j)
+    {
+      if (!active[j])
+      {
+        continue;
+      }
+      const Contact& c = contacts[static_cast<size_t>(j)];
+      nowHeld[{ c.muscle, c.point, c.obstacle }].push_back(c.triangle);
+      ++inContact[c.muscle];
+      for (const Term& t : c.terms)
+      {
+        next[t.muscle] += (multipliers(j) * t.coefficient) * *t.column * c.normal.transpose();
+      }
+    }
+    for (size_t m = 0; m < count; ++m)
+    {
       if (!next[m].allFinite())
       {
         throw OfMuscle(ComputationError("the full-mesh deformation of a muscle diverged"), m);
       }
-      const double change = (next[m] - x).cwiseAbs().maxCoeff();
-      reports[m].iterations = iteration + 1;
-      reports[m].pointsInContact = std::count(state.held.begin(), state.held.end(), 1);
-      if (change > parameters.tolerance * energy.Size() || !sameRows ||
-        std::abs(volume - volumes[m]) > 1e-9 * std::abs(volumes[m]))
+    }
+    settled = nowHeld == held;
+    for (size_t m = 0; m < count; ++m)
+    {
+      const double change = (next[m] - meshes[m].points).cwiseAbs().maxCoeff();
+      if (change > parameters.tolerance * energies[m]->Size() ||
+        std::abs(volumeNow[m] - volumes[m]) > 1e-9 * std::abs(volumes[m]))
       {
         settled = false;
       }
-      state.seconds += seconds(start);
-    }
-    for (size_t m = 0; m < count; ++m)
-    {
+      previous[m] = std::move(meshes[m].points);
       meshes[m].points = std::move(next[m]);
+      reports[m].pointsInContact = inContact[m];
     }
-    if (settled)
-    {
-      for (SettleReport& report : reports)
-      {
-        report.converged = true;
-      }
-      break;
-    }
+    held = std::move(nowHeld);
   }
-  for (size_t m = 0; m < count; ++m)
+  // The muscles are settled together: the time is shared.
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  for (SettleReport& report : reports)
   {
-    reports[m].seconds = states[m].seconds;
+    report.iterations = iteration;
+    report.converged = settled;
+    report.seconds = seconds / static_cast<double>(std::max<size_t>(1, count));
   }
   return reports;
 }

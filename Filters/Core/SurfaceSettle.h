@@ -4,29 +4,30 @@
 // coordinates, action-line rows, volume) with contact, posed on every point
 // of the full mesh and converged there. The hull-based pass gives the
 // starting guess; the answer is the energy's minimum, so it does not depend on
-// the hull's size or on the order of its collapses. Experimental and off by
-// default (InterpolationParameters::settleOnSurface): without contact it
-// converges in a few iterations; with contact it does not yet (a patch in
-// contact slides by small steps) and costs a factorisation per change of the
-// contacts.
+// the hull's size or on the order of its collapses. Contact is a constraint,
+// not a penalty: a point may not go inside a bone or another muscle, each
+// linearised as a half-space at its nearest surface point, and the constrained
+// minimum is found by an active set on the constraints' multipliers with the
+// energy's matrix factorised once per muscle (for a whole motion). Experimental
+// and off by default (InterpolationParameters::settleOnSurface).
 #pragma once
 
 #include "MuscleDeformer.h"
 #include "StaticIntersections.h"
 #include "VolumeConstrainedSolver.h"
 
+#include <Eigen/SparseCholesky>
+
+#include <unordered_map>
 #include <vector>
 
 namespace md
 {
 struct SettleParameters
 {
-  /// Contact rows: a point inside a bone (or another muscle) is pulled just
-  /// outside by a row of this weight (a point's Laplacian row weighs about 1;
-  /// see SurfaceEnergy).
-  double contactWeight = 4;
-  /// Of an overlap between two muscles, the share each side moves out.
-  double muscleShare = 0.5;
+  /// A point in contact is held this fraction of its muscle's size outside
+  /// the obstacle, so that the surfaces do not touch.
+  double contactOffset = 1e-3;
   /// Rows pulling every point to where its nearest action-line segment's
   /// motion takes it, relative to the shape rows: they fix the near-null
   /// modes of the other rows (see DeformationParameters::followWeight).
@@ -37,9 +38,11 @@ struct SettleParameters
   /// default size): the energy is then comparable with the paper's, and it
   /// depends on the muscle's own mesh only.
   double balancePoints = 250;
-  int maximumIterations = 100;
+  /// Linearisations of the volume and of the obstacles' surfaces.
+  int maximumIterations = 50;
   /// Converged when no point moves more than this fraction of the muscle's
-  /// size in an iteration and the volume is within 1e-9 of its target.
+  /// size in an iteration, the contacts are those of the iteration before,
+  /// and the volume is within 1e-9 of its target.
   double tolerance = 1e-7;
 };
 
@@ -49,7 +52,8 @@ struct SettleParameters
 /// action-line sample inside the rest muscle written as a fixed combination of
 /// the surface points where chords through it along the three axes meet the
 /// surface: a sparse row that reproduces the sample exactly in the rest pose),
-/// the follow rows, and their normal matrix.
+/// the follow rows, their normal matrix and its factorisation. Not safe to
+/// share between threads (its cache of the inverse's columns).
 class SurfaceEnergy
 {
 public:
@@ -63,6 +67,14 @@ public:
   Points RightHandSide(const std::vector<MatchedLine>& lines) const;
   /// Rows^T Rows.
   const SparseMatrix& NormalMatrix() const { return this->Normal; }
+
+  /// The normal matrix's inverse applied to every column of `rhs`.
+  Points Solve(const Points& rhs) const;
+  /// Column `point` of the normal matrix's inverse (how every point moves
+  /// when a unit force acts on `point`), computed once and kept; `Prepare`
+  /// computes the missing ones of `points` in parallel.
+  void Prepare(const std::vector<Eigen::Index>& points) const;
+  const Eigen::VectorXd& InverseColumn(Eigen::Index point) const;
 
   const std::vector<char>& Used() const { return this->PointUsed; }
   Eigen::Index SampleCount() const { return static_cast<Eigen::Index>(this->SampleIndex.size()); }
@@ -79,23 +91,28 @@ private:
   std::vector<Eigen::Index> SampleIndex; // samples (SampleMatchedLines order) inside the rest muscle
   SparseMatrix Rows;                     // shape, action-line and follow rows stacked
   SparseMatrix Normal;                   // Rows^T Rows
+  Eigen::SimplicialLDLT<SparseMatrix> Factor;
+  mutable std::unordered_map<Eigen::Index, Eigen::VectorXd> Columns;
 };
 
 struct SettleReport
 {
   int iterations = 0;
   bool converged = false;
-  std::int64_t pointsInContact = 0; ///< held by contact rows at the minimum
+  std::int64_t pointsInContact = 0; ///< held by a contact at the minimum
   double seconds = 0;
 };
 
 /// Settles every muscle of `meshes` (their points in, the settled points
 /// out) to the minimum of its full-mesh energy for the pose `lines[m]`
-/// describes, holding `volumes[m]`, with contact rows against the bones
-/// (`bones`, in that pose) and against each other (each moving `muscleShare`
-/// of an overlap). Overlap the rest pose has (`restOverlap`, OverlapMasks
+/// describes, holding `volumes[m]`, none of its points inside a bone
+/// (`bones`, in that pose) or another muscle: the muscles are settled
+/// together, and where two are in contact each gives way as its own
+/// stiffness says. Overlap the rest pose has (`restOverlap`, OverlapMasks
 /// order) is left alone. The starting points decide only which side of an
 /// obstacle a point is on. `energies[m]` belong to the muscles' rest poses.
+/// A point inside an obstacle at the start goes out the nearest way; one that
+/// goes in during the settle goes back out the way it came in.
 std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
   const std::vector<const SurfaceEnergy*>& energies, const std::vector<std::vector<MatchedLine>>& lines,
   const std::vector<double>& volumes, const std::vector<FixedObstacle>& bones, const OverlapMasks* restOverlap,

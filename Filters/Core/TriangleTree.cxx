@@ -312,10 +312,10 @@ bool TriangleTree::Inside(const Eigen::Vector3d& p) const
   return 2 * votesInside > votes;
 }
 
-TriangleTree::Closest TriangleTree::ClosestPoint(const Eigen::Vector3d& p) const
+TriangleTree::Closest TriangleTree::ClosestPoint(const Eigen::Vector3d& p, double within) const
 {
   Closest best;
-  double bestSquared = std::numeric_limits<double>::max();
+  double bestSquared = within < std::numeric_limits<double>::max() ? within * within : within;
   NodeStack stack;
   stack.Push(0);
   while (!stack.Empty())

