@@ -195,8 +195,13 @@ void SurfaceEnergy::Prepare(const std::vector<Eigen::Index>& points) const
 
 const Eigen::VectorXd& SurfaceEnergy::InverseColumn(Eigen::Index point) const
 {
-  this->Prepare({ point });
-  return this->Columns.at(point);
+  auto column = this->Columns.find(point);
+  if (column == this->Columns.end())
+  {
+    this->Prepare({ point });
+    column = this->Columns.find(point);
+  }
+  return column->second;
 }
 
 Points SurfaceEnergy::RightHandSide(const std::vector<MatchedLine>& lines) const
@@ -290,13 +295,12 @@ Contact Linearise(size_t m, Eigen::Index i, size_t o, Eigen::Index triangle, con
   }
   return c;
 }
-}
 
 /// The multipliers of the dual system `system` y = `rhs` whose first slack.size() rows are
 /// contacts (inequalities: a multiplier pushes or is zero) and the rest equalities (the
-/// volumes), by a primal-dual active set from `active` (left as found): an active contact whose
-/// multiplier pulls lets go; an inactive one joins when its residual (a_j . x - target at
-/// the new points) is below -slack[j].
+/// volumes), by a primal-dual active set starting from `active` (and left as the final set): an
+/// active contact whose multiplier pulls lets go; an inactive one joins when its residual
+/// (a_j . x - target at the new points) is below -slack[j].
 Eigen::VectorXd SolveActiveSet(const Eigen::MatrixXd& system, const Eigen::VectorXd& rhs,
   const std::vector<double>& slack, std::vector<char>& active)
 {
@@ -359,6 +363,87 @@ Eigen::VectorXd SolveActiveSet(const Eigen::MatrixXd& system, const Eigen::Vecto
   return multipliers;
 }
 
+/// Every contact to consider at the points `meshes` hold: of each point inside an obstacle, or
+/// outside it nearer than the offset, or `held` at the last iteration, one per triangle (the
+/// triangle it went in through since `previous`, or its nearest, and those it was held by).
+/// `wasInside` (per muscle, point * obstacles + obstacle) is read and updated to the points now.
+std::vector<Contact> FindContacts(const std::vector<TriangleMesh>& meshes,
+  const std::vector<const SurfaceEnergy*>& energies, const std::vector<FixedObstacle>& bones,
+  const std::vector<std::unique_ptr<TriangleTree>>& trees, const OverlapMasks* restOverlap, const HeldContacts& held,
+  const std::vector<Points>& previous, const SettleParameters& parameters, std::vector<std::vector<char>>& wasInside)
+{
+  const size_t count = meshes.size(), obstacles = bones.size() + count;
+  auto obstacle = [&](size_t o) -> const TriangleTree& {
+    return o < bones.size() ? *bones[o].tree : *trees[o - bones.size()];
+  };
+  std::vector<Contact> contacts;
+  for (size_t m = 0; m < count; ++m)
+  {
+    const Points& x = meshes[m].points;
+    const double offset = parameters.contactOffset * energies[m]->Size();
+    std::vector<std::vector<Contact>> found(static_cast<size_t>(x.rows()));
+    std::vector<char> inNow(static_cast<size_t>(x.rows()) * obstacles, 0);
+#pragma omp parallel for schedule(dynamic, 256)
+    for (Eigen::Index i = 0; i < x.rows(); ++i)
+    {
+      if (!energies[m]->Used()[i])
+      {
+        continue;
+      }
+      const Eigen::Vector3d p = x.row(i).transpose();
+      for (size_t o = 0; o < obstacles; ++o)
+      {
+        if ((o >= bones.size() && o - bones.size() == m) || InOverlap(restOverlap, m, o, i))
+        {
+          continue;
+        }
+        const TriangleTree& tree = obstacle(o);
+        const bool inside = tree.InBounds(p) && tree.Inside(p);
+        const auto before = held.find({ m, i, o });
+        // Outside, a point closer than the offset breaks its constraint too.
+        const TriangleTree::Closest near = inside ? TriangleTree::Closest() : tree.ClosestPoint(p, offset);
+        if (!inside && near.triangle < 0 && before == held.end())
+        {
+          continue;
+        }
+        // A point that went in during the last iteration is held by the triangle it went in
+        // through: the nearest may be on the far side of a thin bone.
+        const size_t flag = static_cast<size_t>(i) * obstacles + o;
+        std::optional<TriangleTree::Hit> wayIn;
+        if (inside && !wasInside[m][flag])
+        {
+          wayIn = tree.FirstHit(previous[m].row(i).transpose(), p);
+        }
+        inNow[flag] = inside;
+        std::vector<Eigen::Index> triangles{ wayIn ? wayIn->triangle
+            : near.triangle >= 0                   ? near.triangle
+                                                   : tree.ClosestPoint(p).triangle };
+        if (before != held.end())
+        {
+          triangles.insert(triangles.end(), before->second.begin(), before->second.end());
+        }
+        std::sort(triangles.begin(), triangles.end());
+        triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
+        for (const Eigen::Index t : triangles)
+        {
+          found[i].push_back(
+            Linearise(m, i, o, t, p, inside, inside || near.triangle >= 0, tree, bones.size(), offset));
+        }
+      }
+    }
+    wasInside[m] = std::move(inNow);
+    for (auto& list : found)
+    {
+      for (Contact& c : list)
+      {
+        contacts.push_back(std::move(c));
+      }
+    }
+  }
+  return contacts;
+}
+}
+
 std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
   const std::vector<const SurfaceEnergy*>& energies, const std::vector<std::vector<MatchedLine>>& lines,
   const std::vector<double>& volumes, const std::vector<FixedObstacle>& bones, const OverlapMasks* restOverlap,
@@ -408,75 +493,9 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
         trees[m] = std::make_unique<TriangleTree>(meshes[m]);
       }
     }
-    auto obstacle = [&](size_t o) -> const TriangleTree& {
-      return o < bones.size() ? *bones[o].tree : *trees[o - bones.size()];
-    };
-
-    // The contacts: every point inside an obstacle, and those held before.
-    std::vector<Contact> contacts;
-    for (size_t m = 0; m < count; ++m)
-    {
-      const Points& x = meshes[m].points;
-      const double offset = parameters.contactOffset * energies[m]->Size();
-      std::vector<std::vector<Contact>> found(static_cast<size_t>(x.rows()));
-      std::vector<char> inNow(static_cast<size_t>(x.rows()) * obstacles, 0);
-#pragma omp parallel for schedule(dynamic, 256)
-      for (Eigen::Index i = 0; i < x.rows(); ++i)
-      {
-        if (!energies[m]->Used()[i])
-        {
-          continue;
-        }
-        const Eigen::Vector3d p = x.row(i).transpose();
-        for (size_t o = 0; o < obstacles; ++o)
-        {
-          if ((o >= bones.size() && o - bones.size() == m) || InOverlap(restOverlap, m, o, i))
-          {
-            continue;
-          }
-          const TriangleTree& tree = obstacle(o);
-          const bool inside = tree.InBounds(p) && tree.Inside(p);
-          const auto before = held.find({ m, i, o });
-          // Outside, a point closer than the offset breaks its constraint too.
-          const TriangleTree::Closest near = inside ? TriangleTree::Closest() : tree.ClosestPoint(p, offset);
-          if (!inside && near.triangle < 0 && before == held.end())
-          {
-            continue;
-          }
-          // A point that went in during the last iteration is held by the triangle it went in
-          // through: the nearest may be on the far side of a thin bone.
-          const size_t flag = static_cast<size_t>(i) * obstacles + o;
-          std::optional<TriangleTree::Hit> wayIn;
-          if (inside && !wasInside[m][flag])
-          {
-            wayIn = tree.FirstHit(previous[m].row(i).transpose(), p);
-          }
-          inNow[flag] = inside;
-          std::vector<Eigen::Index> triangles{ wayIn ? wayIn->triangle
-              : near.triangle >= 0                   ? near.triangle
-                                                     : tree.ClosestPoint(p).triangle };
-          if (before != held.end())
-          {
-            triangles.insert(triangles.end(), before->second.begin(), before->second.end());
-          }
-          std::sort(triangles.begin(), triangles.end());
-          triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
-          for (const Eigen::Index t : triangles)
-          {
-            found[i].push_back(
-              Linearise(m, i, o, t, p, inside, inside || near.triangle >= 0, tree, bones.size(), offset));
-          }
-        }
-      }
-      wasInside[m] = std::move(inNow);
-      for (auto& list : found)
-      {
-        for (Contact& c : list)
-        {
-          contacts.push_back(std::move(c));
-        }
-      }
-    }
+    // The contacts: every point inside an obstacle or nearer than the offset, and those held before.
+    std::vector<Contact> contacts =
+      FindContacts(meshes, energies, bones, trees, restOverlap, held, previous, parameters, wasInside);
 
     // The inverse's columns at every point a contact names, and the volume's direction.
     std::vector<std::vector<Eigen::Index>> needed(count);
