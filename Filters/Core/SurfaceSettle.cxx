@@ -114,6 +114,7 @@ SurfaceEnergy::SurfaceEnergy(
     if (!row.empty())
     {
       this->SampleIndex.push_back(s);
+      this->SampleClearance.push_back(tree.ClosestPoint(p).distance);
       sampleRows.push_back(std::move(row));
     }
   }
@@ -204,7 +205,35 @@ const Eigen::VectorXd& SurfaceEnergy::InverseColumn(Eigen::Index point) const
   return column->second;
 }
 
-Points SurfaceEnergy::RightHandSide(const std::vector<MatchedLine>& lines) const
+namespace
+{
+/// Where an action-line sample `p` pulls the muscle when the line runs through a bone or
+/// nearer to it than `clearance` (the sample's depth inside its rest muscle): to the bone's
+/// nearest surface point, `clearance` out along the outward direction, so that the muscle
+/// around the sample fits outside the bone. Otherwise `p` itself; the two agree where the
+/// sample is `clearance` from the bone, so the target moves continuously with the line.
+Eigen::Vector3d OutsideBones(Eigen::Vector3d p, double clearance, const std::vector<FixedObstacle>& bones)
+{
+  for (const FixedObstacle& bone : bones)
+  {
+    const TriangleTree& tree = *bone.tree;
+    const bool inside = tree.InBounds(p) && tree.Inside(p);
+    const TriangleTree::Closest near = inside ? tree.ClosestPoint(p) : tree.ClosestPoint(p, clearance);
+    if (near.triangle < 0)
+    {
+      continue;
+    }
+    const Eigen::Vector3d away = inside ? Eigen::Vector3d(near.point - p) : Eigen::Vector3d(p - near.point);
+    const double length = away.norm();
+    const Eigen::Vector3d outwards = length > 0 ? Eigen::Vector3d(away / length) : tree.Normal(near.triangle);
+    p = near.point + clearance * outwards;
+  }
+  return p;
+}
+}
+
+Points SurfaceEnergy::RightHandSide(
+  const std::vector<MatchedLine>& lines, const std::vector<FixedObstacle>& bones) const
 {
   const Eigen::Index n = this->RestPoints.rows();
   Points targets(this->Rows.rows(), 3);
@@ -220,7 +249,9 @@ Points SurfaceEnergy::RightHandSide(const std::vector<MatchedLine>& lines) const
   SampleMatchedLines(lines, this->SamplesPerSegment, restSamples, currentSamples);
   for (Eigen::Index s = 0; s < this->SampleCount(); ++s)
   {
-    targets.row(n + s) = currentSamples.row(this->SampleIndex[static_cast<size_t>(s)]);
+    const size_t k = static_cast<size_t>(s);
+    targets.row(n + s) =
+      OutsideBones(currentSamples.row(this->SampleIndex[k]).transpose(), this->SampleClearance[k], bones).transpose();
   }
   return this->Rows.transpose() * targets;
 }
@@ -464,7 +495,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
   std::vector<Points> free(count); // the minimum without contact and volume
   for (size_t m = 0; m < count; ++m)
   {
-    free[m] = energies[m]->Solve(energies[m]->RightHandSide(lines[m]));
+    free[m] = energies[m]->Solve(energies[m]->RightHandSide(lines[m], bones));
   }
   std::vector<std::unique_ptr<TriangleTree>> trees(count);
   HeldContacts held; // the contacts active at the last iteration

@@ -63,8 +63,14 @@ public:
   SurfaceEnergy(const TriangleMesh& rest, const std::vector<Points>& restLines, const SettleParameters& parameters);
 
   /// Rows^T targets for the pose that `lines` (rest -> current) describe:
-  /// the right-hand side of the normal equations without contact.
-  Points RightHandSide(const std::vector<MatchedLine>& lines) const;
+  /// the right-hand side of the normal equations without contact. Where a
+  /// line runs through one of `bones` (in that pose), or so near it that the
+  /// muscle around it could not fit, its samples pull the muscle to the
+  /// nearest place outside the bone where it fits (each sample as far out as
+  /// it lies deep inside the rest muscle), not into the bone: the contact
+  /// would otherwise have to fight the lines, and the muscle wraps round the
+  /// bone's end instead of lying against it.
+  Points RightHandSide(const std::vector<MatchedLine>& lines, const std::vector<FixedObstacle>& bones = {}) const;
   /// Rows^T Rows.
   const SparseMatrix& NormalMatrix() const { return this->Normal; }
 
@@ -89,6 +95,7 @@ private:
   double ShapeWeight = 1;
   double FollowWeight = 0;
   std::vector<Eigen::Index> SampleIndex; // samples (SampleMatchedLines order) inside the rest muscle
+  std::vector<double> SampleClearance;   // their distances from the rest surface
   SparseMatrix Rows;                     // shape, action-line and follow rows stacked
   SparseMatrix Normal;                   // Rows^T Rows
   Eigen::SimplicialLDLT<SparseMatrix> Factor;
