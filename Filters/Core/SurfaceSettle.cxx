@@ -207,6 +207,16 @@ const Eigen::VectorXd& SurfaceEnergy::InverseColumn(Eigen::Index point) const
 
 namespace
 {
+/// The direction out of an obstacle at `q`, its surface point (on `triangle`) nearest to `p`:
+/// from q towards p when p is outside, from p towards q when p is inside, and the triangle's
+/// normal when p lies on it.
+Eigen::Vector3d Outwards(
+  const Eigen::Vector3d& p, const Eigen::Vector3d& q, bool inside, const TriangleTree& tree, Eigen::Index triangle)
+{
+  const double distance = (p - q).norm();
+  return distance > 0 ? Eigen::Vector3d((inside ? -1.0 : 1.0) * (p - q) / distance) : tree.Normal(triangle);
+}
+
 /// Where an action-line sample `p` pulls the muscle when the line runs through a bone or
 /// nearer to it than `clearance` (the sample's depth inside its rest muscle): to the bone's
 /// nearest surface point, `clearance` out along the outward direction, so that the muscle
@@ -223,10 +233,7 @@ Eigen::Vector3d OutsideBones(Eigen::Vector3d p, double clearance, const std::vec
     {
       continue;
     }
-    const Eigen::Vector3d away = inside ? Eigen::Vector3d(near.point - p) : Eigen::Vector3d(p - near.point);
-    const double length = away.norm();
-    const Eigen::Vector3d outwards = length > 0 ? Eigen::Vector3d(away / length) : tree.Normal(near.triangle);
-    p = near.point + clearance * outwards;
+    p = near.point + clearance * Outwards(p, near.point, inside, tree, near.triangle);
   }
   return p;
 }
@@ -302,14 +309,13 @@ Contact Linearise(size_t m, Eigen::Index i, size_t o, Eigen::Index triangle, con
     return Eigen::Vector3d(mesh.points.row(mesh.triangles(triangle, k)).transpose());
   };
   const Eigen::Vector3d q = ClosestPointOnTriangle(p, corner(0), corner(1), corner(2));
-  const double distance = (p - q).norm();
   Contact c;
   c.muscle = m;
   c.point = i;
   c.obstacle = o;
   c.triangle = triangle;
   c.violated = violated;
-  c.normal = distance > 0 ? Eigen::Vector3d((inside ? -1.0 : 1.0) * (p - q) / distance) : tree.Normal(triangle);
+  c.normal = Outwards(p, q, inside, tree, triangle);
   c.terms.push_back({ m, i, 1.0 });
   if (o < bones)
   {
