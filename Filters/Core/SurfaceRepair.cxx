@@ -494,9 +494,10 @@ std::vector<std::int64_t> ClusterNearPoints(const Points& points, const Triangle
 
 /// Merges points closer than `tolerance` (`representative`: each input point's surviving twin, the
 /// lowest index of its cluster; the merged points at other coordinates are added to
-/// report.pointsToEnclose) and drops degenerate, duplicate and back-to-back triangles.
-std::vector<Triangle> MergeAndDeduplicate(
-  const TriangleMesh& surface, double tolerance, std::vector<std::int64_t>& representative, RepairReport& report)
+/// report.pointsToEnclose) and drops degenerate and duplicate triangles, and back-to-back ones
+/// unless `keepFins`.
+std::vector<Triangle> MergeAndDeduplicate(const TriangleMesh& surface, double tolerance,
+  std::vector<std::int64_t>& representative, RepairReport& report, bool keepFins = false)
 {
   const auto pointCount = static_cast<std::int64_t>(surface.points.rows());
   representative = ClusterNearPoints(surface.points, surface.triangles, tolerance);
@@ -550,6 +551,11 @@ std::vector<Triangle> MergeAndDeduplicate(
       if (sameWay)
       {
         ++report.duplicateTrianglesRemoved;
+      }
+      else if (keepFins)
+      {
+        kept.push_back(tri);
+        fin.push_back(false);
       }
       else if (!fin[found->second])
       {
@@ -968,5 +974,21 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
     throw InputError("the surface encloses no volume (it is flat or degenerate)");
   }
   return out;
+}
+
+Triangles WeldedTriangles(const TriangleMesh& surface, std::vector<std::int64_t>& representative)
+{
+  RepairReport unused;
+  const double tolerance = kMergeTolerance * BoxDiagonal(UsedPoints(surface));
+  const std::vector<Triangle> kept = MergeAndDeduplicate(surface, tolerance, representative, unused, true);
+  Triangles triangles(static_cast<Eigen::Index>(kept.size()), 3);
+  for (size_t t = 0; t < kept.size(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      triangles(static_cast<Eigen::Index>(t), k) = kept[t][k];
+    }
+  }
+  return triangles;
 }
 }

@@ -6,6 +6,7 @@
 #include "MeshTypes.h"
 
 #include <string>
+#include <vector>
 
 namespace md
 {
@@ -54,4 +55,12 @@ struct RepairReport
 /// open surface (boundary edges), fewer than 4 triangles, non-finite
 /// coordinates, a surface of no volume.
 TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& report);
+
+/// The triangles of `surface` with its points closer than the repair's merge tolerance (1e-5 of
+/// its size) welded into one (`representative`: each point's surviving twin, the lowest index of
+/// its cluster) and the degenerate and duplicate triangles that leaves dropped: the surface on
+/// its own points as RepairClosedSurface first sees it (back-to-back pairs, fins of no
+/// thickness, are kept), so that a scan's exact and split duplicate points give the same
+/// triangles.
+Triangles WeldedTriangles(const TriangleMesh& surface, std::vector<std::int64_t>& representative);
 }

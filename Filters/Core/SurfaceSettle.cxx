@@ -3,6 +3,7 @@
 
 #include "MeshChecks.h"
 #include "NearestSegment.h"
+#include "SurfaceRepair.h"
 #include "TriangleTree.h"
 #include "VolumeConstrainedSolver.h"
 
@@ -85,8 +86,12 @@ SurfaceEnergy::SurfaceEnergy(
   , SamplesPerSegment(std::max(1, parameters.samplesPerSegment))
 {
   const Eigen::Index n = rest.points.rows();
-  this->PointUsed = UsedMask(rest);
-  this->Span = BoxDiagonal(UsedPoints(rest));
+  std::vector<std::int64_t> representative;
+  const TriangleMesh welded{ rest.points, WeldedTriangles(rest, representative) };
+  this->Welded = welded.triangles;
+  this->PointUsed = UsedMask(welded);
+  this->Span = BoxDiagonal(UsedPoints(welded));
+  this->FindLeaders(rest, representative);
   const Eigen::Index used = std::count(this->PointUsed.begin(), this->PointUsed.end(), 1);
   if (used == 0)
   {
@@ -101,7 +106,7 @@ SurfaceEnergy::SurfaceEnergy(
   }
   Points samples, unused;
   SampleMatchedLines(still, this->SamplesPerSegment, samples, unused);
-  const TriangleTree tree(rest);
+  const TriangleTree tree(welded);
   std::vector<RowEntries> sampleRows;
   for (Eigen::Index s = 0; s < samples.rows(); ++s)
   {
@@ -123,7 +128,7 @@ SurfaceEnergy::SurfaceEnergy(
     throw InputError("none of its action-line samples lies inside the muscle");
   }
 
-  const SparseMatrix laplacian = CotangentLaplacian(rest);
+  const SparseMatrix laplacian = CotangentLaplacian(welded);
   this->Delta = laplacian * rest.points;
   const double balance = std::max(1.0, parameters.balancePoints);
   this->ShapeWeight = std::sqrt(static_cast<double>(used) / balance);
@@ -162,6 +167,74 @@ SurfaceEnergy::SurfaceEnergy(
   if (this->Factor.info() != Eigen::Success)
   {
     throw ComputationError("its full-mesh system could not be factorised");
+  }
+}
+
+void SurfaceEnergy::FindLeaders(const TriangleMesh& rest, const std::vector<std::int64_t>& representative)
+{
+  const Eigen::Index n = rest.points.rows();
+  const std::vector<char> usedBefore = UsedMask(rest);
+  for (Eigen::Index i = 0; i < n; ++i)
+  {
+    if (this->PointUsed[i] || !usedBefore[i])
+    {
+      continue;
+    }
+    const Eigen::Index twin = representative[static_cast<size_t>(i)];
+    if (this->PointUsed[twin])
+    {
+      this->Leaders.push_back({ i, { twin } });
+    }
+    else
+    {
+      this->Leaders.push_back({ i, {} });
+    }
+  }
+  // A point that only degenerate triangles used follows the welded points of its triangles.
+  std::unordered_map<Eigen::Index, size_t> orphan;
+  for (size_t k = 0; k < this->Leaders.size(); ++k)
+  {
+    if (this->Leaders[k].second.empty())
+    {
+      orphan.emplace(this->Leaders[k].first, k);
+    }
+  }
+  for (Eigen::Index t = 0; t < rest.triangles.rows() && !orphan.empty(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      const auto found = orphan.find(rest.triangles(t, k));
+      if (found == orphan.end())
+      {
+        continue;
+      }
+      for (int l = 1; l < 3; ++l)
+      {
+        const Eigen::Index other = representative[static_cast<size_t>(rest.triangles(t, (k + l) % 3))];
+        if (this->PointUsed[other])
+        {
+          this->Leaders[found->second].second.push_back(other);
+        }
+      }
+    }
+  }
+  for (auto& [point, leaders] : this->Leaders)
+  {
+    std::sort(leaders.begin(), leaders.end());
+    leaders.erase(std::unique(leaders.begin(), leaders.end()), leaders.end());
+  }
+}
+
+void SurfaceEnergy::CarryToUnwelded(const Points& start, Points& settled) const
+{
+  for (const auto& [point, leaders] : this->Leaders)
+  {
+    Eigen::RowVector3d moved = Eigen::RowVector3d::Zero();
+    for (const Eigen::Index leader : leaders)
+    {
+      moved += settled.row(leader) - start.row(leader);
+    }
+    settled.row(point) = start.row(point) + moved / static_cast<double>(std::max<size_t>(1, leaders.size()));
   }
 }
 
@@ -481,7 +554,7 @@ std::vector<Contact> FindContacts(const std::vector<TriangleMesh>& meshes,
 }
 }
 
-std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
+std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   const std::vector<const SurfaceEnergy*>& energies, const std::vector<std::vector<MatchedLine>>& lines,
   const std::vector<double>& volumes, const std::vector<FixedObstacle>& bones, const OverlapMasks* restOverlap,
   const SettleParameters& parameters)
@@ -495,7 +568,18 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
   // joins when its point would be inside (a primal-dual active set). S needs K^-1 only at the
   // points in contact: columns of the inverse, kept by the energy for the whole motion.
   const auto start = Clock::now();
-  const size_t count = meshes.size();
+  const size_t count = muscles.size();
+  // Settled on the welded surfaces (the energies' triangles), written back at the end. The
+  // volume each must hold is the muscle's less the difference the welding makes at the start
+  // (nothing for exact duplicates, rounding for split ones).
+  std::vector<TriangleMesh> meshes(count);
+  std::vector<double> targets(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    meshes[m] = { muscles[m].points, energies[m]->Surface() };
+    targets[m] = volumes[m] - EnclosedVolume(muscles[m].points, muscles[m].triangles) +
+      EnclosedVolume(meshes[m].points, meshes[m].triangles);
+  }
   const size_t obstacles = bones.size() + count;
   std::vector<SettleReport> reports(count);
   std::vector<Points> free(count); // the minimum without contact and volume
@@ -554,7 +638,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
       volumeNow[m] = EnclosedVolume(meshes[m].points, meshes[m].triangles, &gradients[m]);
       along[m] = energies[m]->Solve(gradients[m]);
       // g . x_new = V - V(x) + g . x, the volume's linearisation at x.
-      rhs(nc + static_cast<Eigen::Index>(m)) = volumes[m] - volumeNow[m] +
+      rhs(nc + static_cast<Eigen::Index>(m)) = targets[m] - volumeNow[m] +
         (gradients[m].array() * meshes[m].points.array()).sum() - (gradients[m].array() * free[m].array()).sum();
     }
     for (Contact& c : contacts)
@@ -653,7 +737,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
     {
       const double change = (next[m] - meshes[m].points).cwiseAbs().maxCoeff();
       if (change > parameters.tolerance * energies[m]->Size() ||
-        std::abs(volumeNow[m] - volumes[m]) > 1e-9 * std::abs(volumes[m]))
+        std::abs(volumeNow[m] - targets[m]) > 1e-9 * std::abs(targets[m]))
       {
         settled = false;
       }
@@ -662,6 +746,11 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
       reports[m].pointsInContact = inContact[m];
     }
     held = std::move(nowHeld);
+  }
+  for (size_t m = 0; m < count; ++m)
+  {
+    energies[m]->CarryToUnwelded(muscles[m].points, meshes[m].points);
+    muscles[m].points = std::move(meshes[m].points);
   }
   // The muscles are settled together: the time is shared.
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();

@@ -82,12 +82,25 @@ public:
   void Prepare(const std::vector<Eigen::Index>& points) const;
   const Eigen::VectorXd& InverseColumn(Eigen::Index point) const;
 
+  /// The rest surface's triangles with its duplicate points welded (WeldedTriangles): the
+  /// energy is posed on them, so that a scan's exact and split duplicates give the same energy.
+  const Triangles& Surface() const { return this->Welded; }
+  /// Writes every point of the muscle that the welded surface does not use but its own
+  /// triangles do into `settled` (the welded surface's points settled from `start`): a welded
+  /// twin moves as the point it was welded to, a point that only dropped (degenerate)
+  /// triangles used moves as the welded points of those triangles do on average.
+  void CarryToUnwelded(const Points& start, Points& settled) const;
+
   const std::vector<char>& Used() const { return this->PointUsed; }
   Eigen::Index SampleCount() const { return static_cast<Eigen::Index>(this->SampleIndex.size()); }
   double Size() const { return this->Span; }
 
 private:
+  void FindLeaders(const TriangleMesh& rest, const std::vector<std::int64_t>& representative);
+
   Points RestPoints;
+  Triangles Welded;
+  std::vector<std::pair<Eigen::Index, std::vector<Eigen::Index>>> Leaders; // unwelded point, whom it follows
   double Span = 0;
   int SamplesPerSegment = 10;
   std::vector<char> PointUsed;
@@ -110,17 +123,16 @@ struct SettleReport
   double seconds = 0;
 };
 
-/// Settles every muscle of `meshes` (their points in, the settled points
-/// out) to the minimum of its full-mesh energy for the pose `lines[m]`
-/// describes, holding `volumes[m]`, none of its points inside a bone
-/// (`bones`, in that pose) or another muscle: the muscles are settled
-/// together, and where two are in contact each gives way as its own
-/// stiffness says. Overlap the rest pose has (`restOverlap`, OverlapMasks
-/// order) is left alone. The starting points decide only which side of an
-/// obstacle a point is on. `energies[m]` belong to the muscles' rest poses.
-/// A point inside an obstacle at the start goes out the nearest way; one that
+/// Settles every muscle of `muscles` (their points in, the settled points out) to the minimum
+/// of its full-mesh energy for the pose `lines[m]` describes, holding `volumes[m]`, none of its
+/// points inside a bone (`bones`, in that pose) or another muscle: the muscles are settled
+/// together, and where two are in contact each gives way as its own stiffness says. Overlap
+/// the rest pose has (`restOverlap`, OverlapMasks order) is left alone. The starting points
+/// decide only which side of an obstacle a point is on. `energies[m]` belong to the muscles'
+/// rest poses; the settle runs on their welded surfaces and writes the other points back with
+/// CarryToUnwelded. A point inside an obstacle at the start goes out the nearest way; one that
 /// goes in during the settle goes back out the way it came in.
-std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& meshes,
+std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   const std::vector<const SurfaceEnergy*>& energies, const std::vector<std::vector<MatchedLine>>& lines,
   const std::vector<double>& volumes, const std::vector<FixedObstacle>& bones, const OverlapMasks* restOverlap,
   const SettleParameters& parameters);

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 using md::Points;
@@ -164,6 +165,45 @@ TEST(SurfaceRepair, MergesPointsRoundingNoiseSplitAndSaysSo)
   }
   md::RepairReport report;
   EXPECT_THROW(md::RepairClosedSurface(SphereWithASeam(1e-4), report), md::InputError); // a real gap
+}
+
+// The surface the full-mesh settle is posed on: the same welding on the input's own points, with
+// fins kept (they are part of the muscle's shape there) and what welding leaves of no area dropped.
+TEST(SurfaceRepair, WeldsDuplicatesOnTheSurfacesOwnPoints)
+{
+  const TriangleMesh sphere = Sphere(Eigen::Vector3d(100, 50, 20), 10, 3);
+  for (double split : { 0.0, 1e-7 })
+  {
+    SCOPED_TRACE(split);
+    const TriangleMesh seam = SphereWithASeam(split);
+    std::vector<std::int64_t> representative;
+    const md::Triangles welded = md::WeldedTriangles(seam, representative);
+    ASSERT_EQ(representative.size(), static_cast<size_t>(seam.points.rows()));
+    // The sphere's triangles again, each corner one point of the seamed surface at its place.
+    ASSERT_EQ(welded.rows(), sphere.triangles.rows());
+    std::vector<std::int64_t> used(welded.data(), welded.data() + welded.size());
+    std::sort(used.begin(), used.end());
+    EXPECT_EQ(std::unique(used.begin(), used.end()) - used.begin(), sphere.points.rows());
+    for (Eigen::Index t = 0; t < welded.rows(); ++t)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        EXPECT_LT((seam.points.row(welded(t, k)) - sphere.points.row(sphere.triangles(t, k))).norm(), 1e-5);
+      }
+    }
+  }
+  TriangleMesh box = Box({ 0, 0, 0 }, { 1, 1, 1 });
+  const Eigen::Index n = box.triangles.rows();
+  box.points.conservativeResize(box.points.rows() + 1, 3);
+  box.points.row(8) = box.points.row(0); // a duplicate of point 0 ...
+  box.triangles.conservativeResize(n + 3, 3);
+  box.triangles.row(n) << 0, 8, 5;     // ... in a triangle of no area
+  box.triangles.row(n + 1) << 0, 5, 6; // a fin ...
+  box.triangles.row(n + 2) << 0, 6, 5; // ... both sides
+  std::vector<std::int64_t> representative;
+  const md::Triangles welded = md::WeldedTriangles(box, representative);
+  EXPECT_EQ(representative[8], 0);
+  EXPECT_EQ(welded.rows(), n + 2);
 }
 
 TEST(SurfaceRepair, RefusesWhatCannotBeRepaired)
