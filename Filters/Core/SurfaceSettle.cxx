@@ -338,6 +338,13 @@ Points SurfaceEnergy::RightHandSide(
 
 namespace
 {
+/// An iteration that moves a point by this fraction of its muscle's size has gone beyond the
+/// linearisations' reach. One or two such moves happen and are undone by the next iteration
+/// (a contact linearised at a bad start); a settle that keeps making them (contacts of two
+/// moving surfaces feeding each other) has diverged and stops.
+constexpr double kFarMove = 0.5;
+constexpr int kFarMovesToStop = 3;
+
 /// One point of a constraint's combination: `coefficient` times point
 /// `point` of muscle `muscle`.
 struct Term
@@ -598,9 +605,10 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     wasInside[m].assign(static_cast<size_t>(meshes[m].points.rows()) * obstacles, 1);
     previous[m] = meshes[m].points;
   }
-  bool settled = false;
+  bool settled = false, diverging = false;
+  int farMoves = 0;
   int iteration = 0;
-  for (; iteration < parameters.maximumIterations && !settled; ++iteration)
+  for (; iteration < parameters.maximumIterations && !settled && !diverging; ++iteration)
   {
 #pragma omp parallel for schedule(dynamic, 1)
     for (int m = 0; m < static_cast<int>(count); ++m)
@@ -736,6 +744,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     for (size_t m = 0; m < count; ++m)
     {
       const double change = (next[m] - meshes[m].points).cwiseAbs().maxCoeff();
+      farMoves += change > kFarMove * energies[m]->Size() ? 1 : 0;
       if (change > parameters.tolerance * energies[m]->Size() ||
         std::abs(volumeNow[m] - targets[m]) > 1e-9 * std::abs(targets[m]))
       {
@@ -746,8 +755,11 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       reports[m].pointsInContact = inContact[m];
     }
     held = std::move(nowHeld);
+    diverging = farMoves >= kFarMovesToStop;
   }
-  for (size_t m = 0; m < count; ++m)
+  // A settle that diverged leaves the muscles where they started (the hull-based answer) rather
+  // than at an iterate that means nothing; one that ran out of iterations keeps its last.
+  for (size_t m = 0; m < count && !diverging; ++m)
   {
     energies[m]->CarryToUnwelded(muscles[m].points, meshes[m].points);
     muscles[m].points = std::move(meshes[m].points);

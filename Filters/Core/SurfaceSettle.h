@@ -131,7 +131,10 @@ struct SettleReport
 /// decide only which side of an obstacle a point is on. `energies[m]` belong to the muscles'
 /// rest poses; the settle runs on their welded surfaces and writes the other points back with
 /// CarryToUnwelded. A point inside an obstacle at the start goes out the nearest way; one that
-/// goes in during the settle goes back out the way it came in.
+/// goes in during the settle goes back out the way it came in. A settle that does not converge
+/// within SettleParameters::maximumIterations keeps its last iterate, with `converged` false;
+/// one that diverges (a third iteration that moves a point by half its muscle's size) stops
+/// and leaves every muscle at its starting points, also with `converged` false.
 std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   const std::vector<const SurfaceEnergy*>& energies, const std::vector<std::vector<MatchedLine>>& lines,
   const std::vector<double>& volumes, const std::vector<FixedObstacle>& bones, const OverlapMasks* restOverlap,

@@ -38,6 +38,7 @@ struct Output
   std::vector<md::Points> points;
   std::string failure;
   double seconds = 0;
+  int unsettledStep = 0; ///< with the settle: the first step whose settle did not converge, or 0
 };
 
 Output Run(const MotionCase& c, const Method& method, int hullPoints, md::RestMappingCache& cache)
@@ -53,6 +54,13 @@ Output Run(const MotionCase& c, const Method& method, int hullPoints, md::RestMa
   {
     md::InterpolationResult r = md::DeformByInterpolation(c.muscles, c.bones, parameters, {}, &cache);
     out.points = r.points.back();
+    for (size_t j = 1; j < r.measures.size() && method.settleOnSurface && out.unsettledStep == 0; ++j)
+    {
+      for (const md::MuscleStepMeasures& measures : r.measures[j])
+      {
+        out.unsettledStep = measures.settled ? out.unsettledStep : static_cast<int>(j);
+      }
+    }
   }
   catch (const std::exception& e)
   {
@@ -64,14 +72,15 @@ Output Run(const MotionCase& c, const Method& method, int hullPoints, md::RestMa
 
 struct Distance
 {
-  double largest = 0;                 ///< over all muscles and points
-  double rmsLow = 1e300, rmsHigh = 0; ///< the per-muscle RMS, min-max
-  std::string worst;                  ///< the muscle of the largest
+  double largest = 0;             ///< over all muscles and points
+  double rmsLow = 0, rmsHigh = 0; ///< the per-muscle RMS, min-max
+  std::string worst;              ///< the muscle of the largest
 };
 
 Distance Between(const MotionCase& c, const Output& a, const Output& b)
 {
   Distance d;
+  d.rmsLow = 1e300;
   for (size_t m = 0; m < c.muscles.size(); ++m)
   {
     const Eigen::VectorXd per = (a.points[m] - b.points[m]).rowwise().norm();
@@ -95,8 +104,13 @@ void Print(const std::string& method, const std::string& variation, const Output
       "  %-28s %-26s FAILED (%.1f s): %s\n", method.c_str(), variation.c_str(), run.seconds, run.failure.c_str());
     return;
   }
-  std::printf("  %-28s %-26s %9.4f %9.4f-%-9.4f %-18s %5.1f\n", method.c_str(), variation.c_str(), d->largest,
-    d->rmsLow, d->rmsHigh, d->worst.c_str(), run.seconds);
+  std::printf("  %-28s %-26s %9.4f %9.4f-%-9.4f %-18s %5.1f", method.c_str(), variation.c_str(), d->largest, d->rmsLow,
+    d->rmsHigh, d->worst.c_str(), run.seconds);
+  if (run.unsettledStep > 0)
+  {
+    std::printf("  (the settle did not converge at step %d)", run.unsettledStep);
+  }
+  std::printf("\n");
 }
 
 /// The spread of one kind of variation: the largest distance and the largest RMS over its runs.
@@ -164,6 +178,8 @@ void Study(const MotionCase& exact, const std::vector<Method>& methods, int seed
       Print(method.label, inputs[0].label, runs[0], nullptr);
       continue;
     }
+    const Distance none;
+    Print(method.label, inputs[0].label, runs[0], &none);
     Spread noise, split, hulls, hullPairs;
     for (size_t i = 1; i < inputs.size(); ++i)
     {

@@ -414,27 +414,25 @@ TEST(SurfaceSettle, OnTheHipEveryStepSettlesAndSplitDuplicatesChangeLittle)
   EXPECT_LT(apart, 3.0);
 }
 
-// Open (issue 13): from the rest pose, with the lines bent towards each other, the settle of
-// two muscles in contact does not converge yet - the contacts of two moving surfaces change
-// from iteration to iteration. Disabled so that the suite passes; gtest lists it as disabled.
-TEST(SurfaceSettle, DISABLED_TwoMusclesPressedTogetherBothGiveWay)
+namespace
 {
-  // Two spindles side by side, 2 apart, their lines bent 40 degrees towards each other:
-  // settled together, neither has a point inside the other, and each is pushed away from
-  // where it would go alone.
-  const Spindle s;
-  const Eigen::RowVector3d apart(0, 26, 0);
-  const md::Points otherRest = s.muscle.points.rowwise() + apart;
-  const md::Points otherLine = s.line.rowwise() + apart;
-  const md::TriangleMesh other{ otherRest, s.muscle.triangles };
-  const md::SurfaceEnergy first(s.muscle, { s.line }, md::SettleParameters());
-  const md::SurfaceEnergy second(other, { otherLine }, md::SettleParameters());
-  md::Points otherBent = Bent(s.line, -40);
-  otherBent.rowwise() += apart;
-  const std::vector<std::vector<md::MatchedLine>> lines{ { { s.line, Bent(s.line, 40) } },
-    { { otherLine, otherBent } } };
-  const double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
-  auto settle = [&](bool together, std::vector<md::SettleReport>& reports) {
+/// Two spindles side by side, 2 apart, their lines bent 40 degrees towards each other, so that
+/// alone each would go into the other.
+struct TwoSpindlesBentTogether
+{
+  Spindle s;
+  Eigen::RowVector3d apart{ 0, 26, 0 };
+  md::TriangleMesh other{ s.muscle.points.rowwise() + apart, s.muscle.triangles };
+  md::Points otherLine = s.line.rowwise() + apart;
+  md::SurfaceEnergy first{ s.muscle, { s.line }, md::SettleParameters() };
+  md::SurfaceEnergy second{ other, { otherLine }, md::SettleParameters() };
+  std::vector<std::vector<md::MatchedLine>> lines{ { { s.line, Bent(s.line, 40) } },
+    { { otherLine, Bent(s.line, -40).rowwise() + apart } } };
+  double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
+
+  /// Both settled from their rest poses, together or each alone.
+  std::vector<md::TriangleMesh> Settle(bool together, std::vector<md::SettleReport>& reports) const
+  {
     std::vector<md::TriangleMesh> meshes{ s.muscle, other };
     if (together)
     {
@@ -449,10 +447,58 @@ TEST(SurfaceSettle, DISABLED_TwoMusclesPressedTogetherBothGiveWay)
       meshes[m] = alone[0];
     }
     return meshes;
+  }
+};
+}
+
+TEST(SurfaceSettle, OnTheHipASettleThatDivergesIsStoppedAndTheMusclesStaySound)
+{
+  // LHDL hip, adduction -40 degrees (hip_adduction.mot frame 0), inputs moved by 1e-7 (seed 1),
+  // N = 4: the gluteus maximus and medius pressed together do not settle (the open case of
+  // the disabled test below). A step that runs out of iterations keeps its last iterate; one
+  // whose iterations keep moving points by half a muscle's size (a third time) stops and keeps
+  // the hull-based answer. Before, the iteration went on to move the iliacus by 13 times its
+  // size in one iteration, with thousands of contacts, for minutes a step (this test did not
+  // finish in 5 minutes). Measured: up to 25.2 mm from the hull-based answer at any step,
+  // volumes held, no new bone penetration, about 20 s.
+  MotionCase exact;
+  if (!LhdlMotion("hip_adduction", 0, exact))
+  {
+    GTEST_SKIP() << "LHDL data not found (set MUSCLEDEFORMATION_DATA_DIR)";
+  }
+  const MotionCase input = Perturbed(exact, 1);
+  auto run = [&](bool settle) {
+    md::InterpolationParameters parameters;
+    parameters.numberOfSteps = 4;
+    parameters.settleOnSurface = settle;
+    return md::DeformByInterpolation(input.muscles, input.bones, parameters);
   };
+  const md::InterpolationResult settled = run(true);
+  const md::InterpolationResult hullBased = run(false);
+  for (size_t m = 0; m < input.muscles.size(); ++m)
+  {
+    SCOPED_TRACE(input.muscles[m].name);
+    const md::MuscleStepMeasures& s = settled.measures.back()[m];
+    EXPECT_LT(std::abs(s.volumeChangePercent), 1e-4);
+    EXPECT_EQ(s.newBonePenetrationCount, 0);
+    for (size_t j = 1; j < settled.points.size(); ++j)
+    {
+      EXPECT_LT((settled.points[j][m] - hullBased.points[j][m]).rowwise().norm().maxCoeff(), 50.0) << "step " << j;
+    }
+  }
+}
+
+// Open (issue 13): from the rest pose, with the lines bent towards each other, the settle of
+// two muscles in contact does not converge yet - the contacts of two moving surfaces change
+// from iteration to iteration. Disabled so that the suite passes; gtest lists it as disabled.
+TEST(SurfaceSettle, DISABLED_TwoMusclesPressedTogetherBothGiveWay)
+{
+  // Settled together, neither has a point inside the other, and each is pushed away from
+  // where it would go alone.
+  const TwoSpindlesBentTogether two;
   std::vector<md::SettleReport> aloneReports, togetherReports;
-  const std::vector<md::TriangleMesh> alone = settle(false, aloneReports);
-  const std::vector<md::TriangleMesh> together = settle(true, togetherReports);
+  const std::vector<md::TriangleMesh> alone = two.Settle(false, aloneReports);
+  const std::vector<md::TriangleMesh> together = two.Settle(true, togetherReports);
   ASSERT_GT(CountInside(md::TriangleTree(alone[1]), alone[0].points), 10); // alone they overlap
   for (size_t m = 0; m < 2; ++m)
   {
@@ -461,10 +507,10 @@ TEST(SurfaceSettle, DISABLED_TwoMusclesPressedTogetherBothGiveWay)
     const md::TriangleTree otherTree(together[1 - m]);
     EXPECT_EQ(CountInside(otherTree, together[m].points), 0) << "muscle " << m;
     EXPECT_GT((together[m].points - alone[m].points).rowwise().norm().maxCoeff(), 1.0) << "muscle " << m;
-    EXPECT_NEAR(md::EnclosedVolume(together[m].points, together[m].triangles), volume, 1e-8 * volume);
+    EXPECT_NEAR(md::EnclosedVolume(together[m].points, together[m].triangles), two.volume, 1e-8 * two.volume);
   }
   // The same stiffness on both sides: they give way alike (mirror images about y = 13).
   md::Points mirrored = together[1].points;
   mirrored.col(1) = (26.0 - mirrored.col(1).array()).matrix();
-  EXPECT_LT((mirrored - together[0].points).rowwise().norm().maxCoeff(), 1e-3 * s.Size());
+  EXPECT_LT((mirrored - together[0].points).rowwise().norm().maxCoeff(), 1e-3 * two.s.Size());
 }
