@@ -58,7 +58,10 @@ Output Run(const MotionCase& c, const Method& method, int hullPoints, md::RestMa
     {
       for (const md::MuscleStepMeasures& measures : r.measures[j])
       {
-        out.unsettledStep = measures.settled ? out.unsettledStep : static_cast<int>(j);
+        if (!measures.settled)
+        {
+          out.unsettledStep = static_cast<int>(j);
+        }
       }
     }
   }
@@ -72,15 +75,14 @@ Output Run(const MotionCase& c, const Method& method, int hullPoints, md::RestMa
 
 struct Distance
 {
-  double largest = 0;             ///< over all muscles and points
-  double rmsLow = 0, rmsHigh = 0; ///< the per-muscle RMS, min-max
-  std::string worst;              ///< the muscle of the largest
+  double largest = 0;                 ///< over all muscles and points
+  double rmsLow = 1e300, rmsHigh = 0; ///< the per-muscle RMS, min-max
+  std::string worst;                  ///< the muscle of the largest
 };
 
 Distance Between(const MotionCase& c, const Output& a, const Output& b)
 {
   Distance d;
-  d.rmsLow = 1e300;
   for (size_t m = 0; m < c.muscles.size(); ++m)
   {
     const Eigen::VectorXd per = (a.points[m] - b.points[m]).rowwise().norm();
@@ -178,7 +180,8 @@ void Study(const MotionCase& exact, const std::vector<Method>& methods, int seed
       Print(method.label, inputs[0].label, runs[0], nullptr);
       continue;
     }
-    const Distance none;
+    Distance none; // the exact run against itself
+    none.rmsLow = 0;
     Print(method.label, inputs[0].label, runs[0], &none);
     Spread noise, split, hulls, hullPairs;
     for (size_t i = 1; i < inputs.size(); ++i)

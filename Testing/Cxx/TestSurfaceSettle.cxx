@@ -414,43 +414,6 @@ TEST(SurfaceSettle, OnTheHipEveryStepSettlesAndSplitDuplicatesChangeLittle)
   EXPECT_LT(apart, 3.0);
 }
 
-namespace
-{
-/// Two spindles side by side, 2 apart, their lines bent 40 degrees towards each other, so that
-/// alone each would go into the other.
-struct TwoSpindlesBentTogether
-{
-  Spindle s;
-  Eigen::RowVector3d apart{ 0, 26, 0 };
-  md::TriangleMesh other{ s.muscle.points.rowwise() + apart, s.muscle.triangles };
-  md::Points otherLine = s.line.rowwise() + apart;
-  md::SurfaceEnergy first{ s.muscle, { s.line }, md::SettleParameters() };
-  md::SurfaceEnergy second{ other, { otherLine }, md::SettleParameters() };
-  std::vector<std::vector<md::MatchedLine>> lines{ { { s.line, Bent(s.line, 40) } },
-    { { otherLine, Bent(s.line, -40).rowwise() + apart } } };
-  double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
-
-  /// Both settled from their rest poses, together or each alone.
-  std::vector<md::TriangleMesh> Settle(bool together, std::vector<md::SettleReport>& reports) const
-  {
-    std::vector<md::TriangleMesh> meshes{ s.muscle, other };
-    if (together)
-    {
-      reports = md::SettleMuscles(meshes, { &first, &second }, lines, { volume, volume }, {}, nullptr, {});
-      return meshes;
-    }
-    for (size_t m = 0; m < 2; ++m)
-    {
-      std::vector<md::TriangleMesh> alone{ meshes[m] };
-      reports.push_back(
-        md::SettleMuscles(alone, { m == 0 ? &first : &second }, { lines[m] }, { volume }, {}, nullptr, {})[0]);
-      meshes[m] = alone[0];
-    }
-    return meshes;
-  }
-};
-}
-
 TEST(SurfaceSettle, OnTheHipASettleThatDivergesIsStoppedAndTheMusclesStaySound)
 {
   // LHDL hip, adduction -40 degrees (hip_adduction.mot frame 0), inputs moved by 1e-7 (seed 1),
@@ -493,12 +456,40 @@ TEST(SurfaceSettle, OnTheHipASettleThatDivergesIsStoppedAndTheMusclesStaySound)
 // from iteration to iteration. Disabled so that the suite passes; gtest lists it as disabled.
 TEST(SurfaceSettle, DISABLED_TwoMusclesPressedTogetherBothGiveWay)
 {
-  // Settled together, neither has a point inside the other, and each is pushed away from
+  // Two spindles side by side, 2 apart, their lines bent 40 degrees towards each other:
+  // settled together, neither has a point inside the other, and each is pushed away from
   // where it would go alone.
-  const TwoSpindlesBentTogether two;
+  const Spindle s;
+  const Eigen::RowVector3d apart(0, 26, 0);
+  const md::Points otherRest = s.muscle.points.rowwise() + apart;
+  const md::Points otherLine = s.line.rowwise() + apart;
+  const md::TriangleMesh other{ otherRest, s.muscle.triangles };
+  const md::SurfaceEnergy first(s.muscle, { s.line }, md::SettleParameters());
+  const md::SurfaceEnergy second(other, { otherLine }, md::SettleParameters());
+  md::Points otherBent = Bent(s.line, -40);
+  otherBent.rowwise() += apart;
+  const std::vector<std::vector<md::MatchedLine>> lines{ { { s.line, Bent(s.line, 40) } },
+    { { otherLine, otherBent } } };
+  const double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
+  auto settle = [&](bool together, std::vector<md::SettleReport>& reports) {
+    std::vector<md::TriangleMesh> meshes{ s.muscle, other };
+    if (together)
+    {
+      reports = md::SettleMuscles(meshes, { &first, &second }, lines, { volume, volume }, {}, nullptr, {});
+      return meshes;
+    }
+    for (size_t m = 0; m < 2; ++m)
+    {
+      std::vector<md::TriangleMesh> alone{ meshes[m] };
+      reports.push_back(
+        md::SettleMuscles(alone, { m == 0 ? &first : &second }, { lines[m] }, { volume }, {}, nullptr, {})[0]);
+      meshes[m] = alone[0];
+    }
+    return meshes;
+  };
   std::vector<md::SettleReport> aloneReports, togetherReports;
-  const std::vector<md::TriangleMesh> alone = two.Settle(false, aloneReports);
-  const std::vector<md::TriangleMesh> together = two.Settle(true, togetherReports);
+  const std::vector<md::TriangleMesh> alone = settle(false, aloneReports);
+  const std::vector<md::TriangleMesh> together = settle(true, togetherReports);
   ASSERT_GT(CountInside(md::TriangleTree(alone[1]), alone[0].points), 10); // alone they overlap
   for (size_t m = 0; m < 2; ++m)
   {
@@ -507,10 +498,10 @@ TEST(SurfaceSettle, DISABLED_TwoMusclesPressedTogetherBothGiveWay)
     const md::TriangleTree otherTree(together[1 - m]);
     EXPECT_EQ(CountInside(otherTree, together[m].points), 0) << "muscle " << m;
     EXPECT_GT((together[m].points - alone[m].points).rowwise().norm().maxCoeff(), 1.0) << "muscle " << m;
-    EXPECT_NEAR(md::EnclosedVolume(together[m].points, together[m].triangles), two.volume, 1e-8 * two.volume);
+    EXPECT_NEAR(md::EnclosedVolume(together[m].points, together[m].triangles), volume, 1e-8 * volume);
   }
   // The same stiffness on both sides: they give way alike (mirror images about y = 13).
   md::Points mirrored = together[1].points;
   mirrored.col(1) = (26.0 - mirrored.col(1).array()).matrix();
-  EXPECT_LT((mirrored - together[0].points).rowwise().norm().maxCoeff(), 1e-3 * two.s.Size());
+  EXPECT_LT((mirrored - together[0].points).rowwise().norm().maxCoeff(), 1e-3 * s.Size());
 }
