@@ -419,6 +419,19 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
     }
   }
 
+  // Each step's settle goes on from the last one's answer (from the rest pose at the first):
+  // the hull-based pass's answer is not its start, so the settled answer does not depend on
+  // the hull at all, and depends continuously on the input (docs/DESIGN.md section 7).
+  std::vector<const SurfaceEnergy*> energyPointers(count);
+  SettleMotion settleMotion;
+  if (parameters.settleOnSurface)
+  {
+    for (size_t m = 0; m < count; ++m)
+    {
+      energyPointers[m] = energies[m].get();
+    }
+    settleMotion = StartMotion(current, energyPointers, restLines, fixed);
+  }
   DeformationParameters stepParameters = parameters.deformation;
   stepParameters.measureSamplesInside = false; // not part of the method's measures
   // Contact rows leave the rest pose's overlap with each bone alone.
@@ -509,17 +522,16 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
     std::vector<SettleReport> settled(count);
     if (parameters.settleOnSurface)
     {
-      std::vector<const SurfaceEnergy*> energyPointers(count);
       std::vector<std::vector<MatchedLine>> wholeMotion(count); // rest pose -> this step
       for (size_t m = 0; m < count; ++m)
       {
-        energyPointers[m] = energies[m].get();
         for (size_t l = 0; l < lineMotions[m].size(); ++l)
         {
           wholeMotion[m].push_back({ restLines[m][l], lineMotions[m][l].AtStep(j, steps) });
         }
       }
-      settled = SettleMuscles(next, energyPointers, wholeMotion, restVolumes, fixed, &restOverlap, parameters.settle);
+      settled = SettleMuscles(
+        next, energyPointers, wholeMotion, restVolumes, fixed, &restOverlap, parameters.settle, &settleMotion);
     }
     StaticResolveResult resolved = ResolveStaticIntersections(next, fixed, &restOverlap, parameters.staticResolve);
     // The volume is given back over the whole surface, except at the overlap

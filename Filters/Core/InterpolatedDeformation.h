@@ -97,8 +97,9 @@ struct InterpolationParameters
   int detailRelaxation = 2;
   StaticResolveParameters staticResolve;
   DeformationParameters deformation = StepDeformationDefaults();
-  /// Each step's answer settled on the full mesh (SurfaceSettle), the hull-based pass its
-  /// starting guess; false: the hull-based pass's answer (the paper's, hull-dependent).
+  /// Each step's answer settled on the full mesh (SurfaceSettle), each settle starting from the
+  /// last one's answer (SettleMotion): independent of the hull; false: the hull-based pass's
+  /// answer (the paper's, hull-dependent).
   bool settleOnSurface = false;
   SettleParameters settle;
   HullParameters hull;

@@ -48,6 +48,18 @@ Eigen::Matrix3d BestRotation(const Eigen::Matrix3d& covariance)
   return svd.matrixU() * reflectionFix * svd.matrixV().transpose();
 }
 
+namespace
+{
+/// Points spread across their own axis by less than this fraction of their spread along it
+/// (the smaller two singular values of the covariance against the largest) are nearly
+/// collinear: the rotation about that axis is fixed by the pull to the identity below.
+constexpr double kCollinearSpread = 0.01;
+/// The pull's weight, relative to the covariance's largest singular value, for exactly
+/// collinear points: small enough that the fit of the axis is not biased (by about 2e-6 rad),
+/// large against rounding.
+constexpr double kIdentityPull = 1e-6;
+}
+
 RigidFit FitRigidTransform(const Points& from, const Points& to)
 {
   if (from.rows() != to.rows() || from.rows() == 0)
@@ -56,8 +68,20 @@ RigidFit FitRigidTransform(const Points& from, const Points& to)
   }
   const Eigen::RowVector3d cFrom = from.colwise().mean();
   const Eigen::RowVector3d cTo = to.colwise().mean();
+  Eigen::Matrix3d covariance = (to.rowwise() - cTo).transpose() * (from.rowwise() - cFrom);
+  // Collinear points (an action line of two points, a straight polyline) fix no rotation about
+  // their own axis: every twist about it fits as well, and rounding picked one at random (two
+  // fits of the same line 2.5 rad apart, which moved the interpolated line by 12 mm halfway).
+  // Of the rotations that fit, the one nearest the identity is taken, by adding a pull towards
+  // it, w * trace(R), that fades continuously to nothing as the points spread across the axis.
+  const Eigen::Vector3d spread = Eigen::JacobiSVD<Eigen::Matrix3d>(covariance).singularValues();
+  if (spread(0) > 0)
+  {
+    const double across = std::max(0.0, 1.0 - (spread(1) + spread(2)) / (kCollinearSpread * spread(0)));
+    covariance += kIdentityPull * spread(0) * across * across * Eigen::Matrix3d::Identity();
+  }
   RigidFit fit;
-  fit.transform.rotation = BestRotation((to.rowwise() - cTo).transpose() * (from.rowwise() - cFrom));
+  fit.transform.rotation = BestRotation(covariance);
   fit.transform.translation = cTo.transpose() - fit.transform.rotation * cFrom.transpose();
   const Points residual = to - fit.transform.Apply(from);
   const Eigen::VectorXd norms = residual.rowwise().norm();

@@ -561,10 +561,27 @@ std::vector<Contact> FindContacts(const std::vector<TriangleMesh>& meshes,
 }
 }
 
+SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::vector<const SurfaceEnergy*>& energies,
+  const std::vector<std::vector<Points>>& restLines, const std::vector<FixedObstacle>& restBones)
+{
+  SettleMotion motion;
+  for (size_t m = 0; m < muscles.size(); ++m)
+  {
+    std::vector<MatchedLine> still;
+    for (const Points& line : restLines[m])
+    {
+      still.push_back({ line, line });
+    }
+    motion.points.push_back(muscles[m].points);
+    motion.free.push_back(energies[m]->Solve(energies[m]->RightHandSide(still, restBones)));
+  }
+  return motion;
+}
+
 std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   const std::vector<const SurfaceEnergy*>& energies, const std::vector<std::vector<MatchedLine>>& lines,
   const std::vector<double>& volumes, const std::vector<FixedObstacle>& bones, const OverlapMasks* restOverlap,
-  const SettleParameters& parameters)
+  const SettleParameters& parameters, SettleMotion* motion)
 {
   // Sequential quadratic programming: at each iteration the volume and the obstacles' surfaces
   // are linearised at the current points, and the quadratic energy is minimised exactly under
@@ -579,6 +596,20 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   // Settled on the welded surfaces (the energies' triangles), written back at the end. The
   // volume each must hold is the muscle's less the difference the welding makes at the start
   // (nothing for exact duplicates, rounding for split ones).
+  const size_t obstacles = bones.size() + count;
+  std::vector<Points> free(count); // the minimum without contact and volume
+  for (size_t m = 0; m < count; ++m)
+  {
+    free[m] = energies[m]->Solve(energies[m]->RightHandSide(lines[m], bones));
+  }
+  const bool continued = motion && motion->points.size() == count;
+  if (continued)
+  {
+    for (size_t m = 0; m < count; ++m)
+    {
+      muscles[m].points = motion->points[m] + (free[m] - motion->free[m]);
+    }
+  }
   std::vector<TriangleMesh> meshes(count);
   std::vector<double> targets(count);
   for (size_t m = 0; m < count; ++m)
@@ -587,13 +618,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     targets[m] = volumes[m] - EnclosedVolume(muscles[m].points, muscles[m].triangles) +
       EnclosedVolume(meshes[m].points, meshes[m].triangles);
   }
-  const size_t obstacles = bones.size() + count;
   std::vector<SettleReport> reports(count);
-  std::vector<Points> free(count); // the minimum without contact and volume
-  for (size_t m = 0; m < count; ++m)
-  {
-    free[m] = energies[m]->Solve(energies[m]->RightHandSide(lines[m], bones));
-  }
   std::vector<std::unique_ptr<TriangleTree>> trees(count);
   HeldContacts held; // the contacts active at the last iteration
   // Which obstacles each point was inside at the last iteration (at the start: as if it were
@@ -763,6 +788,15 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   {
     energies[m]->CarryToUnwelded(muscles[m].points, meshes[m].points);
     muscles[m].points = std::move(meshes[m].points);
+  }
+  if (motion)
+  {
+    motion->points.clear();
+    for (size_t m = 0; m < count; ++m)
+    {
+      motion->points.push_back(muscles[m].points);
+    }
+    motion->free = std::move(free);
   }
   // The muscles are settled together: the time is shared.
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();

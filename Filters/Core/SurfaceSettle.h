@@ -2,9 +2,10 @@
 // The deformation's answer on the muscle itself (docs/DESIGN.md section 7):
 // the energy of the Kellnhofer & Kohout deformation (rotated Laplacian
 // coordinates, action-line rows, volume) with contact, posed on every point
-// of the full mesh and converged there. The hull-based pass gives the
-// starting guess; the answer is the energy's minimum, so it does not depend on
-// the hull's size or on the order of its collapses. Contact is a constraint,
+// of the full mesh and converged there. Through a motion each step's settle
+// starts from the last step's answer (SettleMotion), not from the hull-based
+// pass, so the answer does not depend on the hull's size or on the order of
+// its collapses. Contact is a constraint,
 // not a penalty: a point may not go inside a bone or another muscle, each
 // linearised as a half-space at its nearest surface point, and the constrained
 // minimum is found by an active set on the constraints' multipliers with the
@@ -123,6 +124,21 @@ struct SettleReport
   double seconds = 0;
 };
 
+/// A motion's settles, from step to step (SettleMuscles' `motion`): where the last settle
+/// ended. The next step's settle starts from those points moved by the change of the
+/// unconstrained minimum between the two poses: a start that depends continuously on the input
+/// and not at all on the hull, so that the minimum found does too (docs/DESIGN.md section 7).
+struct SettleMotion
+{
+  std::vector<Points> points; ///< every muscle's points where the last settle ended
+  std::vector<Points> free;   ///< the minimum of that pose without contact and volume
+};
+
+/// The start of a motion: `muscles` in the rest pose (their action lines `restLines`, the
+/// bones `restBones` in the rest pose).
+SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::vector<const SurfaceEnergy*>& energies,
+  const std::vector<std::vector<Points>>& restLines, const std::vector<FixedObstacle>& restBones);
+
 /// Settles every muscle of `muscles` (their points in, the settled points out) to the minimum
 /// of its full-mesh energy for the pose `lines[m]` describes, holding `volumes[m]`, none of its
 /// points inside a bone (`bones`, in that pose) or another muscle: the muscles are settled
@@ -135,8 +151,10 @@ struct SettleReport
 /// within SettleParameters::maximumIterations keeps its last iterate, with `converged` false;
 /// one that diverges (a third iteration that moves a point by half its muscle's size) stops
 /// and leaves every muscle at its starting points, also with `converged` false.
+/// With `motion` (a step of a motion, StartMotion at the first), the muscles' points in are
+/// not read: the settle starts where `motion` says, and `motion` is moved on to where it ends.
 std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   const std::vector<const SurfaceEnergy*>& energies, const std::vector<std::vector<MatchedLine>>& lines,
   const std::vector<double>& volumes, const std::vector<FixedObstacle>& bones, const OverlapMasks* restOverlap,
-  const SettleParameters& parameters);
+  const SettleParameters& parameters, SettleMotion* motion = nullptr);
 }

@@ -358,7 +358,7 @@ TEST(SurfaceSettle, OnThePhantomTheAnswerIsSmoothAndStable)
   // The case is not trivial: without the settle the rectus femoris has sharp edges.
   EXPECT_GT(hullBased.measures.back()[static_cast<size_t>(rectus - exact.muscles.begin())].sharpEdgeCount, 0);
   // Distances in mm between corresponding points, all muscles (measured: noise 7e-5-0.0017,
-  // split duplicates 1e-4, hull 200 1e-5; before the lines' pull was moved out of the bones
+  // split duplicates 1e-4, hulls 0; before the lines' pull was moved out of the bones
   // 0.46-16 mm).
   auto largest = [&](const md::InterpolationResult& other) {
     double d = 0;
@@ -373,82 +373,81 @@ TEST(SurfaceSettle, OnThePhantomTheAnswerIsSmoothAndStable)
     EXPECT_LT(largest(run(Perturbed(exact, seed), 250, true)), 0.01) << "1e-7 noise, seed " << seed;
   }
   EXPECT_LT(largest(run(Perturbed(exact, 1, true), 250, true)), 0.01) << "1e-7 noise, duplicates split";
-  // Hull 400 finds another minimum of the contact 0.44 mm away (issue 13: at most 3 mm).
-  EXPECT_LT(largest(run(exact, 200, true)), 0.01) << "hull 200";
-  EXPECT_LT(largest(run(exact, 400, true)), 1.0) << "hull 400";
+  // Each settle goes on from the last step's answer, so the hull is no part of the answer
+  // (when the hull-based answer was its start, hull 400 found another minimum 0.44 mm away).
+  EXPECT_LT(largest(run(exact, 200, true)), 1e-9) << "hull 200";
+  EXPECT_LT(largest(run(exact, 400, true)), 1e-9) << "hull 400";
 }
 
-TEST(SurfaceSettle, OnTheHipEveryStepSettlesAndSplitDuplicatesChangeLittle)
+namespace
 {
-  // LHDL hip, flexion 30 degrees (hip_flexion.mot frame 20), four muscles, N = 4. The
-  // scans have duplicate points at seams (the gluteus medius's make a pinch of triangles of no
-  // area); the energy is posed with them welded, so every step converges and splitting them by
-  // 1e-7 moves the settled muscles by what the contact's other minima allow (measured 1.0-1.7 mm;
-  // before the welding 9.8 mm, the psoas, and step 2 stopped at the iteration limit).
+/// The largest distance between corresponding points of two runs' muscles, at any step.
+double LargestAtAnyStep(const md::InterpolationResult& a, const md::InterpolationResult& b)
+{
+  double largest = 0;
+  for (size_t j = 1; j < a.points.size() && j < b.points.size(); ++j)
+  {
+    for (size_t m = 0; m < a.points[j].size(); ++m)
+    {
+      largest = std::max(largest, (a.points[j][m] - b.points[j][m]).rowwise().norm().maxCoeff());
+    }
+  }
+  return largest;
+}
+
+/// The LHDL motion settled on the full mesh at N = 4, with every muscle settled at every step,
+/// its volume held and no new bone penetration.
+md::InterpolationResult SettledHip(const MotionCase& c, int hullPoints = 250)
+{
+  md::InterpolationParameters parameters;
+  parameters.numberOfSteps = 4;
+  parameters.hull.targetNumberOfPoints = hullPoints;
+  parameters.settleOnSurface = true;
+  md::InterpolationResult result = md::DeformByInterpolation(c.muscles, c.bones, parameters);
+  for (size_t m = 0; m < c.muscles.size(); ++m)
+  {
+    const md::MuscleStepMeasures& s = result.measures.back()[m];
+    EXPECT_TRUE(s.settled) << c.muscles[m].name; // at every step
+    EXPECT_EQ(s.newBonePenetrationCount, 0) << c.muscles[m].name;
+    EXPECT_LT(std::abs(s.volumeChangePercent), 1e-4) << c.muscles[m].name;
+  }
+  return result;
+}
+}
+
+TEST(SurfaceSettle, OnTheHipTheAnswerDependsOnNeitherRoundingNorTheHull)
+{
+  // LHDL hip, flexion 30 degrees (hip_flexion.mot frame 20), four muscles, N = 4. Each step's
+  // settle goes on from the last one's answer, so the hull is not part of the answer at all,
+  // and the answer moves with the input continuously. Measured at any step: 1e-7 noise
+  // 0.003-0.006 mm, split duplicates 0.016-0.023 mm, hull 200 against 250 0 (issue 13 asks
+  // 0.01, 0.1 and 3 mm). Before, with the hull-based answer as each settle's start, 0.8,
+  // 1.7 and 1.0 mm at the last step; and before the straight action lines' fit was made
+  // definite, 7-20 mm at the middle steps.
   MotionCase exact;
   if (!LhdlMotion("hip_flexion", 20, exact))
   {
     GTEST_SKIP() << "LHDL data not found (set MUSCLEDEFORMATION_DATA_DIR)";
   }
-  auto run = [](const MotionCase& c) {
-    md::InterpolationParameters parameters;
-    parameters.numberOfSteps = 4;
-    parameters.settleOnSurface = true;
-    return md::DeformByInterpolation(c.muscles, c.bones, parameters);
-  };
-  const md::InterpolationResult settled = run(exact);
-  const md::InterpolationResult split = run(Perturbed(exact, 1, true));
-  double apart = 0;
-  for (size_t m = 0; m < exact.muscles.size(); ++m)
-  {
-    SCOPED_TRACE(exact.muscles[m].name);
-    for (const md::InterpolationResult* result : { &settled, &split })
-    {
-      const md::MuscleStepMeasures& s = result->measures.back()[m];
-      EXPECT_TRUE(s.settled); // at every step
-      EXPECT_EQ(s.newBonePenetrationCount, 0);
-      EXPECT_LT(std::abs(s.volumeChangePercent), 1e-4);
-    }
-    apart = std::max(apart, (settled.points.back()[m] - split.points.back()[m]).rowwise().norm().maxCoeff());
-  }
-  EXPECT_LT(apart, 3.0);
+  const md::InterpolationResult settled = SettledHip(exact);
+  EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 2))), 0.01) << "1e-7 noise";
+  EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 1, true))), 0.1) << "duplicates split";
+  EXPECT_LT(LargestAtAnyStep(settled, SettledHip(exact, 200)), 1e-9) << "hull 200";
 }
 
-TEST(SurfaceSettle, OnTheHipASettleThatDivergesIsStoppedAndTheMusclesStaySound)
+TEST(SurfaceSettle, OnTheHipTheGluteiPressedTogetherSettle)
 {
-  // LHDL hip, adduction -40 degrees (hip_adduction.mot frame 0), inputs moved by 1e-7 (seed 1),
-  // N = 4: the gluteus maximus and medius pressed together do not settle (the open case of
-  // the disabled test below). A step that runs out of iterations keeps its last iterate; one
-  // whose iterations keep moving points by half a muscle's size (a third time) stops and keeps
-  // the hull-based answer. Before, the iteration went on to move the iliacus by 13 times its
-  // size in one iteration, with thousands of contacts, for minutes a step (this test did not
-  // finish in 5 minutes). Measured: up to 25.2 mm from the hull-based answer at any step,
-  // volumes held, no new bone penetration, about 20 s.
+  // LHDL hip, adduction -40 degrees (hip_adduction.mot frame 0), N = 4: the gluteus maximus and
+  // medius are pressed together. Started from the hull-based answers, some steps' settles did
+  // not converge and one diverged (the iliacus moved by 13 times its size in one iteration
+  // before such a settle was stopped); going on from the last step's answer every step
+  // settles, and 1e-7 noise moves the answer by 0.008-0.019 mm at any step (measured).
   MotionCase exact;
   if (!LhdlMotion("hip_adduction", 0, exact))
   {
     GTEST_SKIP() << "LHDL data not found (set MUSCLEDEFORMATION_DATA_DIR)";
   }
-  const MotionCase input = Perturbed(exact, 1);
-  auto run = [&](bool settle) {
-    md::InterpolationParameters parameters;
-    parameters.numberOfSteps = 4;
-    parameters.settleOnSurface = settle;
-    return md::DeformByInterpolation(input.muscles, input.bones, parameters);
-  };
-  const md::InterpolationResult settled = run(true);
-  const md::InterpolationResult hullBased = run(false);
-  for (size_t m = 0; m < input.muscles.size(); ++m)
-  {
-    SCOPED_TRACE(input.muscles[m].name);
-    const md::MuscleStepMeasures& s = settled.measures.back()[m];
-    EXPECT_LT(std::abs(s.volumeChangePercent), 1e-4);
-    EXPECT_EQ(s.newBonePenetrationCount, 0);
-    for (size_t j = 1; j < settled.points.size(); ++j)
-    {
-      EXPECT_LT((settled.points[j][m] - hullBased.points[j][m]).rowwise().norm().maxCoeff(), 50.0) << "step " << j;
-    }
-  }
+  EXPECT_LT(LargestAtAnyStep(SettledHip(exact), SettledHip(Perturbed(exact, 1))), 0.05);
 }
 
 // Open (issue 13): from the rest pose, with the lines bent towards each other, the settle of
