@@ -24,6 +24,17 @@ namespace
 {
 using Clock = std::chrono::steady_clock;
 
+/// The rest pose's lines as a motion that goes nowhere (rest -> rest).
+std::vector<MatchedLine> Still(const std::vector<Points>& restLines)
+{
+  std::vector<MatchedLine> still;
+  for (const Points& line : restLines)
+  {
+    still.push_back({ line, line });
+  }
+  return still;
+}
+
 /// Barycentric coordinates of q (on the triangle's plane) in triangle t of `mesh`.
 Eigen::Vector3d Barycentric(const TriangleMesh& mesh, Eigen::Index t, const Eigen::Vector3d& q)
 {
@@ -99,13 +110,8 @@ SurfaceEnergy::SurfaceEnergy(
   }
 
   // The action-line samples inside the rest muscle, as sparse rows.
-  std::vector<MatchedLine> still;
-  for (const Points& line : restLines)
-  {
-    still.push_back({ line, line });
-  }
   Points samples, unused;
-  SampleMatchedLines(still, this->SamplesPerSegment, samples, unused);
+  SampleMatchedLines(Still(restLines), this->SamplesPerSegment, samples, unused);
   const TriangleTree tree(welded);
   std::vector<RowEntries> sampleRows;
   for (Eigen::Index s = 0; s < samples.rows(); ++s)
@@ -567,13 +573,8 @@ SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::ve
   SettleMotion motion;
   for (size_t m = 0; m < muscles.size(); ++m)
   {
-    std::vector<MatchedLine> still;
-    for (const Points& line : restLines[m])
-    {
-      still.push_back({ line, line });
-    }
     motion.points.push_back(muscles[m].points);
-    motion.free.push_back(energies[m]->Solve(energies[m]->RightHandSide(still, restBones)));
+    motion.free.push_back(energies[m]->Solve(energies[m]->RightHandSide(Still(restLines[m]), restBones)));
   }
   return motion;
 }
@@ -593,23 +594,23 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   // points in contact: columns of the inverse, kept by the energy for the whole motion.
   const auto start = Clock::now();
   const size_t count = muscles.size();
-  // Settled on the welded surfaces (the energies' triangles), written back at the end. The
-  // volume each must hold is the muscle's less the difference the welding makes at the start
-  // (nothing for exact duplicates, rounding for split ones).
   const size_t obstacles = bones.size() + count;
   std::vector<Points> free(count); // the minimum without contact and volume
   for (size_t m = 0; m < count; ++m)
   {
     free[m] = energies[m]->Solve(energies[m]->RightHandSide(lines[m], bones));
   }
-  const bool continued = motion && motion->points.size() == count;
-  if (continued)
+  // A motion's step starts where the last ended, moved as the unconstrained minimum moved.
+  if (motion && motion->points.size() == count)
   {
     for (size_t m = 0; m < count; ++m)
     {
       muscles[m].points = motion->points[m] + (free[m] - motion->free[m]);
     }
   }
+  // Settled on the welded surfaces (the energies' triangles), written back at the end. The
+  // volume each must hold is the muscle's less the difference the welding makes at the start
+  // (nothing for exact duplicates, rounding for split ones).
   std::vector<TriangleMesh> meshes(count);
   std::vector<double> targets(count);
   for (size_t m = 0; m < count; ++m)

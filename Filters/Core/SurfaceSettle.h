@@ -5,12 +5,12 @@
 // of the full mesh and converged there. Through a motion each step's settle
 // starts from the last step's answer (SettleMotion), not from the hull-based
 // pass, so the answer does not depend on the hull's size or on the order of
-// its collapses. Contact is a constraint,
-// not a penalty: a point may not go inside a bone or another muscle, each
-// linearised as a half-space at its nearest surface point, and the constrained
-// minimum is found by an active set on the constraints' multipliers with the
-// energy's matrix factorised once per muscle (for a whole motion). Experimental
-// and off by default (InterpolationParameters::settleOnSurface).
+// its collapses. Contact is a constraint, not a penalty: a point may not go
+// inside a bone or another muscle, each linearised as a half-space at its
+// nearest surface point, and the constrained minimum is found by an active set
+// on the constraints' multipliers with the energy's matrix factorised once per
+// muscle (for a whole motion). Experimental and off by default
+// (InterpolationParameters::settleOnSurface).
 #pragma once
 
 #include "MuscleDeformer.h"
