@@ -171,16 +171,16 @@ def interpolation_pipeline(inputs, steps=4, mode="Rigid"):
     # move with different bodies, so they are interpolated linearly.
     pipeline["lines"] = simple.BoneInterpolation(Input=simple.OutputPort(pipeline["matching"], 0),
                                                  NumberOfSteps=steps, InterpolationMode="Linear")
-    # The whole method (the paper's interpolation), and the one-pass method as the paper has it to
-    # compare with: one step, the same static resolution and measures, and the paper's deformation
-    # step, in which bones only stop points (BoneContactWeight 0; the method's own step lets them
-    # push the muscle).
+    # The whole method (the paper's interpolation, each step solved on the muscles' surfaces), and
+    # the one-pass method as the paper has it to compare with: one step on the hull, the same
+    # static resolution and measures, and the paper's deformation step, in which bones only stop
+    # points (BoneContactWeight 0; the method's own step lets them push the muscle).
     method_inputs = dict(Input=inputs["muscles"], BonesRest=inputs["bones_rest"],
                          BonesCurrent=inputs["bones_current"], ActionLinesRest=inputs["lines_rest"],
                          ActionLinesCurrent=inputs["lines_current"], BoneInterpolationMode=mode)
     pipeline["interpolated"] = simple.InterpolatedMuscleDeformation(NumberOfSteps=steps, **method_inputs)
-    pipeline["one_pass"] = simple.InterpolatedMuscleDeformation(NumberOfSteps=1, BoneContactWeight=0.0,
-                                                                **method_inputs)
+    pipeline["one_pass"] = simple.InterpolatedMuscleDeformation(NumberOfSteps=1, DeformationMesh="Hull (paper)",
+                                                                BoneContactWeight=0.0, **method_inputs)
     pipeline["hulls"] = simple.HullDecimation(Input=inputs["muscles"])
     # One pass RP -> CP (the paper's original method), every muscle together, bones in the CP.
     pipeline["deformation"] = simple.MuscleDeformation(Input=inputs["muscles"],

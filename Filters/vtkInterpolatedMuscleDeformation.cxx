@@ -378,6 +378,7 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     parameters.numberOfSteps = this->ResolvedNumberOfSteps;
     parameters.maximumStepDisplacement = frame.LengthToLocal(this->MaximumStepDisplacement);
     parameters.interpolationMode = static_cast<md::InterpolationMode>(this->BoneInterpolationMode);
+    parameters.settleOnSurface = this->DeformationMesh == MUSCLE_SURFACE;
     parameters.hullMode = static_cast<md::HullMode>(this->HullMode);
     parameters.refitRegularisation = this->RefitRegularisation;
     parameters.staticResolve.deformableShare = this->DeformableShare;
@@ -603,6 +604,7 @@ void vtkInterpolatedMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfSteps: " << this->NumberOfSteps << "\n";
   os << indent << "MaximumStepDisplacement: " << this->MaximumStepDisplacement << "\n";
   os << indent << "BoneInterpolationMode: " << this->BoneInterpolationMode << "\n";
+  os << indent << "DeformationMesh: " << this->DeformationMesh << "\n";
   os << indent << "HullMode: " << this->HullMode << "\n";
   os << indent << "MatchingTolerance: " << this->MatchingTolerance << "\n";
   os << indent << "DeformableShare: " << this->DeformableShare << "\n";

@@ -11,11 +11,16 @@
  * the volume each muscle had in the rest pose is given back. Overlap the
  * rest pose already has (scans overlap the bones) is left alone.
  *
- * HullMode Refit (default) keeps each muscle's rest-pose hull and mean value
- * coordinates for the whole motion and refits the hull to the resolved mesh
- * by least squares after each step, keeping the residual as per-point
- * detail; Rebuild builds a new hull and mapping before every step, as the
- * paper did.
+ * DeformationMesh HULL (default) is the paper's pass: each step's deformation
+ * solved on a coarse hull that the muscle follows. HullMode Refit (default)
+ * keeps each muscle's rest-pose hull and mean value coordinates for the whole
+ * motion and refits the hull to the resolved mesh by least squares after each
+ * step, keeping the residual as per-point detail; Rebuild builds a new hull
+ * and mapping before every step, as the paper did. MUSCLE_SURFACE solves each
+ * step on every point of the muscle's own surface (docs/DESIGN.md section 7):
+ * the answer does not depend on a hull, moves with the input continuously, and
+ * no point enters a bone or another muscle; where an action line runs through
+ * a bone the muscle is drawn round it (see the XML documentation).
  *
  * Inputs: 0 Input, muscles in the rest pose; 1 BonesRest and 2 BonesCurrent,
  * the bones in both poses (blocks paired by name, else by order; the same
@@ -73,6 +78,11 @@ public:
     REFIT = 0,
     REBUILD = 1,
   };
+  enum DeformationMeshes
+  {
+    HULL = 0,
+    MUSCLE_SURFACE = 1,
+  };
 
   /// N; 0 = automatic from MaximumStepDisplacement. Default 4.
   vtkSetClampMacro(NumberOfSteps, int, 0, 10000);
@@ -83,7 +93,12 @@ public:
   /// LINEAR (the paper's eq. 1) or RIGID (default), for bones and action lines.
   vtkSetClampMacro(BoneInterpolationMode, int, LINEAR, RIGID);
   vtkGetMacro(BoneInterpolationMode, int);
-  /// REFIT (default) or REBUILD.
+  /// HULL (default): each step solved on a coarse hull the muscle follows (the paper's; the Hull,
+  /// iteration and contact-weight properties apply to it only); MUSCLE_SURFACE: on the muscle's
+  /// own surface.
+  vtkSetClampMacro(DeformationMesh, int, HULL, MUSCLE_SURFACE);
+  vtkGetMacro(DeformationMesh, int);
+  /// With DeformationMesh HULL: REFIT (default) or REBUILD.
   vtkSetClampMacro(HullMode, int, REFIT, REBUILD);
   vtkGetMacro(HullMode, int);
   /// Action-line matching tolerance (normalised arc length). Default 0.01.
@@ -138,6 +153,7 @@ protected:
   int NumberOfSteps = 4;
   double MaximumStepDisplacement = 20.0;
   int BoneInterpolationMode = RIGID;
+  int DeformationMesh = HULL;
   int HullMode = REFIT;
   double MatchingTolerance = 0.01;
   double DeformableShare = 0.6;

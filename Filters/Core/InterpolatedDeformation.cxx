@@ -221,6 +221,233 @@ int ResolveNumberOfSteps(const std::vector<BoneMotion>& bones, const Interpolati
 
 namespace
 {
+/// The hull-based pass through a motion (the paper's deformation, HullMode): each muscle's hull,
+/// the mean value coordinates of its points in it, and the per-point detail the hull does not carry.
+struct HullPass
+{
+  std::vector<TriangleMesh> hulls;
+  std::vector<const WeightMatrix*> weights;
+  std::vector<WeightMatrix> rebuiltWeights;
+  std::vector<std::unique_ptr<HullRefitter>> refitters; ///< HullMode::Refit's
+  std::vector<Points> details;
+  std::vector<std::vector<std::vector<char>>> boneOverlap; ///< [muscle][bone][point]: rest-pose overlap
+  DeformationParameters step;
+};
+
+/// The rest-pose hulls (the muscles in parallel) and mappings (each in parallel inside), or those
+/// an earlier run left in `kept` where they still hold; their time is added to `seconds[m]`.
+HullPass PrepareHullPass(const std::vector<MuscleMotion>& muscles, const InterpolationParameters& parameters,
+  RestMappingCache* kept, std::vector<double>& seconds, const std::function<void(double)>& report)
+{
+  const size_t count = muscles.size();
+  RestMappingCache scratch;
+  RestMappingCache& rest = kept ? *kept : scratch;
+  rest.muscles.resize(count);
+  std::vector<const Points*> restPointers(count);
+  std::vector<char> build(count, 0);
+  for (size_t m = 0; m < count; ++m)
+  {
+    const RestMappingCache::Entry& entry = rest.muscles[m];
+    restPointers[m] = &muscles[m].muscle.points;
+    build[m] = entry.weights.size() == 0 || !SameMesh(entry.surface, muscles[m].muscle) ||
+      !entry.hull.SameHullAs(parameters.hull);
+  }
+  std::vector<std::string> errors;
+  std::vector<TriangleMesh> built = BuildHulls(muscles, restPointers, parameters.hull, errors, seconds, &build);
+  for (size_t m = 0; m < count; ++m)
+  {
+    RestMappingCache::Entry& entry = rest.muscles[m];
+    if (build[m])
+    {
+      entry = RestMappingCache::Entry{};
+    }
+    if (build[m] && errors[m].empty())
+    {
+      const auto mappingStart = Clock::now();
+      entry.surface = muscles[m].muscle;
+      entry.hull = parameters.hull;
+      entry.hull.cancelled = nullptr;
+      entry.restHull = std::move(built[m]);
+      try
+      {
+        entry.weights = MeanValueCoordinates(entry.restHull, muscles[m].muscle.points);
+      }
+      catch (const InputError& e)
+      {
+        errors[m] = "muscle '" + muscles[m].name + "': " + e.what();
+        entry = RestMappingCache::Entry{};
+        continue;
+      }
+      ++rest.hullBuildCount;
+      seconds[m] += SecondsSince(mappingStart);
+    }
+    report(0.15 * (m + 1) / count);
+  }
+  for (size_t m = 0; m < count; ++m)
+  {
+    if (!errors[m].empty())
+    {
+      throw OfMuscle(InputError(errors[m]), m);
+    }
+  }
+  // Rebuild replaces hulls and weights; Refit moves only the hull's points.
+  HullPass pass;
+  pass.hulls.resize(count);
+  pass.weights.resize(count);
+  pass.rebuiltWeights.resize(count);
+  pass.refitters.resize(count);
+  pass.details.resize(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    const auto mappingStart = Clock::now();
+    pass.hulls[m] = rest.muscles[m].restHull;
+    pass.weights[m] = &rest.muscles[m].weights;
+    pass.details[m] = muscles[m].muscle.points - *pass.weights[m] * pass.hulls[m].points;
+    if (parameters.hullMode == HullMode::Refit)
+    {
+      pass.refitters[m] =
+        std::make_unique<HullRefitter>(*pass.weights[m], pass.hulls[m], parameters.refitRegularisation);
+    }
+    seconds[m] += SecondsSince(mappingStart);
+    report(0.15 + 0.05 * (m + 1) / count);
+  }
+  pass.step = parameters.deformation;
+  pass.step.measureSamplesInside = false; // not part of the method's measures
+  return pass;
+}
+
+/// Step j of the hull-based pass: with HullMode::Rebuild a new hull and mapping of each muscle as
+/// it is now (the paper), then the muscles deformed together from `current`.
+std::vector<DeformationResult> DeformHullStep(HullPass& pass, int j, int steps,
+  const std::vector<MuscleMotion>& muscles, const std::vector<std::vector<PoseInterpolator>>& lineMotions,
+  const std::vector<TriangleMesh>& current, const std::vector<double>& restVolumes,
+  const std::vector<Obstacle>& obstacles, const InterpolationParameters& parameters,
+  std::vector<MuscleStepMeasures>& measures, std::vector<std::string>& warnings,
+  const std::function<void(double)>& progress)
+{
+  const size_t count = muscles.size();
+  if (parameters.hullMode == HullMode::Rebuild && j > 1)
+  {
+    std::vector<const Points*> currentPointers(count);
+    for (size_t m = 0; m < count; ++m)
+    {
+      currentPointers[m] = &current[m].points;
+    }
+    std::vector<std::string> failures;
+    std::vector<double> seconds;
+    std::vector<TriangleMesh> rebuilt = BuildHulls(muscles, currentPointers, parameters.hull, failures, seconds);
+    for (size_t m = 0; m < count; ++m)
+    {
+      const auto mappingStart = Clock::now();
+      if (failures[m].empty() && !CheckEdges(rebuilt[m].triangles).IsClosedOrientedManifold())
+      {
+        failures[m] = "the rebuilt hull is not a closed manifold surface";
+      }
+      if (failures[m].empty())
+      {
+        pass.hulls[m] = std::move(rebuilt[m]);
+        pass.rebuiltWeights[m] = MeanValueCoordinates(pass.hulls[m], current[m].points);
+        pass.weights[m] = &pass.rebuiltWeights[m];
+        pass.details[m] = current[m].points - *pass.weights[m] * pass.hulls[m].points;
+      }
+      else
+      {
+        warnings.push_back("step " + std::to_string(j) + ": the hull of muscle '" + muscles[m].name +
+          "' could not be rebuilt (" + failures[m] + "); the previous step's hull is kept");
+      }
+      measures[m].hullSeconds = seconds[m] + SecondsSince(mappingStart);
+    }
+  }
+  std::vector<MuscleToDeform> toDeform(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    MuscleToDeform& d = toDeform[m];
+    d.name = muscles[m].name;
+    d.muscle = &current[m];
+    d.hull = &pass.hulls[m];
+    d.weights = pass.weights[m];
+    d.detail = &pass.details[m];
+    d.targetVolume = restVolumes[m];
+    d.reference = &muscles[m].muscle.points; // folds an earlier step left are undone too
+    d.boneOverlap = &pass.boneOverlap[m];
+    for (const PoseInterpolator& line : lineMotions[m])
+    {
+      d.lines.push_back({ line.AtStep(j - 1, steps), line.AtStep(j, steps) });
+    }
+  }
+  return DeformMuscles(toDeform, obstacles, pass.step, progress);
+}
+
+/// After a step's static resolution and volume: each hull brought to the muscle it now maps
+/// (refitted, or the deformed hull with Rebuild) and the rest kept as relaxed detail.
+void RefitHulls(HullPass& pass, const std::vector<TriangleMesh>& resolved,
+  const std::vector<DeformationResult>& deformed, const std::vector<MuscleMotion>& muscles,
+  const InterpolationParameters& parameters, std::vector<MuscleStepMeasures>& measures)
+{
+  for (size_t m = 0; m < resolved.size(); ++m)
+  {
+    const auto hullStart = Clock::now();
+    pass.hulls[m].points = parameters.hullMode == HullMode::Refit
+      ? pass.refitters[m]->Fit(resolved[m].points, deformed[m].hullPoints)
+      : deformed[m].hullPoints;
+    pass.details[m] = resolved[m].points - *pass.weights[m] * pass.hulls[m].points;
+    RelaxDetail(muscles[m].muscle.triangles, parameters.detailRelaxation, pass.details[m]);
+    measures[m].hullSeconds += SecondsSince(hullStart);
+  }
+}
+
+/// The full-mesh energy of every muscle in the rest pose (SurfaceEnergy), the muscles in
+/// parallel; `restLines[m]` receives each muscle's matched lines at step 0 and `seconds[m]`
+/// the time of its energy.
+std::vector<std::unique_ptr<SurfaceEnergy>> BuildEnergies(const std::vector<MuscleMotion>& muscles,
+  const std::vector<std::vector<PoseInterpolator>>& lineMotions, int steps, const SettleParameters& parameters,
+  std::vector<std::vector<Points>>& restLines, std::vector<double>& seconds, const std::function<void(double)>& report)
+{
+  const size_t count = muscles.size();
+  std::vector<std::unique_ptr<SurfaceEnergy>> energies(count);
+  std::vector<std::exception_ptr> failed(count); // no exception may leave a parallel region
+  for (size_t m = 0; m < count; ++m)
+  {
+    for (const PoseInterpolator& line : lineMotions[m])
+    {
+      restLines[m].push_back(line.AtStep(0, steps));
+    }
+  }
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int k = 0; k < static_cast<int>(count); ++k)
+  {
+    const size_t m = static_cast<size_t>(k);
+    const auto energyStart = Clock::now();
+    try
+    {
+      energies[m] = std::make_unique<SurfaceEnergy>(muscles[m].muscle, restLines[m], parameters);
+    }
+    catch (const InputError& e)
+    {
+      failed[m] = std::make_exception_ptr(OfMuscle(InputError("muscle '" + muscles[m].name + "': " + e.what()), m));
+    }
+    catch (const ComputationError& e)
+    {
+      failed[m] =
+        std::make_exception_ptr(OfMuscle(ComputationError("muscle '" + muscles[m].name + "': " + e.what()), m));
+    }
+    catch (...)
+    {
+      failed[m] = std::current_exception();
+    }
+    seconds[m] += SecondsSince(energyStart);
+  }
+  for (const std::exception_ptr& failure : failed)
+  {
+    if (failure)
+    {
+      std::rethrow_exception(failure);
+    }
+  }
+  report(0.2);
+  return energies;
+}
+
 /// DeformByInterpolation on input already in its local frame.
 InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles, const std::vector<BoneMotion>& bones,
   const InterpolationParameters& parameters, const std::function<void(double)>& progress, RestMappingCache* kept)
@@ -289,79 +516,16 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
     }
   }
 
-  // The rest-pose hulls (the muscles in parallel) and mappings (each in parallel inside), or
-  // those an earlier run left in `kept` where they still hold.
-  RestMappingCache scratch;
-  RestMappingCache& rest = kept ? *kept : scratch;
-  rest.muscles.resize(count);
-  std::vector<const Points*> restPointers(count);
-  std::vector<char> build(count, 0);
-  for (size_t m = 0; m < count; ++m)
-  {
-    const RestMappingCache::Entry& entry = rest.muscles[m];
-    restPointers[m] = &muscles[m].muscle.points;
-    build[m] = entry.weights.size() == 0 || !SameMesh(entry.surface, muscles[m].muscle) ||
-      !entry.hull.SameHullAs(parameters.hull);
-  }
-  std::vector<std::string> errors;
-  std::vector<TriangleMesh> built =
-    BuildHulls(muscles, restPointers, parameters.hull, errors, result.restHullSeconds, &build);
-  for (size_t m = 0; m < count; ++m)
-  {
-    RestMappingCache::Entry& entry = rest.muscles[m];
-    if (build[m])
-    {
-      entry = RestMappingCache::Entry{};
-    }
-    if (build[m] && errors[m].empty())
-    {
-      const auto mappingStart = Clock::now();
-      entry.surface = muscles[m].muscle;
-      entry.hull = parameters.hull;
-      entry.hull.cancelled = nullptr;
-      entry.restHull = std::move(built[m]);
-      try
-      {
-        entry.weights = MeanValueCoordinates(entry.restHull, muscles[m].muscle.points);
-      }
-      catch (const InputError& e)
-      {
-        errors[m] = "muscle '" + muscles[m].name + "': " + e.what();
-        entry = RestMappingCache::Entry{};
-        continue;
-      }
-      ++rest.hullBuildCount;
-      result.restHullSeconds[m] += SecondsSince(mappingStart);
-    }
-    report(0.15 * (m + 1) / count);
-  }
-  for (size_t m = 0; m < count; ++m)
-  {
-    if (!errors[m].empty())
-    {
-      throw OfMuscle(InputError(errors[m]), m);
-    }
-  }
-  // Rebuild replaces hulls and weights; Refit moves only the hull's points.
-  std::vector<TriangleMesh> hulls(count);
-  std::vector<const WeightMatrix*> weights(count);
-  std::vector<WeightMatrix> rebuiltWeights(count);
-  std::vector<std::unique_ptr<HullRefitter>> refitters(count);
-  std::vector<Points> details(count);
   std::vector<double> restVolumes(count);
   for (size_t m = 0; m < count; ++m)
   {
-    const auto mappingStart = Clock::now();
-    hulls[m] = rest.muscles[m].restHull;
-    weights[m] = &rest.muscles[m].weights;
-    details[m] = muscles[m].muscle.points - *weights[m] * hulls[m].points;
-    if (parameters.hullMode == HullMode::Refit)
-    {
-      refitters[m] = std::make_unique<HullRefitter>(*weights[m], hulls[m], parameters.refitRegularisation);
-    }
     restVolumes[m] = EnclosedVolume(muscles[m].muscle.points, muscles[m].muscle.triangles);
-    result.restHullSeconds[m] += SecondsSince(mappingStart);
-    report(0.15 + 0.05 * (m + 1) / count);
+  }
+  const bool settle = parameters.settleOnSurface;
+  HullPass hullPass;
+  if (!settle)
+  {
+    hullPass = PrepareHullPass(muscles, parameters, kept, result.restHullSeconds, report);
   }
 
   // The bones' hierarchies, built once in the rest pose and refitted to the
@@ -377,68 +541,43 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
     }
     return meshes;
   }());
-  auto fixedObstacles = [](const std::vector<Obstacle>& obstacles) {
-    std::vector<FixedObstacle> fixed;
-    for (const Obstacle& o : obstacles)
-    {
-      fixed.push_back({ o.name, o.tree.get() });
-    }
-    return fixed;
-  };
+  std::vector<FixedObstacle> fixed;
+  for (const Obstacle& o : obstacles)
+  {
+    fixed.push_back({ o.name, o.tree.get() });
+  }
   std::vector<TriangleMesh> current(count);
   for (size_t m = 0; m < count; ++m)
   {
     current[m] = muscles[m].muscle;
   }
-  const OverlapMasks restOverlap = FindOverlaps(current, fixedObstacles(obstacles));
-  const std::vector<FixedObstacle> fixed = fixedObstacles(obstacles);
+  const OverlapMasks restOverlap = FindOverlaps(current, fixed);
 
-  // The full-mesh energies (rest pose only), kept for every step.
-  std::vector<std::unique_ptr<SurfaceEnergy>> energies(count);
+  // The full-mesh energies (rest pose only), kept for every step; each step's settle goes on
+  // from the last one's answer (from the rest pose at the first), so the answer depends
+  // continuously on the input and not at all on a hull (docs/DESIGN.md section 7).
+  std::vector<std::unique_ptr<SurfaceEnergy>> energies;
+  std::vector<const SurfaceEnergy*> energyPointers;
   std::vector<std::vector<Points>> restLines(count); // the matched lines at step 0
-  if (parameters.settleOnSurface)
-  {
-    for (size_t m = 0; m < count; ++m)
-    {
-      for (const PoseInterpolator& line : lineMotions[m])
-      {
-        restLines[m].push_back(line.AtStep(0, steps));
-      }
-      try
-      {
-        energies[m] = std::make_unique<SurfaceEnergy>(muscles[m].muscle, restLines[m], parameters.settle);
-      }
-      catch (const InputError& e)
-      {
-        throw OfMuscle(InputError("muscle '" + muscles[m].name + "': " + e.what()), m);
-      }
-      catch (const ComputationError& e)
-      {
-        throw OfMuscle(ComputationError("muscle '" + muscles[m].name + "': " + e.what()), m);
-      }
-    }
-  }
-
-  // Each step's settle goes on from the last one's answer (from the rest pose at the first):
-  // the hull-based pass's answer is not its start, so the settled answer does not depend on
-  // the hull at all, and depends continuously on the input (docs/DESIGN.md section 7).
-  std::vector<const SurfaceEnergy*> energyPointers(count);
   SettleMotion settleMotion;
-  if (parameters.settleOnSurface)
+  if (settle)
   {
-    for (size_t m = 0; m < count; ++m)
+    energies = BuildEnergies(muscles, lineMotions, steps, parameters.settle, restLines, result.restHullSeconds, report);
+    for (const std::unique_ptr<SurfaceEnergy>& energy : energies)
     {
-      energyPointers[m] = energies[m].get();
+      energyPointers.push_back(energy.get());
     }
     settleMotion = StartMotion(current, energyPointers, restLines, fixed);
   }
-  DeformationParameters stepParameters = parameters.deformation;
-  stepParameters.measureSamplesInside = false; // not part of the method's measures
-  // Contact rows leave the rest pose's overlap with each bone alone.
-  std::vector<std::vector<std::vector<char>>> boneOverlap(count);
-  for (size_t m = 0; m < count; ++m)
+  else
   {
-    boneOverlap[m].assign(restOverlap[m].begin(), restOverlap[m].begin() + static_cast<std::ptrdiff_t>(bones.size()));
+    // Contact rows leave the rest pose's overlap with each bone alone.
+    hullPass.boneOverlap.resize(count);
+    for (size_t m = 0; m < count; ++m)
+    {
+      hullPass.boneOverlap[m].assign(
+        restOverlap[m].begin(), restOverlap[m].begin() + static_cast<std::ptrdiff_t>(bones.size()));
+    }
   }
   double stepStart = 0.2;
   const double stepShare = 0.8 / steps;
@@ -454,84 +593,39 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
     }
 
     std::vector<MuscleStepMeasures> measures(count);
-    if (parameters.hullMode == HullMode::Rebuild && j > 1)
-    {
-      // The paper: a new hull and mapping of each muscle as it is now.
-      std::vector<const Points*> currentPointers(count);
-      for (size_t m = 0; m < count; ++m)
-      {
-        currentPointers[m] = &current[m].points;
-      }
-      std::vector<std::string> failures;
-      std::vector<double> seconds;
-      std::vector<TriangleMesh> rebuilt = BuildHulls(muscles, currentPointers, parameters.hull, failures, seconds);
-      for (size_t m = 0; m < count; ++m)
-      {
-        const auto mappingStart = Clock::now();
-        if (failures[m].empty() && !CheckEdges(rebuilt[m].triangles).IsClosedOrientedManifold())
-        {
-          failures[m] = "the rebuilt hull is not a closed manifold surface";
-        }
-        if (failures[m].empty())
-        {
-          hulls[m] = std::move(rebuilt[m]);
-          rebuiltWeights[m] = MeanValueCoordinates(hulls[m], current[m].points);
-          weights[m] = &rebuiltWeights[m];
-          details[m] = current[m].points - *weights[m] * hulls[m].points;
-        }
-        else
-        {
-          result.warnings.push_back("step " + std::to_string(j) + ": the hull of muscle '" + muscles[m].name +
-            "' could not be rebuilt (" + failures[m] + "); the previous step's hull is kept");
-        }
-        measures[m].hullSeconds = seconds[m] + SecondsSince(mappingStart);
-      }
-    }
-    std::vector<MuscleToDeform> toDeform(count);
-    for (size_t m = 0; m < count; ++m)
-    {
-      MuscleToDeform& d = toDeform[m];
-      d.name = muscles[m].name;
-      d.muscle = &current[m];
-      d.hull = &hulls[m];
-      d.weights = weights[m];
-      d.detail = &details[m];
-      d.targetVolume = restVolumes[m];
-      d.reference = &muscles[m].muscle.points; // folds an earlier step left are undone too
-      d.boneOverlap = &boneOverlap[m];
-      for (const PoseInterpolator& line : lineMotions[m])
-      {
-        d.lines.push_back({ line.AtStep(j - 1, steps), line.AtStep(j, steps) });
-      }
-    }
-
-    const std::vector<DeformationResult> deformed = DeformMuscles(
-      toDeform, obstacles, stepParameters, [&](double fraction) { report(stepStart + 0.9 * stepShare * fraction); });
     std::vector<TriangleMesh> next(count);
-    for (size_t m = 0; m < count; ++m)
-    {
-      next[m] = { deformed[m].points, muscles[m].muscle.triangles };
-      for (const std::string& warning : deformed[m].warnings)
-      {
-        if (warned.insert(warning).second) // said once, at the first step that has it
-        {
-          result.warnings.push_back("step " + std::to_string(j) + ": " + warning);
-        }
-      }
-    }
+    std::vector<DeformationResult> deformed(count); // the hull-based pass's
     std::vector<SettleReport> settled(count);
-    if (parameters.settleOnSurface)
+    if (settle)
     {
       std::vector<std::vector<MatchedLine>> wholeMotion(count); // rest pose -> this step
       for (size_t m = 0; m < count; ++m)
       {
+        next[m].triangles = muscles[m].muscle.triangles; // the points come from settleMotion
+        next[m].points = current[m].points;
         for (size_t l = 0; l < lineMotions[m].size(); ++l)
         {
           wholeMotion[m].push_back({ restLines[m][l], lineMotions[m][l].AtStep(j, steps) });
         }
       }
-      settled = SettleMuscles(
-        next, energyPointers, wholeMotion, restVolumes, fixed, &restOverlap, parameters.settle, &settleMotion);
+      settled = SettleMuscles(next, energyPointers, wholeMotion, restVolumes, fixed, &restOverlap, parameters.settle,
+        &settleMotion, [&](double fraction) { report(stepStart + 0.9 * stepShare * fraction); });
+    }
+    else
+    {
+      deformed = DeformHullStep(hullPass, j, steps, muscles, lineMotions, current, restVolumes, obstacles, parameters,
+        measures, result.warnings, [&](double fraction) { report(stepStart + 0.9 * stepShare * fraction); });
+      for (size_t m = 0; m < count; ++m)
+      {
+        next[m] = { deformed[m].points, muscles[m].muscle.triangles };
+        for (const std::string& warning : deformed[m].warnings)
+        {
+          if (warned.insert(warning).second) // said once, at the first step that has it
+          {
+            result.warnings.push_back("step " + std::to_string(j) + ": " + warning);
+          }
+        }
+      }
     }
     StaticResolveResult resolved = ResolveStaticIntersections(next, fixed, &restOverlap, parameters.staticResolve);
     // The volume is given back over the whole surface, except at the overlap
@@ -554,15 +648,9 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
     {
       RestoreVolumes(next, restVolumes, fixed, held);
     }
-    for (size_t m = 0; m < count; ++m)
+    if (!settle)
     {
-      const auto hullStart = Clock::now();
-      hulls[m].points = parameters.hullMode == HullMode::Refit
-        ? refitters[m]->Fit(next[m].points, deformed[m].hullPoints)
-        : deformed[m].hullPoints;
-      details[m] = next[m].points - *weights[m] * hulls[m].points;
-      RelaxDetail(muscles[m].muscle.triangles, parameters.detailRelaxation, details[m]);
-      measures[m].hullSeconds += SecondsSince(hullStart);
+      RefitHulls(hullPass, next, deformed, muscles, parameters, measures);
     }
     const std::vector<Penetration> penetration = MeasureNewPenetration(next, fixed, &restOverlap);
 
@@ -582,13 +670,11 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       s.staticallyMovedPoints = resolved.reports[m].penetratingPoints;
       s.sharpEdgeCount = CountNewSharpEdges(rest.points, next[m].points, rest.triangles);
       s.flippedTriangleCount = CountFlippedTriangles(rest.points, next[m].points, rest.triangles);
-      s.stepIterations = deformed[m].iterations;
+      s.stepIterations = settle ? settled[m].iterations : deformed[m].iterations;
       s.iterations = previous[m].iterations + s.stepIterations;
-      s.converged = previous[m].converged && deformed[m].converged;
+      s.converged = previous[m].converged && (settle ? settled[m].converged : deformed[m].converged);
       s.pointsFrozenInObstacles = deformed[m].verticesFrozen;
-      s.settleIterations = settled[m].iterations;
-      s.settled = previous[m].settled && (!parameters.settleOnSurface || settled[m].converged);
-      s.deformationSeconds = deformed[m].seconds + settled[m].seconds;
+      s.deformationSeconds = settle ? settled[m].seconds : deformed[m].seconds;
       s.staticShift = std::move(resolved.shift[m]);
       stepPoints[m] = next[m].points;
     }

@@ -122,8 +122,6 @@ struct MuscleStepMeasures
   int iterations = 0;                       ///< steps 1..j
   bool converged = true;                    ///< every step so far
   std::int64_t pointsFrozenInObstacles = 0; ///< this step
-  int settleIterations = 0;                 ///< this step's full-mesh iterations
-  bool settled = true;                      ///< every step's full-mesh settle so far converged
   double hullSeconds = 0;                   ///< this step's hull work: refit, or rebuild and mapping
   double deformationSeconds = 0;            ///< this step's deformation and static resolution (its share)
   Points staticShift;                       ///< this step's static move, per point

@@ -108,6 +108,15 @@ SurfaceEnergy::SurfaceEnergy(
   {
     throw InputError("the surface has no triangles");
   }
+  // The volume and the inside of the muscle need a closed surface (the hull-based pass needs
+  // one too: its hull cannot enclose an open one). Scans' few edges shared by four triangles
+  // (two sheets touching) do no harm.
+  const EdgeReport edges = CheckEdges(this->Welded);
+  if (!edges.Closed())
+  {
+    throw InputError("its surface is open: " + std::to_string(edges.boundaryEdges) +
+      " edges border a hole; close it (e.g. Fill Holes) before deforming it");
+  }
 
   // The action-line samples inside the rest muscle, as sparse rows.
   Points samples, unused;
@@ -244,9 +253,60 @@ void SurfaceEnergy::CarryToUnwelded(const Points& start, Points& settled) const
   }
 }
 
+namespace
+{
+/// Overwrites the rows of `y` (the factor's order) by (L D L^T)^-1 y, every column at once: the
+/// columns share one pass over L, which is what the solve's time goes on (the order of the
+/// arithmetic is that of Eigen's own solve, column by column). The forward pass skips the rows
+/// still zero: for a unit vector it touches only the points the elimination reaches.
+template<class Rows>
+void SolveFactored(
+  const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& lower, const Eigen::VectorXd& diagonal, Rows& y)
+{
+  const Eigen::Index n = lower.cols();
+  const auto* start = lower.outerIndexPtr();
+  const auto* row = lower.innerIndexPtr();
+  const double* value = lower.valuePtr();
+  for (Eigen::Index j = 0; j < n; ++j)
+  {
+    if ((y.row(j).array() == 0.0).all())
+    {
+      continue;
+    }
+    for (auto k = start[j]; k < start[j + 1]; ++k)
+    {
+      y.row(row[k]) -= value[k] * y.row(j);
+    }
+  }
+  for (Eigen::Index j = 0; j < n; ++j)
+  {
+    y.row(j) *= 1.0 / diagonal(j);
+  }
+  for (Eigen::Index j = n - 1; j >= 0; --j)
+  {
+    for (auto k = start[j]; k < start[j + 1]; ++k)
+    {
+      y.row(j) -= value[k] * y.row(row[k]);
+    }
+  }
+}
+}
+
 Points SurfaceEnergy::Solve(const Points& rhs) const
 {
-  return this->Factor.solve(Eigen::MatrixXd(rhs));
+  const auto& order = this->Factor.permutationP().indices();
+  Points y(rhs.rows(), 3);
+  for (Eigen::Index i = 0; i < rhs.rows(); ++i)
+  {
+    y.row(order(i)) = rhs.row(i);
+  }
+  SolveFactored(this->Factor.matrixL().nestedExpression(), this->Factor.vectorD(), y);
+  Points x(rhs.rows(), 3);
+  for (Eigen::Index i = 0; i < rhs.rows(); ++i)
+  {
+    x.row(i) = y.row(order(i));
+  }
+  return x;
 }
 
 void SurfaceEnergy::Prepare(const std::vector<Eigen::Index>& points) const
@@ -261,11 +321,33 @@ void SurfaceEnergy::Prepare(const std::vector<Eigen::Index>& points) const
   }
   std::sort(missing.begin(), missing.end());
   missing.erase(std::unique(missing.begin(), missing.end()), missing.end());
+  // In blocks of columns, each block one pass over the factor.
+  constexpr int kBlock = 8;
+  using Block = Eigen::Matrix<double, Eigen::Dynamic, kBlock, Eigen::RowMajor>;
+  const Eigen::Index n = this->Normal.rows();
+  const auto& order = this->Factor.permutationP().indices();
+  const int blocks = static_cast<int>((missing.size() + kBlock - 1) / kBlock);
   std::vector<Eigen::VectorXd> solved(missing.size());
-#pragma omp parallel for schedule(dynamic, 4)
-  for (int k = 0; k < static_cast<int>(missing.size()); ++k)
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int b = 0; b < blocks; ++b)
   {
-    solved[k] = this->Factor.solve(Eigen::VectorXd::Unit(this->Normal.rows(), missing[k]));
+    const size_t first = static_cast<size_t>(b) * kBlock;
+    const size_t width = std::min<size_t>(kBlock, missing.size() - first);
+    Block y = Block::Zero(n, kBlock);
+    for (size_t k = 0; k < width; ++k)
+    {
+      y(order(missing[first + k]), static_cast<Eigen::Index>(k)) = 1.0;
+    }
+    SolveFactored(this->Factor.matrixL().nestedExpression(), this->Factor.vectorD(), y);
+    for (size_t k = 0; k < width; ++k)
+    {
+      Eigen::VectorXd& column = solved[first + k];
+      column.resize(n);
+      for (Eigen::Index i = 0; i < n; ++i)
+      {
+        column(i) = y(order(i), static_cast<Eigen::Index>(k));
+      }
+    }
   }
   for (size_t k = 0; k < missing.size(); ++k)
   {
@@ -582,7 +664,7 @@ SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::ve
 std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   const std::vector<const SurfaceEnergy*>& energies, const std::vector<std::vector<MatchedLine>>& lines,
   const std::vector<double>& volumes, const std::vector<FixedObstacle>& bones, const OverlapMasks* restOverlap,
-  const SettleParameters& parameters, SettleMotion* motion)
+  const SettleParameters& parameters, SettleMotion* motion, const std::function<void(double)>& progress)
 {
   // Sequential quadratic programming: at each iteration the volume and the obstacles' surfaces
   // are linearised at the current points, and the quadratic energy is minimised exactly under
@@ -596,7 +678,8 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   const size_t count = muscles.size();
   const size_t obstacles = bones.size() + count;
   std::vector<Points> free(count); // the minimum without contact and volume
-  for (size_t m = 0; m < count; ++m)
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int m = 0; m < static_cast<int>(count); ++m)
   {
     free[m] = energies[m]->Solve(energies[m]->RightHandSide(lines[m], bones));
   }
@@ -669,6 +752,11 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     for (size_t m = 0; m < count; ++m)
     {
       energies[m]->Prepare(needed[m]);
+    }
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int k = 0; k < static_cast<int>(count); ++k)
+    {
+      const size_t m = static_cast<size_t>(k);
       volumeNow[m] = EnclosedVolume(meshes[m].points, meshes[m].triangles, &gradients[m]);
       along[m] = energies[m]->Solve(gradients[m]);
       // g . x_new = V - V(x) + g . x, the volume's linearisation at x.
@@ -782,6 +870,10 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     }
     held = std::move(nowHeld);
     diverging = farMoves >= kFarMovesToStop;
+    if (progress)
+    {
+      progress(static_cast<double>(iteration + 1) / std::max(1, parameters.maximumIterations));
+    }
   }
   // A settle that diverged leaves the muscles where they started (the hull-based answer) rather
   // than at an iterate that means nothing; one that ran out of iterations keeps its last.

@@ -9,7 +9,7 @@
 // inside a bone or another muscle, each linearised as a half-space at its
 // nearest surface point, and the constrained minimum is found by an active set
 // on the constraints' multipliers with the energy's matrix factorised once per
-// muscle (for a whole motion). Experimental and off by default
+// muscle (for a whole motion). The interpolation method's default
 // (InterpolationParameters::settleOnSurface).
 #pragma once
 
@@ -18,6 +18,8 @@
 #include "VolumeConstrainedSolver.h"
 
 #include <Eigen/SparseCholesky>
+
+#include <functional>
 
 #include <unordered_map>
 #include <vector>
@@ -153,8 +155,10 @@ SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::ve
 /// and leaves every muscle at its starting points, also with `converged` false.
 /// With `motion` (a step of a motion, StartMotion at the first), the muscles' points in are
 /// not read: the settle starts where `motion` says, and `motion` is moved on to where it ends.
+/// `progress` (optional) receives the share of SettleParameters::maximumIterations done after
+/// each iteration; it may throw (Cancelled) to stop the settle.
 std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   const std::vector<const SurfaceEnergy*>& energies, const std::vector<std::vector<MatchedLine>>& lines,
   const std::vector<double>& volumes, const std::vector<FixedObstacle>& bones, const OverlapMasks* restOverlap,
-  const SettleParameters& parameters, SettleMotion* motion = nullptr);
+  const SettleParameters& parameters, SettleMotion* motion = nullptr, const std::function<void(double)>& progress = {});
 }

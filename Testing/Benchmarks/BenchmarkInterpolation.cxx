@@ -9,7 +9,7 @@
 // Prints figures; asserts nothing (see the tests).
 //
 //   BenchmarkInterpolation [data folder] [number of steps] [phantom flexion]
-//   [all|one-pass|refit|rebuild|refit-paper-step]
+//   [all|one-pass|refit|rebuild|refit-paper-step|settle]
 //                          [LHDL motion] [frame]      (default hip_flexion 35: 60 degrees of flexion)
 //                          [perturbation]  (-1: none, the default; 0: inputs rounded to float; s > 0: rounded
 //                                           after a seeded random move of 1e-7 of each coordinate)
@@ -21,12 +21,14 @@
 
 namespace
 {
-void Run(const MotionCase& c, const char* label, int steps, md::HullMode mode, double contactWeight)
+void Run(const MotionCase& c, const char* label, int steps, md::HullMode mode, double contactWeight,
+  bool settleOnSurface = false)
 {
   md::InterpolationParameters parameters;
   parameters.numberOfSteps = steps;
   parameters.hullMode = mode;
   parameters.deformation.contactWeight = contactWeight;
+  parameters.settleOnSurface = settleOnSurface;
   md::InterpolationResult r;
   try
   {
@@ -86,6 +88,13 @@ void Run(const MotionCase& c, const char* label, int steps, md::HullMode mode, d
   {
     std::printf("  warning: %s\n", w.c_str());
   }
+  for (const std::string& f : r.failures)
+  {
+    if (!f.empty())
+    {
+      std::printf("  FAILED: %s\n", f.c_str());
+    }
+  }
 }
 
 /// `runs`: "all", or one of "one-pass", "refit", "rebuild", "refit-paper-step"
@@ -112,6 +121,10 @@ void Compare(const MotionCase& c, int steps, const std::string& runs)
   {
     Run(c, "interpolation, Refit, paper's step", steps, md::HullMode::Refit, 0.0);
   }
+  if (runs == "all" || runs == "settle")
+  {
+    Run(c, "interpolation, settled on the full mesh", steps, md::HullMode::Refit, contact, true);
+  }
 }
 }
 
@@ -125,9 +138,10 @@ int main(int argc, char* argv[])
               "(> 60 deg), flipped triangles, iterations, converged in every step, points frozen in bones\n"
               "(summed over steps).\n");
   const std::string runs = argc > 4 ? argv[4] : "all";
-  if (runs != "all" && runs != "one-pass" && runs != "refit" && runs != "rebuild" && runs != "refit-paper-step")
+  if (runs != "all" && runs != "one-pass" && runs != "refit" && runs != "rebuild" && runs != "refit-paper-step" &&
+    runs != "settle")
   {
-    std::fprintf(stderr, "unknown run '%s': all, one-pass, refit, rebuild or refit-paper-step\n", runs.c_str());
+    std::fprintf(stderr, "unknown run '%s': all, one-pass, refit, rebuild, refit-paper-step or settle\n", runs.c_str());
     return 2;
   }
   Compare(PhantomMotion(argc > 3 ? std::atof(argv[3]) : 30), steps, runs);

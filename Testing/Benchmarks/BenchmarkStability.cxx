@@ -58,7 +58,7 @@ Output Run(const MotionCase& c, const Method& method, int hullPoints, md::RestMa
     {
       for (const md::MuscleStepMeasures& measures : r.measures[j])
       {
-        if (!measures.settled)
+        if (!measures.converged)
         {
           out.unsettledStep = static_cast<int>(j);
         }

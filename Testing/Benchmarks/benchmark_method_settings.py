@@ -3,11 +3,13 @@
 
     pvpython Testing/Benchmarks/benchmark_method_settings.py [data folder]
 
-The LHDL hip (four muscles, flexion frame 35, as the main job) through the whole method: the
-first run (rest-pose hulls and mappings built), then a change of NumberOfSteps, of
-BoneContactWeight and of ConvergenceTolerance (hulls kept: only the steps are computed), then of
-HullTargetNumberOfPoints (every hull built again). Prints each run's seconds (FilterTests counts
-the hulls: InterpolatedMuscleDeformationFilter.RestHullsAreKept...). Asserts nothing.
+The LHDL hip (four muscles, flexion frame 35, as the main job) through the whole method, with
+each DeformationMesh: solved on the muscles' surfaces (the default), the first run and a change
+of NumberOfSteps; solved on hulls (the paper's), the first run (rest-pose hulls and mappings
+built), then a change of NumberOfSteps, of BoneContactWeight and of ConvergenceTolerance (hulls
+kept: only the steps are computed), then of HullTargetNumberOfPoints (every hull built again).
+Prints each run's seconds (FilterTests counts the hulls:
+InterpolatedMuscleDeformationFilter.RestHullsAreKept...). Asserts nothing.
 """
 import os
 import sys
@@ -28,21 +30,28 @@ if not data or not os.path.isdir(folder):
 import lhdl  # noqa: E402
 
 inputs = lhdl.load(folder)
-method = simple.InterpolatedMuscleDeformation(
-    Input=inputs["muscles"], BonesRest=inputs["bones_rest"], BonesCurrent=inputs["bones_current"],
-    ActionLinesRest=inputs["lines_rest"], ActionLinesCurrent=inputs["lines_current"], NumberOfSteps=4)
 for source in inputs.values():
     if hasattr(source, "UpdatePipeline"):
         source.UpdatePipeline()
-changes = [("first run", None, None), ("NumberOfSteps 4 -> 3", "NumberOfSteps", 3),
-           ("BoneContactWeight 0.5 -> 0.25", "BoneContactWeight", 0.25),
-           ("ConvergenceTolerance 0.01 -> 0.005", "ConvergenceTolerance", 0.005),
-           ("HullTargetNumberOfPoints 250 -> 200", "HullTargetNumberOfPoints", 200)]
+runs = {
+    "Muscle surface": [("first run", None, None), ("NumberOfSteps 4 -> 3", "NumberOfSteps", 3)],
+    "Hull (paper)": [("first run", None, None), ("NumberOfSteps 4 -> 3", "NumberOfSteps", 3),
+                     ("BoneContactWeight 0.5 -> 0.25", "BoneContactWeight", 0.25),
+                     ("ConvergenceTolerance 0.01 -> 0.005", "ConvergenceTolerance", 0.005),
+                     ("HullTargetNumberOfPoints 250 -> 200", "HullTargetNumberOfPoints", 200)],
+}
 print("LHDL hip, frame %d (%.1f degrees of flexion), 4 muscles" % (inputs["frame"].index, inputs["frame"].hip_flexion))
-for label, name, value in changes:
-    if name:
-        setattr(method, name, value)
-    start = time.perf_counter()
-    method.UpdatePipeline(method.TimestepValues[-1])
-    seconds = time.perf_counter() - start
-    print("  %-36s %6.2f s" % (label, seconds))
+for mesh, changes in runs.items():
+    method = simple.InterpolatedMuscleDeformation(
+        Input=inputs["muscles"], BonesRest=inputs["bones_rest"], BonesCurrent=inputs["bones_current"],
+        ActionLinesRest=inputs["lines_rest"], ActionLinesCurrent=inputs["lines_current"], NumberOfSteps=4,
+        DeformationMesh=mesh)
+    print("DeformationMesh %s:" % mesh)
+    for label, name, value in changes:
+        if name:
+            setattr(method, name, value)
+        start = time.perf_counter()
+        method.UpdatePipeline(method.TimestepValues[-1])
+        seconds = time.perf_counter() - start
+        print("  %-36s %6.2f s" % (label, seconds))
+    simple.Delete(method)

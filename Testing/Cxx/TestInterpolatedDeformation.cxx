@@ -174,12 +174,17 @@ TEST(InterpolatedDeformation, OneBadMuscleDoesNotTakeTheOthersDown)
 TEST(InterpolatedDeformation, TheMuscleTheFemurSwallowsIsNotFixedOnTheBoneWhenInterpolated)
 {
   const MotionCase c = PhantomMotion(30);
-  md::InterpolationParameters onePass, interpolated;
+  md::InterpolationParameters onePass, interpolated, settled;
   onePass.numberOfSteps = 1;
   onePass.deformation.contactWeight = 0; // the paper's one-pass method
+  onePass.settleOnSurface = false;
   interpolated.numberOfSteps = 8;
+  interpolated.settleOnSurface = false; // the paper's interpolation method, on the hull
+  settled.numberOfSteps = 8;            // each step solved on the muscle itself
+  settled.settleOnSurface = true;
   const md::InterpolationResult one = md::DeformByInterpolation(c.muscles, c.bones, onePass);
   const md::InterpolationResult steps = md::DeformByInterpolation(c.muscles, c.bones, interpolated);
+  const md::InterpolationResult onSurface = md::DeformByInterpolation(c.muscles, c.bones, settled);
   ASSERT_EQ(steps.points.size(), 9u);
   const size_t rectus = 2;
   ASSERT_EQ(c.muscles[rectus].name, "RectusFemoris");
@@ -193,7 +198,15 @@ TEST(InterpolatedDeformation, TheMuscleTheFemurSwallowsIsNotFixedOnTheBoneWhenIn
   EXPECT_LE(b.maxStaticShift, 0.6 * a.maxStaticShift);
   EXPECT_LT(b.flippedTriangleCount, a.flippedTriangleCount);
   EXPECT_LT(b.sharpEdgeCount, a.sharpEdgeCount);
-  for (const md::InterpolationResult* r : { &one, &steps })
+  // On the muscle itself no point enters the femur: nothing is left for the static resolution
+  // (measured: 0 mm, no flipped triangle, no new sharp edge).
+  const md::MuscleStepMeasures& s = onSurface.measures.back()[rectus];
+  EXPECT_TRUE(s.converged);
+  EXPECT_LE(s.maxStaticShift, 0.01 * a.maxStaticShift);
+  EXPECT_LT(s.flippedTriangleCount, a.flippedTriangleCount);
+  EXPECT_LT(s.sharpEdgeCount, a.sharpEdgeCount);
+  EXPECT_EQ(s.newPenetrationCount, 0);
+  for (const md::InterpolationResult* r : { &one, &steps, &onSurface })
   {
     for (const md::MuscleStepMeasures& m : r->measures.back())
     {

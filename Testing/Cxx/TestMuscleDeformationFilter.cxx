@@ -175,6 +175,10 @@ TEST(InterpolatedMuscleDeformationFilter, RestHullsAreKeptAcrossSettingsThatDoNo
   vtkNew<vtkInterpolatedMuscleDeformation> f;
   pipeline.Connect(f);
   f->SetNumberOfSteps(2);
+  f->SetDeformationMesh(vtkInterpolatedMuscleDeformation::MUSCLE_SURFACE);
+  f->Update();
+  ASSERT_EQ(f->GetHullBuildCount(), 0); // solved on the muscles' surfaces: no hull at all
+  f->SetDeformationMesh(vtkInterpolatedMuscleDeformation::HULL);
   f->Update();
   ASSERT_EQ(f->GetHullBuildCount(), 3); // one per muscle
 
@@ -233,11 +237,16 @@ TEST(MuscleDeformationFilter, ProgressNeverGoesBackWithinARun)
   PhantomPipeline pipeline;
   vtkNew<vtkMuscleDeformation> pass;
   pipeline.Connect(pass);
-  vtkNew<vtkInterpolatedMuscleDeformation> method;
+  vtkNew<vtkInterpolatedMuscleDeformation> method; // solved on the muscles' surfaces
   pipeline.Connect(method);
   method->SetNumberOfSteps(2);
-  method->SetHullMode(vtkInterpolatedMuscleDeformation::REBUILD); // hulls inside the steps too
-  for (vtkAlgorithm* f : { static_cast<vtkAlgorithm*>(pass), static_cast<vtkAlgorithm*>(method) })
+  method->SetDeformationMesh(vtkInterpolatedMuscleDeformation::MUSCLE_SURFACE);
+  vtkNew<vtkInterpolatedMuscleDeformation> onHulls;
+  pipeline.Connect(onHulls);
+  onHulls->SetNumberOfSteps(2);
+  onHulls->SetHullMode(vtkInterpolatedMuscleDeformation::REBUILD); // hulls inside the steps too
+  for (vtkAlgorithm* f :
+    { static_cast<vtkAlgorithm*>(pass), static_cast<vtkAlgorithm*>(method), static_cast<vtkAlgorithm*>(onHulls) })
   {
     const std::vector<double> seen = ProgressOfOneUpdate(f);
     ASSERT_GT(seen.size(), 10u) << f->GetClassName();
@@ -294,6 +303,8 @@ TEST(MuscleDeformationFilter, AbortStopsTheWholeMethodToo)
   pipeline.Connect(f);
   f->SetNumberOfSteps(3);
   ExpectAbortStopsCleanly(f, 0.4); // in the second step
+  f->SetDeformationMesh(vtkInterpolatedMuscleDeformation::MUSCLE_SURFACE);
+  ExpectAbortStopsCleanly(f, 0.4); // in the second step's settle
 }
 
 TEST(InterpolatedMuscleDeformationFilter, OutputsTheBonesAndActionLinesOfTheSameStep)

@@ -40,6 +40,7 @@ class Interpolation(unittest.TestCase):
         method = simple.InterpolatedMuscleDeformation()
         self.assertEqual(method.NumberOfSteps, 4)
         self.assertEqual(method.BoneInterpolationMode, "Rigid")
+        self.assertEqual(method.DeformationMesh, "Hull (paper)")
         self.assertEqual(method.HullMode, "Refit")
         self.assertEqual(method.PreserveVolume, 1)
         self.assertAlmostEqual(method.BoneContactWeight, 0.5)
@@ -85,7 +86,7 @@ class Interpolation(unittest.TestCase):
         self.assertEqual(field(block(last, "RectusFemoris"), "ElapsedSeconds"), elapsed)
         simple.Delete(method)
 
-    def test_bones_push_the_muscle_unless_the_contact_weight_is_zero(self):
+    def test_on_the_hull_bones_push_the_muscle_unless_the_contact_weight_is_zero(self):
         # The femur sweeps into the rectus femoris: pushed along by it, the muscle needs a far
         # shorter static resolution than with the paper's step (here 6.5 against 11.5 mm).
         shifts = {}
@@ -98,6 +99,33 @@ class Interpolation(unittest.TestCase):
             self.assertLessEqual(field(muscle, "MaxNewBonePenetrationDepth"), 0.5)
             simple.Delete(method)
         self.assertLess(shifts[0.5], 0.75 * shifts[0.0])
+
+    def test_on_the_muscle_surface_the_hull_is_no_part_of_the_answer(self):
+        # Issue 13: solved on the hull, the hull's size changes the muscles; solved on the
+        # muscles' own surfaces, it changes nothing, and no point enters a bone or
+        # another muscle. Also no sharper, no more folded than on the hull (measured on the
+        # rectus femoris: 0 sharp edges and flips against 54 and 0).
+        def last_points(**properties):
+            method = self.method(NumberOfSteps=4, **properties)
+            method.UpdatePipeline(4)
+            result = servermanager.Fetch(method)
+            simple.Delete(method)
+            return {name: block(result, name) for name in MUSCLES}
+
+        surface = last_points(DeformationMesh="Muscle surface", HullTargetNumberOfPoints=250)
+        coarse = last_points(DeformationMesh="Muscle surface", HullTargetNumberOfPoints=150)
+        hull = last_points(DeformationMesh="Hull (paper)", HullTargetNumberOfPoints=250)
+        hull_coarse = last_points(DeformationMesh="Hull (paper)", HullTargetNumberOfPoints=150)
+        for name in MUSCLES:
+            self.assertTrue(numpy.array_equal(points(surface[name]), points(coarse[name])), name)
+            self.assertEqual(field(surface[name], "NewPenetrationCount"), 0, name)
+            self.assertEqual(field(surface[name], "MaxStaticShift"), 0.0, name)
+            self.assertLess(abs(field(surface[name], "VolumeChangePercent")), 1e-4, name)
+            self.assertEqual(field(surface[name], "Converged"), 1, name)
+            for measure in ("SharpEdgeCount", "FlippedTriangleCount"):
+                self.assertLessEqual(field(surface[name], measure), field(hull[name], measure), name)
+        apart = max(numpy.abs(points(hull[name]) - points(hull_coarse[name])).max() for name in MUSCLES)
+        self.assertGreater(apart, 0.1)  # on the hull the hull's size shows (measured: millimetres)
 
     def test_a_motion_of_zero_length_returns_the_input(self):
         port = lambda k: simple.OutputPort(self.phantom, k)  # noqa: E731
