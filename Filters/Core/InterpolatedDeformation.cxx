@@ -448,6 +448,90 @@ std::vector<std::unique_ptr<SurfaceEnergy>> BuildEnergies(const std::vector<Musc
   return energies;
 }
 
+/// [muscle][line][bone][sample]: whether each of `samplesPerSegment` samples of every segment of
+/// the muscle's action lines (their ends included) lies inside the bone, with the bones' trees in
+/// the pose of `lines`.
+using LineSamplesInside = std::vector<std::vector<std::vector<std::vector<char>>>>;
+LineSamplesInside LineSamplesInBones(
+  const std::vector<std::vector<Points>>& lines, const std::vector<FixedObstacle>& bones, int samplesPerSegment)
+{
+  LineSamplesInside inside(lines.size());
+  for (size_t m = 0; m < lines.size(); ++m)
+  {
+    for (const Points& line : lines[m])
+    {
+      std::vector<Eigen::Vector3d> samples;
+      for (Eigen::Index k = 0; k + 1 < line.rows(); ++k)
+      {
+        for (int s = 0; s <= samplesPerSegment; ++s)
+        {
+          const double t = static_cast<double>(s) / samplesPerSegment;
+          samples.push_back(((1 - t) * line.row(k) + t * line.row(k + 1)).transpose());
+        }
+      }
+      std::vector<std::vector<char>> perBone;
+      for (const FixedObstacle& bone : bones)
+      {
+        std::vector<char> in(samples.size(), 0);
+        for (size_t s = 0; s < samples.size(); ++s)
+        {
+          in[s] = bone.tree->InBounds(samples[s]) && bone.tree->Inside(samples[s]);
+        }
+        perBone.push_back(std::move(in));
+      }
+      inside[m].push_back(std::move(perBone));
+    }
+  }
+  return inside;
+}
+
+/// What to say of every muscle one of whose action lines (`lines[m]`, their current pose the
+/// bones') crosses a bone it did not cross at rest (`atRest`, LineSamplesInBones'): goes into it
+/// and out again, not only ends in it, as a line does at its attachment. Solved on the surface, a
+/// line's pull is moved beside the bone on the side nearest to each sample, so a line that
+/// crosses a bone pulls the muscle round it (docs/DESIGN.md section 7).
+std::vector<std::string> LinesThroughBones(const std::vector<MuscleMotion>& muscles,
+  const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones,
+  const LineSamplesInside& atRest, const InterpolationParameters& parameters)
+{
+  std::vector<std::vector<Points>> current(lines.size());
+  for (size_t m = 0; m < lines.size(); ++m)
+  {
+    for (const MatchedLine& line : lines[m])
+    {
+      current[m].push_back(line.current);
+    }
+  }
+  const LineSamplesInside inside = LineSamplesInBones(current, bones, parameters.settle.samplesPerSegment);
+  std::vector<std::string> warnings;
+  for (size_t m = 0; m < lines.size(); ++m)
+  {
+    for (size_t b = 0; b < bones.size(); ++b)
+    {
+      bool crosses = false;
+      for (size_t l = 0; l < inside[m].size() && !crosses; ++l)
+      {
+        const std::vector<char>& now = inside[m][l][b];
+        const std::vector<char>& rest = atRest[m][l][b];
+        const auto firstOut = std::find(now.begin(), now.end(), 0);
+        const auto lastOut = std::find(now.rbegin(), now.rend(), 0).base(); // one past it
+        for (auto s = firstOut; s < lastOut && !crosses; ++s)
+        {
+          crosses = *s && !rest[static_cast<size_t>(s - now.begin())];
+        }
+      }
+      if (crosses)
+      {
+        warnings.push_back("an action line of muscle '" + muscles[m].name + "' crosses bone '" + bones[b].name +
+          "': solved on the muscle's surface, its pull is moved beside the bone, on either side, which can draw "
+          "the muscle round the bone; check the muscle, give the line a via point, or solve on the hull "
+          "(DeformationMesh Hull)");
+      }
+    }
+  }
+  return warnings;
+}
+
 /// DeformByInterpolation on input already in its local frame.
 InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles, const std::vector<BoneMotion>& bones,
   const InterpolationParameters& parameters, const std::function<void(double)>& progress, RestMappingCache* kept)
@@ -560,6 +644,7 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   std::vector<const SurfaceEnergy*> energyPointers;
   std::vector<std::vector<Points>> restLines(count); // the matched lines at step 0
   SettleMotion settleMotion;
+  LineSamplesInside linesInBonesAtRest; // the scans' own overlap
   if (settle)
   {
     energies = BuildEnergies(muscles, lineMotions, steps, parameters.settle, restLines, result.restHullSeconds, report);
@@ -568,6 +653,7 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       energyPointers.push_back(energy.get());
     }
     settleMotion = StartMotion(current, energyPointers, restLines, fixed);
+    linesInBonesAtRest = LineSamplesInBones(restLines, fixed, parameters.settle.samplesPerSegment);
   }
   else
   {
@@ -610,6 +696,13 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       }
       settled = SettleMuscles(next, energyPointers, wholeMotion, restVolumes, fixed, &restOverlap, parameters.settle,
         &settleMotion, [&](double fraction) { report(stepStart + 0.9 * stepShare * fraction); });
+      for (const std::string& warning : LinesThroughBones(muscles, wholeMotion, fixed, linesInBonesAtRest, parameters))
+      {
+        if (warned.insert(warning).second) // said once, at the first step that has it
+        {
+          result.warnings.push_back("step " + std::to_string(j) + ": " + warning);
+        }
+      }
     }
     else
     {

@@ -324,6 +324,35 @@ TEST(SurfaceSettle, ALineThroughABonePullsTheMuscleBesideItNotIntoIt)
   }
 }
 
+TEST(SurfaceSettle, ALineThatCrossesABoneIsSaid)
+{
+  // At 60 degrees the femur sweeps through the rectus femoris's action line: solved on the
+  // surface, the line's pull is moved beside the femur on both sides and the muscle is drawn
+  // round it (docs/DESIGN.md section 7), so the user is told, once, naming muscle and bone. The
+  // lines that only end in a bone (attachments) are not named.
+  const MotionCase c = PhantomMotion(60);
+  md::InterpolationParameters parameters;
+  parameters.settleOnSurface = true;
+  const md::InterpolationResult r = md::DeformByInterpolation(c.muscles, c.bones, parameters);
+  std::vector<std::string> crossings;
+  for (const std::string& w : r.warnings)
+  {
+    if (w.find("crosses bone") != std::string::npos)
+    {
+      crossings.push_back(w);
+    }
+  }
+  ASSERT_EQ(crossings.size(), 1u);
+  EXPECT_NE(crossings[0].find("muscle 'RectusFemoris' crosses bone 'Femur'"), std::string::npos) << crossings[0];
+  EXPECT_NE(crossings[0].find("DeformationMesh Hull"), std::string::npos) << crossings[0];
+  // The hull-based pass does not move the line's pull, and says nothing of it.
+  parameters.settleOnSurface = false;
+  for (const std::string& w : md::DeformByInterpolation(c.muscles, c.bones, parameters).warnings)
+  {
+    EXPECT_EQ(w.find("crosses bone"), std::string::npos) << w;
+  }
+}
+
 TEST(SurfaceSettle, OnThePhantomTheAnswerIsSmoothAndStable)
 {
   // The phantom at 30 degrees of flexion, N = 4: the femur sweeps into the rectus femoris's
