@@ -247,7 +247,7 @@ int main(int argc, char* argv[])
       methods.push_back({ "interpolation N = " + std::to_string(n), n, md::StepDeformationDefaults().contactWeight });
     }
   }
-  if (methodsArg == "settle") // experimental: each step settled on the full mesh (SurfaceSettle.h)
+  if (methodsArg == "settle") // each step solved on the muscles' surfaces (DeformationMesh Muscle surface)
   {
     methods.push_back(
       { "interpolation N = 4, settled on the full mesh", 4, md::StepDeformationDefaults().contactWeight, true });
