@@ -110,6 +110,11 @@ int vtkInterpolatedMuscleDeformation::GetHullBuildCount() const
   return this->KeptRest->hullBuildCount;
 }
 
+int vtkInterpolatedMuscleDeformation::GetSurfaceEnergyBuildCount() const
+{
+  return this->KeptRest->energyBuildCount;
+}
+
 int vtkInterpolatedMuscleDeformation::FillOutputPortInformation(int port, vtkInformation* info)
 {
   if (port == 3)
@@ -616,4 +621,5 @@ void vtkInterpolatedMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "RefitRegularisation: " << this->RefitRegularisation << "\n";
   os << indent << "ResolvedNumberOfSteps: " << this->ResolvedNumberOfSteps << "\n";
   os << indent << "HullBuildCount: " << this->GetHullBuildCount() << "\n";
+  os << indent << "SurfaceEnergyBuildCount: " << this->GetSurfaceEnergyBuildCount() << "\n";
 }

@@ -139,6 +139,10 @@ public:
   /// muscle or hull size rebuilds that muscle's. (HullMode Rebuild's hulls of later steps are
   /// built anew on every run and not counted.)
   int GetHullBuildCount() const;
+  /// Full-mesh energies built so far (DeformationMesh MUSCLE_SURFACE). A muscle's energy depends on
+  /// its rest-pose surface and its matched action lines in the rest pose only, so it is kept like
+  /// the hulls, with the columns of its inverse found so far.
+  int GetSurfaceEnergyBuildCount() const;
 
 protected:
   vtkInterpolatedMuscleDeformation();

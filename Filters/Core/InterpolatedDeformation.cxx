@@ -254,12 +254,18 @@ HullPass PrepareHullPass(const std::vector<MuscleMotion>& muscles, const Interpo
   }
   std::vector<std::string> errors;
   std::vector<TriangleMesh> built = BuildHulls(muscles, restPointers, parameters.hull, errors, seconds, &build);
+  auto forgetHull = [](RestMappingCache::Entry& entry) { // the energy, if any, stays
+    entry.surface = {};
+    entry.hull = {};
+    entry.restHull = {};
+    entry.weights = {};
+  };
   for (size_t m = 0; m < count; ++m)
   {
     RestMappingCache::Entry& entry = rest.muscles[m];
     if (build[m])
     {
-      entry = RestMappingCache::Entry{};
+      forgetHull(entry);
     }
     if (build[m] && errors[m].empty())
     {
@@ -275,7 +281,7 @@ HullPass PrepareHullPass(const std::vector<MuscleMotion>& muscles, const Interpo
       catch (const InputError& e)
       {
         errors[m] = "muscle '" + muscles[m].name + "': " + e.what();
-        entry = RestMappingCache::Entry{};
+        forgetHull(entry);
         continue;
       }
       ++rest.hullBuildCount;
@@ -396,15 +402,19 @@ void RefitHulls(HullPass& pass, const std::vector<TriangleMesh>& resolved,
   }
 }
 
-/// The full-mesh energy of every muscle in the rest pose (SurfaceEnergy), the muscles in
-/// parallel; `restLines[m]` receives each muscle's matched lines at step 0 and `seconds[m]`
-/// the time of its energy.
-std::vector<std::unique_ptr<SurfaceEnergy>> BuildEnergies(const std::vector<MuscleMotion>& muscles,
+/// The full-mesh energy of every muscle in the rest pose (SurfaceEnergy), or the one an earlier
+/// run left in `kept` where it still holds; those to build are built in parallel. `restLines[m]`
+/// receives each muscle's matched lines at step 0 and `seconds[m]` the time of its energy.
+std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vector<MuscleMotion>& muscles,
   const std::vector<std::vector<PoseInterpolator>>& lineMotions, int steps, const SettleParameters& parameters,
-  std::vector<std::vector<Points>>& restLines, std::vector<double>& seconds, const std::function<void(double)>& report)
+  RestMappingCache* kept, std::vector<std::vector<Points>>& restLines, std::vector<double>& seconds,
+  const std::function<void(double)>& report)
 {
   const size_t count = muscles.size();
-  std::vector<std::unique_ptr<SurfaceEnergy>> energies(count);
+  RestMappingCache scratch;
+  RestMappingCache& rest = kept ? *kept : scratch;
+  rest.muscles.resize(count);
+  std::vector<std::shared_ptr<const SurfaceEnergy>> energies(count);
   std::vector<std::exception_ptr> failed(count); // no exception may leave a parallel region
   for (size_t m = 0; m < count; ++m)
   {
@@ -412,15 +422,28 @@ std::vector<std::unique_ptr<SurfaceEnergy>> BuildEnergies(const std::vector<Musc
     {
       restLines[m].push_back(line.AtStep(0, steps));
     }
+    const RestMappingCache::Entry& entry = rest.muscles[m];
+    const bool same = entry.energy && SameMesh(entry.energySurface, muscles[m].muscle) &&
+      entry.settle.SameEnergyAs(parameters) && entry.restLines.size() == restLines[m].size() &&
+      std::equal(restLines[m].begin(), restLines[m].end(), entry.restLines.begin(),
+        [](const Points& a, const Points& b) { return a.rows() == b.rows() && a == b; });
+    if (same)
+    {
+      energies[m] = entry.energy;
+    }
   }
 #pragma omp parallel for schedule(dynamic, 1)
   for (int k = 0; k < static_cast<int>(count); ++k)
   {
     const size_t m = static_cast<size_t>(k);
+    if (energies[m])
+    {
+      continue;
+    }
     const auto energyStart = Clock::now();
     try
     {
-      energies[m] = std::make_unique<SurfaceEnergy>(muscles[m].muscle, restLines[m], parameters);
+      energies[m] = std::make_shared<const SurfaceEnergy>(muscles[m].muscle, restLines[m], parameters);
     }
     catch (const InputError& e)
     {
@@ -436,6 +459,18 @@ std::vector<std::unique_ptr<SurfaceEnergy>> BuildEnergies(const std::vector<Musc
       failed[m] = std::current_exception();
     }
     seconds[m] += SecondsSince(energyStart);
+  }
+  for (size_t m = 0; m < count; ++m)
+  {
+    RestMappingCache::Entry& entry = rest.muscles[m];
+    if (energies[m] && energies[m] != entry.energy)
+    {
+      entry.energy = energies[m];
+      entry.energySurface = muscles[m].muscle;
+      entry.restLines = restLines[m];
+      entry.settle = parameters;
+      ++rest.energyBuildCount;
+    }
   }
   for (const std::exception_ptr& failure : failed)
   {
@@ -640,15 +675,16 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   // The full-mesh energies (rest pose only), kept for every step; each step's settle goes on
   // from the last one's answer (from the rest pose at the first), so the answer depends
   // continuously on the input and not at all on a hull (docs/DESIGN.md section 7).
-  std::vector<std::unique_ptr<SurfaceEnergy>> energies;
+  std::vector<std::shared_ptr<const SurfaceEnergy>> energies;
   std::vector<const SurfaceEnergy*> energyPointers;
   std::vector<std::vector<Points>> restLines(count); // the matched lines at step 0
   SettleMotion settleMotion;
   LineSamplesInside linesInBonesAtRest; // the scans' own overlap
   if (settle)
   {
-    energies = BuildEnergies(muscles, lineMotions, steps, parameters.settle, restLines, result.restHullSeconds, report);
-    for (const std::unique_ptr<SurfaceEnergy>& energy : energies)
+    energies =
+      BuildEnergies(muscles, lineMotions, steps, parameters.settle, kept, restLines, result.restHullSeconds, report);
+    for (const std::shared_ptr<const SurfaceEnergy>& energy : energies)
     {
       energyPointers.push_back(energy.get());
     }
@@ -843,6 +879,7 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
     std::vector<MuscleMotion> subset;
     RestMappingCache subCache;
     subCache.hullBuildCount = cache.hullBuildCount;
+    subCache.energyBuildCount = cache.energyBuildCount;
     for (size_t m : active)
     {
       subset.push_back(muscles[m]);
@@ -854,6 +891,7 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
         cache.muscles[active[k]] = std::move(subCache.muscles[k]);
       }
       cache.hullBuildCount = subCache.hullBuildCount;
+      cache.energyBuildCount = subCache.energyBuildCount;
     };
     InterpolationResult some;
     try

@@ -142,11 +142,12 @@ struct InterpolationResult
   std::vector<std::string> failures;
 };
 
-/// The rest-pose hull of every muscle and the mean value coordinates of its points in it, kept
-/// between runs of DeformByInterpolation by a caller that runs the method again (another number
-/// of steps, other weights or tolerances): they depend on the rest-pose surface and the hull
-/// parameters alone, and the hull is most of a first run's time. A muscle whose surface or hull
-/// parameters changed gets a new hull; the entries follow the order of the muscles.
+/// The rest-pose hull of every muscle and the mean value coordinates of its points in it, and
+/// with InterpolationParameters::settleOnSurface its full-mesh energy, kept between runs of
+/// DeformByInterpolation by a caller that runs the method again (another number of steps, other
+/// bones, weights or tolerances): they depend on the rest pose and their parameters alone, and
+/// they are most of a first run's time. A muscle whose surface or parameters changed gets a new
+/// hull or energy; the entries follow the order of the muscles.
 struct RestMappingCache
 {
   struct Entry
@@ -155,9 +156,16 @@ struct RestMappingCache
     HullParameters hull;  ///< and the hull parameters
     TriangleMesh restHull;
     WeightMatrix weights;
+    /// The full-mesh energy, of `energySurface` with its matched action lines `restLines` in the
+    /// rest pose (the local frame's), and the inverse's columns it has kept.
+    std::shared_ptr<const SurfaceEnergy> energy;
+    TriangleMesh energySurface;
+    std::vector<Points> restLines;
+    SettleParameters settle;
   };
   std::vector<Entry> muscles;
-  int hullBuildCount = 0; ///< rest-pose hulls built so far (not counting HullMode::Rebuild's)
+  int hullBuildCount = 0;   ///< rest-pose hulls built so far (not counting HullMode::Rebuild's)
+  int energyBuildCount = 0; ///< full-mesh energies built so far
 };
 
 /// Number of steps: `parameters.numberOfSteps`, or when 0 enough steps that no

@@ -47,6 +47,13 @@ struct SettleParameters
   /// size in an iteration, the contacts are those of the iteration before,
   /// and the volume is within 1e-9 of its target.
   double tolerance = 1e-7;
+
+  /// True when `other` gives the same SurfaceEnergy (the settle's own settings aside).
+  bool SameEnergyAs(const SettleParameters& other) const
+  {
+    return this->followWeight == other.followWeight && this->samplesPerSegment == other.samplesPerSegment &&
+      this->balancePoints == other.balancePoints;
+  }
 };
 
 /// The rest-pose parts of one muscle's full-mesh energy, built once and kept

@@ -178,6 +178,27 @@ TEST(InterpolatedMuscleDeformationFilter, RestHullsAreKeptAcrossSettingsThatDoNo
   f->SetDeformationMesh(vtkInterpolatedMuscleDeformation::MUSCLE_SURFACE);
   f->Update();
   ASSERT_EQ(f->GetHullBuildCount(), 0); // solved on the muscles' surfaces: no hull at all
+  ASSERT_EQ(f->GetSurfaceEnergyBuildCount(), 3);
+  // Their energies are kept as the hulls are, and give what a new filter builds for itself. (A
+  // new current pose can change the matched rest lines, points inserted by the matching, and
+  // with them the energy.)
+  f->SetNumberOfSteps(3);
+  f->Update();
+  f->SetDeformableShare(0.5);
+  f->Update();
+  EXPECT_EQ(f->GetSurfaceEnergyBuildCount(), 3);
+  {
+    vtkNew<vtkInterpolatedMuscleDeformation> fresh;
+    pipeline.Connect(fresh);
+    fresh->SetNumberOfSteps(3);
+    fresh->SetDeformableShare(0.5);
+    fresh->SetDeformationMesh(vtkInterpolatedMuscleDeformation::MUSCLE_SURFACE);
+    f->UpdateTimeStep(3);
+    fresh->UpdateTimeStep(3);
+    EXPECT_EQ(LargestDifference(f->GetOutputDataObject(0), fresh->GetOutputDataObject(0)), 0.0);
+  }
+  f->SetDeformableShare(0.6);
+  f->SetNumberOfSteps(2);
   f->SetDeformationMesh(vtkInterpolatedMuscleDeformation::HULL);
   f->Update();
   ASSERT_EQ(f->GetHullBuildCount(), 3); // one per muscle
