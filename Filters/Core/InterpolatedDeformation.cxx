@@ -483,34 +483,27 @@ std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vecto
   return energies;
 }
 
-/// [muscle][line][bone][sample]: whether each of `samplesPerSegment` samples of every segment of
-/// the muscle's action lines (their ends included) lies inside the bone, with the bones' trees in
-/// the pose of `lines`.
+/// [muscle][line][bone][sample]: whether each sample of the current pose of the muscle's matched
+/// lines (SampleMatchedLines') lies inside the bone, with the bones' trees in that pose.
 using LineSamplesInside = std::vector<std::vector<std::vector<std::vector<char>>>>;
 LineSamplesInside LineSamplesInBones(
-  const std::vector<std::vector<Points>>& lines, const std::vector<FixedObstacle>& bones, int samplesPerSegment)
+  const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones, int samplesPerSegment)
 {
   LineSamplesInside inside(lines.size());
   for (size_t m = 0; m < lines.size(); ++m)
   {
-    for (const Points& line : lines[m])
+    for (const MatchedLine& line : lines[m])
     {
-      std::vector<Eigen::Vector3d> samples;
-      for (Eigen::Index k = 0; k + 1 < line.rows(); ++k)
-      {
-        for (int s = 0; s <= samplesPerSegment; ++s)
-        {
-          const double t = static_cast<double>(s) / samplesPerSegment;
-          samples.push_back(((1 - t) * line.row(k) + t * line.row(k + 1)).transpose());
-        }
-      }
+      Points restSamples, samples;
+      SampleMatchedLines({ line }, samplesPerSegment, restSamples, samples);
       std::vector<std::vector<char>> perBone;
       for (const FixedObstacle& bone : bones)
       {
-        std::vector<char> in(samples.size(), 0);
-        for (size_t s = 0; s < samples.size(); ++s)
+        std::vector<char> in(static_cast<size_t>(samples.rows()), 0);
+        for (Eigen::Index k = 0; k < samples.rows(); ++k)
         {
-          in[s] = bone.tree->InBounds(samples[s]) && bone.tree->Inside(samples[s]);
+          const Eigen::Vector3d p = samples.row(k).transpose();
+          in[static_cast<size_t>(k)] = bone.tree->InBounds(p) && bone.tree->Inside(p);
         }
         perBone.push_back(std::move(in));
       }
@@ -529,15 +522,7 @@ std::vector<std::string> LinesThroughBones(const std::vector<MuscleMotion>& musc
   const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones,
   const LineSamplesInside& atRest, const InterpolationParameters& parameters)
 {
-  std::vector<std::vector<Points>> current(lines.size());
-  for (size_t m = 0; m < lines.size(); ++m)
-  {
-    for (const MatchedLine& line : lines[m])
-    {
-      current[m].push_back(line.current);
-    }
-  }
-  const LineSamplesInside inside = LineSamplesInBones(current, bones, parameters.settle.samplesPerSegment);
+  const LineSamplesInside inside = LineSamplesInBones(lines, bones, parameters.settle.samplesPerSegment);
   std::vector<std::string> warnings;
   for (size_t m = 0; m < lines.size(); ++m)
   {
@@ -689,7 +674,12 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       energyPointers.push_back(energy.get());
     }
     settleMotion = StartMotion(current, energyPointers, restLines, fixed);
-    linesInBonesAtRest = LineSamplesInBones(restLines, fixed, parameters.settle.samplesPerSegment);
+    std::vector<std::vector<MatchedLine>> still;
+    for (const std::vector<Points>& lines : restLines)
+    {
+      still.push_back(StillLines(lines));
+    }
+    linesInBonesAtRest = LineSamplesInBones(still, fixed, parameters.settle.samplesPerSegment);
   }
   else
   {

@@ -24,17 +24,6 @@ namespace
 {
 using Clock = std::chrono::steady_clock;
 
-/// The rest pose's lines as a motion that goes nowhere (rest -> rest).
-std::vector<MatchedLine> Still(const std::vector<Points>& restLines)
-{
-  std::vector<MatchedLine> still;
-  for (const Points& line : restLines)
-  {
-    still.push_back({ line, line });
-  }
-  return still;
-}
-
 /// Barycentric coordinates of q (on the triangle's plane) in triangle t of `mesh`.
 Eigen::Vector3d Barycentric(const TriangleMesh& mesh, Eigen::Index t, const Eigen::Vector3d& q)
 {
@@ -120,7 +109,7 @@ SurfaceEnergy::SurfaceEnergy(
 
   // The action-line samples inside the rest muscle, as sparse rows.
   Points samples, unused;
-  SampleMatchedLines(Still(restLines), this->SamplesPerSegment, samples, unused);
+  SampleMatchedLines(StillLines(restLines), this->SamplesPerSegment, samples, unused);
   const TriangleTree tree(welded);
   std::vector<RowEntries> sampleRows;
   for (Eigen::Index s = 0; s < samples.rows(); ++s)
@@ -400,6 +389,16 @@ Eigen::Vector3d OutsideBones(Eigen::Vector3d p, double clearance, const std::vec
 }
 }
 
+std::vector<MatchedLine> StillLines(const std::vector<Points>& restLines)
+{
+  std::vector<MatchedLine> still;
+  for (const Points& line : restLines)
+  {
+    still.push_back({ line, line });
+  }
+  return still;
+}
+
 Points SurfaceEnergy::RightHandSide(
   const std::vector<MatchedLine>& lines, const std::vector<FixedObstacle>& bones) const
 {
@@ -656,7 +655,7 @@ SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::ve
   for (size_t m = 0; m < muscles.size(); ++m)
   {
     motion.points.push_back(muscles[m].points);
-    motion.free.push_back(energies[m]->Solve(energies[m]->RightHandSide(Still(restLines[m]), restBones)));
+    motion.free.push_back(energies[m]->Solve(energies[m]->RightHandSide(StillLines(restLines[m]), restBones)));
   }
   return motion;
 }
@@ -875,8 +874,8 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       progress(static_cast<double>(iteration + 1) / std::max(1, parameters.maximumIterations));
     }
   }
-  // A settle that diverged leaves the muscles where they started (the hull-based answer) rather
-  // than at an iterate that means nothing; one that ran out of iterations keeps its last.
+  // A settle that diverged leaves the muscles where they started rather than at an iterate that
+  // means nothing; one that ran out of iterations keeps its last.
   for (size_t m = 0; m < count && !diverging; ++m)
   {
     energies[m]->CarryToUnwelded(muscles[m].points, meshes[m].points);

@@ -125,6 +125,9 @@ private:
   mutable std::unordered_map<Eigen::Index, Eigen::VectorXd> Columns;
 };
 
+/// The rest pose's lines as a motion that goes nowhere (rest -> rest).
+std::vector<MatchedLine> StillLines(const std::vector<Points>& restLines);
+
 struct SettleReport
 {
   int iterations = 0;
