@@ -543,9 +543,9 @@ std::vector<std::string> LinesThroughBones(const std::vector<MuscleMotion>& musc
       if (crosses)
       {
         warnings.push_back("an action line of muscle '" + muscles[m].name + "' crosses bone '" + bones[b].name +
-          "': solved on the muscle's surface, its pull is moved beside the bone, on either side, which can draw "
-          "the muscle round the bone; check the muscle, give the line a via point, or solve on the hull "
-          "(DeformationMesh Hull)");
+          "': solved on the muscle's surface, the line is let go inside the bone and the muscle lies against "
+          "the bone, which can bend a thin muscle round it; check the muscle, give the line a via point, or "
+          "solve on the hull (DeformationMesh Hull)");
       }
     }
   }

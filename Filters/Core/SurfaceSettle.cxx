@@ -41,7 +41,7 @@ Eigen::Vector3d Barycentric(const TriangleMesh& mesh, Eigen::Index t, const Eige
   return { u, v, 1 - u - v };
 }
 
-using RowEntries = std::vector<std::pair<std::int64_t, double>>;
+using RowEntries = SurfaceEnergy::Row;
 
 /// The sample p (inside the surface) as a combination of surface points: along
 /// each axis the chord through p meets the surface at h+ (distance d+) and h-
@@ -159,6 +159,7 @@ SurfaceEnergy::SurfaceEnergy(
       entries.emplace_back(sampleStart + static_cast<Eigen::Index>(s), point, weight);
     }
   }
+  this->SampleRows = std::move(sampleRows);
   for (Eigen::Index i = 0; i < n; ++i)
   {
     // A point no triangle uses has nothing else to place it.
@@ -298,10 +299,10 @@ Points SurfaceEnergy::Solve(const Points& rhs) const
   return x;
 }
 
-void SurfaceEnergy::Prepare(const std::vector<Eigen::Index>& points) const
+void SurfaceEnergy::Prepare(const std::vector<Eigen::Index>& keys) const
 {
   std::vector<Eigen::Index> missing;
-  for (const Eigen::Index p : points)
+  for (const Eigen::Index p : keys)
   {
     if (this->Columns.find(p) == this->Columns.end())
     {
@@ -325,7 +326,18 @@ void SurfaceEnergy::Prepare(const std::vector<Eigen::Index>& points) const
     Block y = Block::Zero(n, kBlock);
     for (size_t k = 0; k < width; ++k)
     {
-      y(order(missing[first + k]), static_cast<Eigen::Index>(k)) = 1.0;
+      const Eigen::Index key = missing[first + k];
+      if (key >= 0)
+      {
+        y(order(key), static_cast<Eigen::Index>(k)) = 1.0;
+      }
+      else
+      {
+        for (const auto& [point, weight] : this->SampleRow(-1 - key))
+        {
+          y(order(point), static_cast<Eigen::Index>(k)) += weight;
+        }
+      }
     }
     SolveFactored(this->Factor.matrixL().nestedExpression(), this->Factor.vectorD(), y);
     for (size_t k = 0; k < width; ++k)
@@ -344,13 +356,13 @@ void SurfaceEnergy::Prepare(const std::vector<Eigen::Index>& points) const
   }
 }
 
-const Eigen::VectorXd& SurfaceEnergy::InverseColumn(Eigen::Index point) const
+const Eigen::VectorXd& SurfaceEnergy::InverseColumn(Eigen::Index key) const
 {
-  auto column = this->Columns.find(point);
+  auto column = this->Columns.find(key);
   if (column == this->Columns.end())
   {
-    this->Prepare({ point });
-    column = this->Columns.find(point);
+    this->Prepare({ key });
+    column = this->Columns.find(key);
   }
   return column->second;
 }
@@ -387,6 +399,57 @@ Eigen::Vector3d OutsideBones(Eigen::Vector3d p, double clearance, const std::vec
   }
   return p;
 }
+
+/// How far p is inside the bone it is deepest in, negative (the signed distance from the bone's
+/// surface), or 0 when it is inside none.
+double DepthInBones(const Eigen::Vector3d& p, const std::vector<FixedObstacle>& bones)
+{
+  double depth = 0;
+  for (const FixedObstacle& bone : bones)
+  {
+    const TriangleTree& tree = *bone.tree;
+    if (tree.InBounds(p) && tree.Inside(p))
+    {
+      depth = std::min(depth, -tree.ClosestPoint(p).distance);
+    }
+  }
+  return depth;
+}
+}
+
+std::vector<double> SurfaceEnergy::SampleDepthsInBones(
+  const std::vector<MatchedLine>& lines, const std::vector<FixedObstacle>& bones) const
+{
+  Points restSamples, currentSamples;
+  SampleMatchedLines(lines, this->SamplesPerSegment, restSamples, currentSamples);
+  std::vector<double> distances(this->SampleIndex.size());
+  for (size_t s = 0; s < distances.size(); ++s)
+  {
+    distances[s] = DepthInBones(currentSamples.row(this->SampleIndex[s]).transpose(), bones);
+  }
+  return distances;
+}
+
+std::vector<SurfaceEnergy::LetGo> SurfaceEnergy::SamplesLetGo(const std::vector<MatchedLine>& lines,
+  const std::vector<FixedObstacle>& bones, const std::vector<double>* restDepths) const
+{
+  Points restSamples, currentSamples;
+  SampleMatchedLines(lines, this->SamplesPerSegment, restSamples, currentSamples);
+  std::vector<LetGo> letGo;
+  for (size_t s = 0; s < this->SampleIndex.size(); ++s)
+  {
+    const double inMuscle = this->SampleClearance[s]; // its depth in the rest muscle
+    const Eigen::Vector3d p = currentSamples.row(this->SampleIndex[s]).transpose();
+    // From the bone's surface, or from as deep as the sample was at rest (a line that ends in
+    // the bone it is attached to), to its depth in the rest muscle further in.
+    const double from = restDepths && s < restDepths->size() ? (*restDepths)[s] : 0.0;
+    const double share = std::clamp((from - DepthInBones(p, bones)) / inMuscle, 0.0, 1.0);
+    if (share > 1e-9)
+    {
+      letGo.push_back({ static_cast<Eigen::Index>(s), share, OutsideBones(p, inMuscle, bones) });
+    }
+  }
+  return letGo;
 }
 
 std::vector<MatchedLine> StillLines(const std::vector<Points>& restLines)
@@ -432,15 +495,86 @@ namespace
 constexpr double kFarMove = 0.5;
 constexpr int kFarMovesToStop = 3;
 
-/// One point of a constraint's combination: `coefficient` times point
-/// `point` of muscle `muscle`.
+/// Takes a shorter step where the iteration swings back: the linearised contacts leave their
+/// surfaces' curvature out, and where that curvature is strong against a muscle's stiffness
+/// (two muscles in contact, one held by few action-line rows) the plain iteration flips to
+/// and fro about the minimum with a growing or shrinking swing. When this step (`next` less
+/// `meshes`' points, all muscles together) goes back against the last one by the factor
+/// lambda < 0 (its projection on it), the step is shortened by 1 / (1 - lambda), the step
+/// that would land on the swing's fixed point if the factor held (Aitken's). `lastSteps` is
+/// read and replaced by the step taken.
+void DampOscillation(const std::vector<TriangleMesh>& meshes, std::vector<Points>& next, std::vector<Points>& lastSteps)
+{
+  const size_t count = meshes.size();
+  std::vector<Points> steps(count);
+  double along = 0, last = 0;
+  for (size_t m = 0; m < count; ++m)
+  {
+    steps[m] = next[m] - meshes[m].points;
+    if (lastSteps.size() == count)
+    {
+      along += (steps[m].array() * lastSteps[m].array()).sum();
+      last += lastSteps[m].squaredNorm();
+    }
+  }
+  const double lambda = last > 0 ? along / last : 0.0;
+  if (lambda < 0)
+  {
+    const double shorter = 1 / (1 - lambda);
+    for (size_t m = 0; m < count; ++m)
+    {
+      steps[m] *= shorter;
+      next[m] = meshes[m].points + steps[m];
+    }
+  }
+  lastSteps = std::move(steps);
+}
+
+/// One part of a constraint's combination: `coefficient` times point `point` of muscle
+/// `muscle`, or, with `point` a sample's key (SurfaceEnergy::SampleKey), times that action-line
+/// sample's row (the combination of points that gives the sample).
 struct Term
 {
   size_t muscle;
   Eigen::Index point;
   double coefficient;
   const Eigen::VectorXd* column = nullptr; // the energy's inverse at `point`, once known
+  const SurfaceEnergy::Row* row = nullptr; // the sample's row when `point` is a sample's key
 };
+
+/// The term's point (or sample) in `points`, without its coefficient.
+Eigen::Vector3d Where(const Term& t, const Points& points)
+{
+  if (!t.row)
+  {
+    return points.row(t.point).transpose();
+  }
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const auto& [point, weight] : *t.row)
+  {
+    sum += weight * points.row(point).transpose();
+  }
+  return sum;
+}
+
+/// The term `b`'s point (or sample) in the inverse's column of term `a`: a . K^-1 b.
+double InverseBetween(const Term& a, const Term& b)
+{
+  if (a.muscle != b.muscle)
+  {
+    return 0.0;
+  }
+  if (!b.row)
+  {
+    return (*a.column)(b.point);
+  }
+  double sum = 0;
+  for (const auto& [point, weight] : *b.row)
+  {
+    sum += weight * (*a.column)(point);
+  }
+  return sum;
+}
 
 /// A contact linearised at the current points: normal . (sum of the terms'
 /// points) >= target, with the normal the direction from the muscle's point
@@ -656,6 +790,7 @@ SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::ve
   {
     motion.points.push_back(muscles[m].points);
     motion.free.push_back(energies[m]->Solve(energies[m]->RightHandSide(StillLines(restLines[m]), restBones)));
+    motion.restDepths.push_back(energies[m]->SampleDepthsInBones(StillLines(restLines[m]), restBones));
   }
   return motion;
 }
@@ -681,6 +816,29 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   for (int m = 0; m < static_cast<int>(count); ++m)
   {
     free[m] = energies[m]->Solve(energies[m]->RightHandSide(lines[m], bones));
+  }
+  // The samples let go in this pose (their rows' energy taken partly or wholly away): each is
+  // an equality of the dual system per axis, a . x - y / share = target, whose multiplier y
+  // takes that share of the row's pull back out.
+  std::vector<Contact> letGo;
+  std::vector<double> letGoShare;
+  for (size_t m = 0; m < count; ++m)
+  {
+    const std::vector<double>* rest = motion && motion->restDepths.size() == count ? &motion->restDepths[m] : nullptr;
+    for (const SurfaceEnergy::LetGo& sample : energies[m]->SamplesLetGo(lines[m], bones, rest))
+    {
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        Contact row;
+        row.muscle = m;
+        row.normal = Eigen::Vector3d::Unit(axis);
+        row.target = sample.target(axis);
+        row.terms.push_back(
+          { m, SurfaceEnergy::SampleKey(sample.sample), 1.0, nullptr, &energies[m]->SampleRow(sample.sample) });
+        letGo.push_back(std::move(row));
+        letGoShare.push_back(sample.share);
+      }
+    }
   }
   // A motion's step starts where the last ended, moved as the unconstrained minimum moved.
   if (motion && motion->points.size() == count)
@@ -713,6 +871,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     wasInside[m].assign(static_cast<size_t>(meshes[m].points.rows()) * obstacles, 1);
     previous[m] = meshes[m].points;
   }
+  std::vector<Points> lastSteps; // each muscle's last move, for DampOscillation
   bool settled = false, diverging = false;
   int farMoves = 0;
   int iteration = 0;
@@ -733,6 +892,9 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     // The contacts: every point inside an obstacle or nearer than the offset, and those held before.
     std::vector<Contact> contacts =
       FindContacts(meshes, energies, bones, trees, restOverlap, held, previous, parameters, wasInside);
+    const Eigen::Index nc = static_cast<Eigen::Index>(contacts.size());
+    const Eigen::Index volumeStart = nc + static_cast<Eigen::Index>(letGo.size());
+    contacts.insert(contacts.end(), letGo.begin(), letGo.end());
 
     // The inverse's columns at every point a contact names, and the volume's direction.
     std::vector<std::vector<Eigen::Index>> needed(count);
@@ -743,8 +905,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
         needed[t.muscle].push_back(t.point);
       }
     }
-    const Eigen::Index nc = static_cast<Eigen::Index>(contacts.size());
-    const Eigen::Index size = nc + static_cast<Eigen::Index>(count);
+    const Eigen::Index size = volumeStart + static_cast<Eigen::Index>(count);
     std::vector<Points> gradients(count), along(count);
     Eigen::VectorXd rhs(size);
     std::vector<double> volumeNow(count);
@@ -759,7 +920,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       volumeNow[m] = EnclosedVolume(meshes[m].points, meshes[m].triangles, &gradients[m]);
       along[m] = energies[m]->Solve(gradients[m]);
       // g . x_new = V - V(x) + g . x, the volume's linearisation at x.
-      rhs(nc + static_cast<Eigen::Index>(m)) = targets[m] - volumeNow[m] +
+      rhs(volumeStart + static_cast<Eigen::Index>(m)) = targets[m] - volumeNow[m] +
         (gradients[m].array() * meshes[m].points.array()).sum() - (gradients[m].array() * free[m].array()).sum();
     }
     for (Contact& c : contacts)
@@ -769,19 +930,16 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
         t.column = &energies[t.muscle]->InverseColumn(t.point);
       }
     }
-    auto inverse = [](const Term& a, const Term& b) {
-      return a.muscle == b.muscle ? (*a.column)(b.point) : 0.0;
-    };
     Eigen::MatrixXd system = Eigen::MatrixXd::Zero(size, size);
-    for (Eigen::Index j = 0; j < nc; ++j)
+    for (Eigen::Index j = 0; j < volumeStart; ++j)
     {
       const Contact& a = contacts[static_cast<size_t>(j)];
       double value = 0;
       for (const Term& t : a.terms)
       {
-        value += t.coefficient * a.normal.dot(free[t.muscle].row(t.point).transpose());
-        system(j, nc + static_cast<Eigen::Index>(t.muscle)) +=
-          t.coefficient * a.normal.dot(along[t.muscle].row(t.point).transpose());
+        value += t.coefficient * a.normal.dot(Where(t, free[t.muscle]));
+        system(j, volumeStart + static_cast<Eigen::Index>(t.muscle)) +=
+          t.coefficient * a.normal.dot(Where(t, along[t.muscle]));
       }
       rhs(j) = a.target - value;
       for (Eigen::Index l = 0; l <= j; ++l)
@@ -792,16 +950,20 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
         {
           for (const Term& t : b.terms)
           {
-            sum += s.coefficient * t.coefficient * inverse(s, t);
+            sum += s.coefficient * t.coefficient * InverseBetween(s, t);
           }
         }
         system(j, l) = system(l, j) = sum * a.normal.dot(b.normal);
       }
     }
+    for (Eigen::Index j = nc; j < volumeStart; ++j)
+    {
+      system(j, j) -= 1 / letGoShare[static_cast<size_t>(j - nc)];
+    }
     for (size_t m = 0; m < count; ++m)
     {
-      const Eigen::Index v = nc + static_cast<Eigen::Index>(m);
-      system.row(v).head(nc) = system.col(v).head(nc).transpose();
+      const Eigen::Index v = volumeStart + static_cast<Eigen::Index>(m);
+      system.row(v).head(volumeStart) = system.col(v).head(volumeStart).transpose();
       system(v, v) = (gradients[m].array() * along[m].array()).sum();
     }
 
@@ -829,18 +991,21 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     std::vector<Points> next(count);
     for (size_t m = 0; m < count; ++m)
     {
-      next[m] = free[m] + multipliers(nc + static_cast<Eigen::Index>(m)) * along[m];
+      next[m] = free[m] + multipliers(volumeStart + static_cast<Eigen::Index>(m)) * along[m];
     }
     std::vector<std::int64_t> inContact(count, 0);
-    for (Eigen::Index j = 0; j < nc; ++j)
+    for (Eigen::Index j = 0; j < volumeStart; ++j)
     {
       if (!active[j])
       {
         continue;
       }
       const Contact& c = contacts[static_cast<size_t>(j)];
-      nowHeld[{ c.muscle, c.point, c.obstacle }].push_back(c.triangle);
-      ++inContact[c.muscle];
+      if (j < nc)
+      {
+        nowHeld[{ c.muscle, c.point, c.obstacle }].push_back(c.triangle);
+        ++inContact[c.muscle];
+      }
       for (const Term& t : c.terms)
       {
         next[t.muscle] += (multipliers(j) * t.coefficient) * *t.column * c.normal.transpose();
@@ -854,6 +1019,14 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       }
     }
     settled = nowHeld == held;
+    if (settled)
+    {
+      DampOscillation(meshes, next, lastSteps);
+    }
+    else
+    {
+      lastSteps.clear();
+    }
     for (size_t m = 0; m < count; ++m)
     {
       const double change = (next[m] - meshes[m].points).cwiseAbs().maxCoeff();

@@ -81,16 +81,44 @@ public:
   /// would otherwise have to fight the lines, and the muscle wraps round the
   /// bone's end instead of lying against it.
   Points RightHandSide(const std::vector<MatchedLine>& lines, const std::vector<FixedObstacle>& bones = {}) const;
+  /// One action-line sample's row as a combination of surface points (point, weight).
+  using Row = std::vector<std::pair<std::int64_t, double>>;
+  /// A sample whose row is let go, in part, in one pose: the energy of its row is taken
+  /// `share` times away (share in (0, 1]; 1: the sample pulls nothing), `target` its target.
+  struct LetGo
+  {
+    Eigen::Index sample = 0;
+    double share = 0;
+    Eigen::Vector3d target = Eigen::Vector3d::Zero();
+  };
+  /// Every sample of `lines` (one pose) inside one of `bones`, deeper than it was at rest
+  /// (`restDepths`, SampleDepthsInBones of the rest pose; none: as if outside every bone at
+  /// rest): the line there says nothing of where the muscle is, so the sample pulls the less the
+  /// deeper it is, and nothing once it is as deep in the bone as it was in the rest muscle. Its
+  /// target is RightHandSide's (beside the bone). A line that crosses a bone then carries the
+  /// muscle by its parts outside, and the muscle lies against the bone on the side its surface
+  /// is on as a whole, instead of being pulled to both sides sample by sample (docs/DESIGN.md
+  /// section 7).
+  std::vector<LetGo> SamplesLetGo(const std::vector<MatchedLine>& lines, const std::vector<FixedObstacle>& bones,
+    const std::vector<double>* restDepths) const;
+  /// Each sample's depth in the one of `bones` it is deepest in (negative: how far inside; 0 outside) in the
+  /// pose `lines` describes.
+  std::vector<double> SampleDepthsInBones(
+    const std::vector<MatchedLine>& lines, const std::vector<FixedObstacle>& bones) const;
+  const Row& SampleRow(Eigen::Index sample) const { return this->SampleRows[static_cast<size_t>(sample)]; }
   /// Rows^T Rows.
   const SparseMatrix& NormalMatrix() const { return this->Normal; }
 
   /// The normal matrix's inverse applied to every column of `rhs`.
   Points Solve(const Points& rhs) const;
-  /// Column `point` of the normal matrix's inverse (how every point moves
-  /// when a unit force acts on `point`), computed once and kept; `Prepare`
-  /// computes the missing ones of `points` in parallel.
-  void Prepare(const std::vector<Eigen::Index>& points) const;
-  const Eigen::VectorXd& InverseColumn(Eigen::Index point) const;
+  /// Column `key` of the normal matrix's inverse (how every point moves
+  /// when a unit force acts on point `key`), or with `key` a sample's key
+  /// (SampleKey) the inverse applied to that sample's row; computed once and
+  /// kept. `Prepare` computes the missing ones of `keys` in parallel.
+  void Prepare(const std::vector<Eigen::Index>& keys) const;
+  const Eigen::VectorXd& InverseColumn(Eigen::Index key) const;
+  /// The key of action-line sample `sample`'s row among the inverse's columns.
+  static Eigen::Index SampleKey(Eigen::Index sample) { return -1 - sample; }
 
   /// The rest surface's triangles with its duplicate points welded (WeldedTriangles): the
   /// energy is posed on them, so that a scan's exact and split duplicates give the same energy.
@@ -119,6 +147,7 @@ private:
   double FollowWeight = 0;
   std::vector<Eigen::Index> SampleIndex; // samples (SampleMatchedLines order) inside the rest muscle
   std::vector<double> SampleClearance;   // their distances from the rest surface
+  std::vector<Row> SampleRows;           // their rows (ChordRow)
   SparseMatrix Rows;                     // shape, action-line and follow rows stacked
   SparseMatrix Normal;                   // Rows^T Rows
   Eigen::SimplicialLDLT<SparseMatrix> Factor;
@@ -144,6 +173,9 @@ struct SettleMotion
 {
   std::vector<Points> points; ///< every muscle's points where the last settle ended
   std::vector<Points> free;   ///< the minimum of that pose without contact and volume
+  /// Per muscle, its action-line samples' depths in the bones at rest
+  /// (SurfaceEnergy::SampleDepthsInBones): a sample is let go only deeper than that.
+  std::vector<std::vector<double>> restDepths;
 };
 
 /// The start of a motion: `muscles` in the rest pose (their action lines `restLines`, the
