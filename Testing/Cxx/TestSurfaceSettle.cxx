@@ -435,9 +435,9 @@ TEST(SurfaceSettle, ASettleThatSwingsToAndFroIsDamped)
 TEST(SurfaceSettle, ALineThatCrossesABoneIsSaid)
 {
   // At 60 degrees the femur sweeps through the rectus femoris's action line: solved on the
-  // surface, the line's pull is moved beside the femur on both sides and the muscle is drawn
-  // round it (docs/DESIGN.md section 7), so the user is told, once, naming muscle and bone. The
-  // lines that only end in a bone (attachments) are not named.
+  // surface, the line is let go inside the femur and the thin muscle is bent round it
+  // (docs/DESIGN.md section 7), so the user is told, once, naming muscle and bone. The lines
+  // that only end in a bone (attachments) are not named.
   const MotionCase c = PhantomMotion(60);
   md::InterpolationParameters parameters;
   parameters.settleOnSurface = true;
