@@ -669,9 +669,14 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   {
     energies =
       BuildEnergies(muscles, lineMotions, steps, parameters.settle, kept, restLines, result.restHullSeconds, report);
-    for (const std::shared_ptr<const SurfaceEnergy>& energy : energies)
+    for (size_t m = 0; m < count; ++m)
     {
-      energyPointers.push_back(energy.get());
+      energyPointers.push_back(energies[m].get());
+      if (energies[m]->PointsNoLineDrives() > 0)
+      {
+        result.warnings.push_back(PartApartWarning(
+          muscles[m].name, energies[m]->PointsNoLineDrives(), energies[m]->PointsUsed(), "its surface"));
+      }
     }
     settleMotion = StartMotion(current, energyPointers, restLines, fixed);
     std::vector<std::vector<MatchedLine>> still;

@@ -249,10 +249,8 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
     }
     if (!anchored.empty())
     {
-      s.result.warnings.push_back("part of muscle '" + m.name + "' lies apart from the rest, and no action line " +
-        "passes through it (" + std::to_string(anchored.size()) + " of the " + std::to_string(hull.points.rows()) +
-        " points of its coarse hull): it moves with the nearest action-line segment; give that part an " +
-        "action line of its own if it should move otherwise");
+      s.result.warnings.push_back(PartApartWarning(m.name, static_cast<std::int64_t>(anchored.size()),
+        static_cast<std::int64_t>(hull.points.rows()), "its coarse hull"));
     }
   }
 
@@ -1362,5 +1360,13 @@ std::vector<DeformationResult> DeformMusclesThatCan(const std::vector<MuscleToDe
     }
     return all;
   });
+}
+
+std::string PartApartWarning(const std::string& muscle, std::int64_t points, std::int64_t of, const std::string& what)
+{
+  return "part of muscle '" + muscle + "' lies apart from the rest, and no action line passes through it (" +
+    std::to_string(points) + " of the " + std::to_string(of) + " points of " + what +
+    "): it moves with the nearest action-line segment; give that part an action line of its own if it should "
+    "move otherwise";
 }
 }

@@ -194,4 +194,8 @@ std::vector<Eigen::Index> FlippedTriangles(const Points& rest, const Points& def
 
 /// Number of `points` inside the closed surface of `tree` (bounding-box check first).
 std::int64_t CountInsideTree(const TriangleTree& tree, const Points& points);
+
+/// The warning for a part of muscle `muscle` that lies apart from the rest and that no action
+/// line passes through: `points` of the `of` points of `what` (its coarse hull, its surface).
+std::string PartApartWarning(const std::string& muscle, std::int64_t points, std::int64_t of, const std::string& what);
 }

@@ -160,6 +160,24 @@ SurfaceEnergy::SurfaceEnergy(
     }
   }
   this->SampleRows = std::move(sampleRows);
+  this->UsedCount = used;
+  int pieces = 0;
+  const std::vector<int> piece = Components(this->Welded, n, pieces, &this->PointUsed);
+  if (pieces > 1)
+  {
+    std::vector<char> driven(static_cast<size_t>(pieces), 0);
+    for (const Row& row : this->SampleRows)
+    {
+      for (const auto& entry : row)
+      {
+        driven[static_cast<size_t>(piece[static_cast<size_t>(entry.first)])] = 1;
+      }
+    }
+    for (Eigen::Index i = 0; i < n; ++i)
+    {
+      this->Undriven += piece[i] >= 0 && !driven[static_cast<size_t>(piece[i])] ? 1 : 0;
+    }
+  }
   for (Eigen::Index i = 0; i < n; ++i)
   {
     // A point no triangle uses has nothing else to place it.

@@ -132,6 +132,12 @@ public:
   const std::vector<char>& Used() const { return this->PointUsed; }
   Eigen::Index SampleCount() const { return static_cast<Eigen::Index>(this->SampleIndex.size()); }
   double Size() const { return this->Span; }
+  /// The points of the parts of the surface (connected pieces) that no action-line row
+  /// touches: a piece a scan left apart from the rest, with nothing but the follow rows to
+  /// place it (it moves with its nearest action-line segment).
+  std::int64_t PointsNoLineDrives() const { return this->Undriven; }
+  /// The points the welded surface uses.
+  std::int64_t PointsUsed() const { return this->UsedCount; }
 
 private:
   void FindLeaders(const TriangleMesh& rest, const std::vector<std::int64_t>& representative);
@@ -148,8 +154,10 @@ private:
   std::vector<Eigen::Index> SampleIndex; // samples (SampleMatchedLines order) inside the rest muscle
   std::vector<double> SampleClearance;   // their distances from the rest surface
   std::vector<Row> SampleRows;           // their rows (ChordRow)
-  SparseMatrix Rows;                     // shape, action-line and follow rows stacked
-  SparseMatrix Normal;                   // Rows^T Rows
+  std::int64_t Undriven = 0;             // points of pieces no row touches
+  std::int64_t UsedCount = 0;
+  SparseMatrix Rows;   // shape, action-line and follow rows stacked
+  SparseMatrix Normal; // Rows^T Rows
   Eigen::SimplicialLDLT<SparseMatrix> Factor;
   mutable std::unordered_map<Eigen::Index, Eigen::VectorXd> Columns;
 };

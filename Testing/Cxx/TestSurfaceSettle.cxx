@@ -264,6 +264,54 @@ TEST(SurfaceSettle, AScansDuplicatePointsChangeNothing)
   }
 }
 
+namespace
+{
+/// `mesh` with a sphere of radius 5 at `centre` added: a piece apart from it.
+md::TriangleMesh WithAPieceApart(const md::TriangleMesh& mesh, const Eigen::Vector3d& centre)
+{
+  const md::TriangleMesh piece = Sphere(centre, 5, 2);
+  md::TriangleMesh joined;
+  joined.points.resize(mesh.points.rows() + piece.points.rows(), 3);
+  joined.points << mesh.points, piece.points;
+  joined.triangles.resize(mesh.triangles.rows() + piece.triangles.rows(), 3);
+  joined.triangles << mesh.triangles, piece.triangles.array() + mesh.points.rows();
+  return joined;
+}
+}
+
+TEST(SurfaceSettle, APieceNoLinePassesThroughIsSaid)
+{
+  // A scan can leave a piece of a muscle apart from the rest (cut off at a pinch); no action
+  // line passes through it, so only the follow rows place it. The energy counts its points,
+  // and the whole method, solved on the surface as on the hull, says so naming the muscle.
+  const Spindle s;
+  const md::TriangleMesh withPiece = WithAPieceApart(s.muscle, { 0, 40, 0 });
+  EXPECT_EQ(md::SurfaceEnergy(s.muscle, { s.line }, md::SettleParameters()).PointsNoLineDrives(), 0);
+  const md::SurfaceEnergy energy(withPiece, { s.line }, md::SettleParameters());
+  EXPECT_EQ(energy.PointsNoLineDrives(), withPiece.points.rows() - s.muscle.points.rows());
+  EXPECT_EQ(energy.PointsUsed(), withPiece.points.rows());
+
+  MotionCase c = PhantomMotion(30);
+  const auto rectus = std::find_if(
+    c.muscles.begin(), c.muscles.end(), [](const md::MuscleMotion& m) { return m.name == "RectusFemoris"; });
+  ASSERT_NE(rectus, c.muscles.end());
+  const Eigen::Vector3d farInFront = rectus->muscle.points.colwise().mean().transpose() + Eigen::Vector3d(0, 80, 0);
+  rectus->muscle = WithAPieceApart(rectus->muscle, farInFront);
+  for (const bool settle : { true, false })
+  {
+    md::InterpolationParameters parameters;
+    parameters.numberOfSteps = 2;
+    parameters.settleOnSurface = settle;
+    const md::InterpolationResult r = md::DeformByInterpolation(c.muscles, c.bones, parameters);
+    int said = 0;
+    for (const std::string& w : r.warnings)
+    {
+      said += w.find("part of muscle 'RectusFemoris' lies apart from the rest") != std::string::npos ? 1 : 0;
+    }
+    EXPECT_EQ(said, 1) << (settle ? "on the surface" : "on the hull");
+  }
+}
+
 TEST(SurfaceSettle, AMuscleNoActionLinePassesThroughIsRefused)
 {
   const Spindle s;
