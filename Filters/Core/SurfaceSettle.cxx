@@ -160,7 +160,6 @@ SurfaceEnergy::SurfaceEnergy(
     }
   }
   this->SampleRows = std::move(sampleRows);
-  this->UsedCount = used;
   int pieces = 0;
   const std::vector<int> piece = Components(this->Welded, n, pieces, &this->PointUsed);
   if (pieces > 1)

@@ -19,6 +19,7 @@
 
 #include <Eigen/SparseCholesky>
 
+#include <algorithm>
 #include <functional>
 
 #include <unordered_map>
@@ -137,7 +138,7 @@ public:
   /// place it (it moves with its nearest action-line segment).
   std::int64_t PointsNoLineDrives() const { return this->Undriven; }
   /// The points the welded surface uses.
-  std::int64_t PointsUsed() const { return this->UsedCount; }
+  std::int64_t PointsUsed() const { return std::count(this->PointUsed.begin(), this->PointUsed.end(), 1); }
 
 private:
   void FindLeaders(const TriangleMesh& rest, const std::vector<std::int64_t>& representative);
@@ -155,9 +156,8 @@ private:
   std::vector<double> SampleClearance;   // their distances from the rest surface
   std::vector<Row> SampleRows;           // their rows (ChordRow)
   std::int64_t Undriven = 0;             // points of pieces no row touches
-  std::int64_t UsedCount = 0;
-  SparseMatrix Rows;   // shape, action-line and follow rows stacked
-  SparseMatrix Normal; // Rows^T Rows
+  SparseMatrix Rows;                     // shape, action-line and follow rows stacked
+  SparseMatrix Normal;                   // Rows^T Rows
   Eigen::SimplicialLDLT<SparseMatrix> Factor;
   mutable std::unordered_map<Eigen::Index, Eigen::VectorXd> Columns;
 };
