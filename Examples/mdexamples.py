@@ -171,7 +171,8 @@ def interpolation_pipeline(inputs, steps=4, mode="Rigid"):
     # move with different bodies, so they are interpolated linearly.
     pipeline["lines"] = simple.BoneInterpolation(Input=simple.OutputPort(pipeline["matching"], 0),
                                                  NumberOfSteps=steps, InterpolationMode="Linear")
-    # The whole method (the paper's interpolation with its default DeformationMesh, the hull), and
+    # The whole method (the paper's interpolation, each step solved on the muscles' own surfaces:
+    # the default DeformationMesh), and
     # the one-pass method as the paper has it to compare with: one step on the hull, the same
     # static resolution and measures, and the paper's deformation step, in which bones only stop
     # points (BoneContactWeight 0; the method's own step lets them push the muscle).

@@ -11,16 +11,16 @@
  * the volume each muscle had in the rest pose is given back. Overlap the
  * rest pose already has (scans overlap the bones) is left alone.
  *
- * DeformationMesh HULL (default) is the paper's pass: each step's deformation
- * solved on a coarse hull that the muscle follows. HullMode Refit (default)
- * keeps each muscle's rest-pose hull and mean value coordinates for the whole
- * motion and refits the hull to the resolved mesh by least squares after each
- * step, keeping the residual as per-point detail; Rebuild builds a new hull
- * and mapping before every step, as the paper did. MUSCLE_SURFACE solves each
- * step on every point of the muscle's own surface (docs/DESIGN.md section 7):
- * the answer does not depend on a hull, moves with the input continuously, and
- * no point enters a bone or another muscle; where an action line runs through
- * a bone the muscle is drawn round it (see the XML documentation).
+ * DeformationMesh MUSCLE_SURFACE (default) solves each step on every point of
+ * the muscle's own surface (docs/DESIGN.md section 7): the answer does not
+ * depend on a hull, moves with the input continuously, and no point enters a
+ * bone or another muscle; where an action line runs through a bone the muscle
+ * is drawn round it (see the XML documentation). HULL is the paper's pass:
+ * each step's deformation solved on a coarse hull that the muscle follows.
+ * HullMode Refit (default) keeps each muscle's rest-pose hull and mean value
+ * coordinates for the whole motion and refits the hull to the resolved mesh by
+ * least squares after each step, keeping the residual as per-point detail;
+ * Rebuild builds a new hull and mapping before every step, as the paper did.
  *
  * Inputs: 0 Input, muscles in the rest pose; 1 BonesRest and 2 BonesCurrent,
  * the bones in both poses (blocks paired by name, else by order; the same
@@ -41,7 +41,9 @@
  * MaxNewBonePenetrationDepth, MaxStaticShift (steps 1..j), StepStaticShift,
  * SharpEdgeCount, FlippedTriangleCount, NumberOfIterations (steps 1..j),
  * Converged, PointsFrozenInObstacles, InterpolationStep, NumberOfSteps,
- * HullSeconds, StepSeconds, ElapsedSeconds (the whole run).
+ * HullSeconds (the rest hull and its mapping, and each step's refit or rebuild;
+ * with MUSCLE_SURFACE the muscle's full-mesh energy), StepSeconds,
+ * ElapsedSeconds (the whole run).
  */
 #pragma once
 
@@ -93,9 +95,9 @@ public:
   /// LINEAR (the paper's eq. 1) or RIGID (default), for bones and action lines.
   vtkSetClampMacro(BoneInterpolationMode, int, LINEAR, RIGID);
   vtkGetMacro(BoneInterpolationMode, int);
-  /// HULL (default): each step solved on a coarse hull the muscle follows (the paper's; the Hull,
-  /// iteration and contact-weight properties apply to it only); MUSCLE_SURFACE: on the muscle's
-  /// own surface.
+  /// MUSCLE_SURFACE (default): each step solved on the muscle's own surface; HULL: on a coarse
+  /// hull the muscle follows (the paper's; the Hull, iteration and contact-weight properties apply
+  /// to it only).
   vtkSetClampMacro(DeformationMesh, int, HULL, MUSCLE_SURFACE);
   vtkGetMacro(DeformationMesh, int);
   /// With DeformationMesh HULL: REFIT (default) or REBUILD.
@@ -157,7 +159,7 @@ protected:
   int NumberOfSteps = 4;
   double MaximumStepDisplacement = 20.0;
   int BoneInterpolationMode = RIGID;
-  int DeformationMesh = HULL;
+  int DeformationMesh = MUSCLE_SURFACE;
   int HullMode = REFIT;
   double MatchingTolerance = 0.01;
   double DeformableShare = 0.6;

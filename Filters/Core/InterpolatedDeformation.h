@@ -98,9 +98,9 @@ struct InterpolationParameters
   StaticResolveParameters staticResolve;
   DeformationParameters deformation = StepDeformationDefaults();
   /// Each step's answer settled on the full mesh (SurfaceSettle), each settle starting from the
-  /// last one's answer (SettleMotion): independent of the hull; false: the hull-based pass's
-  /// answer (the paper's, hull-dependent).
-  bool settleOnSurface = false;
+  /// last one's answer (SettleMotion): independent of the hull (the default, the filter's too);
+  /// false: the hull-based pass's answer (the paper's, hull-dependent).
+  bool settleOnSurface = true;
   SettleParameters settle;
   HullParameters hull;
 };

@@ -4,8 +4,8 @@
     pvpython Testing/Benchmarks/benchmark_method_settings.py [data folder]
 
 The LHDL hip (four muscles, flexion frame 35, as the main job) through the whole method, with
-each DeformationMesh: solved on the muscles' surfaces (Muscle surface), the first run and a change
-of NumberOfSteps; solved on hulls (Hull (paper), the default), the first run (rest-pose hulls and mappings
+each DeformationMesh: solved on the muscles' surfaces (Muscle surface, the default), the first run
+and a change of NumberOfSteps; solved on hulls (Hull (paper)), the first run (rest-pose hulls and mappings
 built), then a change of NumberOfSteps, of BoneContactWeight and of ConvergenceTolerance (hulls
 kept: only the steps are computed), then of HullTargetNumberOfPoints (every hull built again).
 Prints each run's seconds (FilterTests counts the hulls:

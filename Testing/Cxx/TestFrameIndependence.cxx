@@ -292,23 +292,27 @@ TEST(FrameIndependence, APureTranslationIsReproducedWhereverTheModelSitsAndWhate
     pass->Update();
     EXPECT_LE(TranslationError(muscles, pass->GetOutputDataObject(0), t), p.tolerance) << "MuscleDeformation";
 
-    vtkNew<vtkInterpolatedMuscleDeformation> method;
-    method->SetInputDataObject(0, muscles);
-    const vtkSmartPointer<vtkDataObject> bonesRest = Placed(phantom.port[vtkMusculoskeletalPhantom::BONES_REST], &p);
-    const vtkSmartPointer<vtkDataObject> bonesCurrent = Placed(bonesMoved, &p);
-    const vtkSmartPointer<vtkDataObject> linesRest =
-      Placed(phantom.port[vtkMusculoskeletalPhantom::ACTION_LINES_REST], &p);
-    const vtkSmartPointer<vtkDataObject> linesCurrent = Placed(currentLines, &p);
-    method->SetInputDataObject(1, bonesRest);
-    method->SetInputDataObject(2, bonesCurrent);
-    method->SetInputDataObject(3, linesRest);
-    method->SetInputDataObject(4, linesCurrent);
-    method->SetNumberOfSteps(2);
-    method->SetConvergenceTolerance(0.01 * p.scale);
-    method->SetHullTargetNumberOfPoints(100);
-    method->Update();
-    EXPECT_LE(TranslationError(muscles, method->GetOutputDataObject(0), t), p.tolerance)
-      << "InterpolatedMuscleDeformation";
+    for (const int mesh : { vtkInterpolatedMuscleDeformation::MUSCLE_SURFACE, vtkInterpolatedMuscleDeformation::HULL })
+    {
+      vtkNew<vtkInterpolatedMuscleDeformation> method;
+      method->SetInputDataObject(0, muscles);
+      const vtkSmartPointer<vtkDataObject> bonesRest = Placed(phantom.port[vtkMusculoskeletalPhantom::BONES_REST], &p);
+      const vtkSmartPointer<vtkDataObject> bonesCurrent = Placed(bonesMoved, &p);
+      const vtkSmartPointer<vtkDataObject> linesRest =
+        Placed(phantom.port[vtkMusculoskeletalPhantom::ACTION_LINES_REST], &p);
+      const vtkSmartPointer<vtkDataObject> linesCurrent = Placed(currentLines, &p);
+      method->SetInputDataObject(1, bonesRest);
+      method->SetInputDataObject(2, bonesCurrent);
+      method->SetInputDataObject(3, linesRest);
+      method->SetInputDataObject(4, linesCurrent);
+      method->SetDeformationMesh(mesh);
+      method->SetNumberOfSteps(2);
+      method->SetConvergenceTolerance(0.01 * p.scale);
+      method->SetHullTargetNumberOfPoints(100);
+      method->Update();
+      EXPECT_LE(TranslationError(muscles, method->GetOutputDataObject(0), t), p.tolerance)
+        << "InterpolatedMuscleDeformation, DeformationMesh " << mesh;
+    }
   }
 }
 
@@ -328,7 +332,9 @@ TEST(FrameIndependence, MuscleDeformation)
     {}, { "VolumeChangePercent", "FlippedTriangleCount", "NumberOfIterations" });
 }
 
-TEST(FrameIndependence, InterpolatedMuscleDeformation)
+namespace
+{
+void ExpectInterpolatedMethodIndependentOfPlacement(int deformationMesh)
 {
   RoundedPhantom phantom;
   ExpectIndependentOfPlacement(kExactPlacements,
@@ -338,12 +344,24 @@ TEST(FrameIndependence, InterpolatedMuscleDeformation)
       {
         f->SetInputDataObject(port, place(phantom.port[port]));
       }
+      f->SetDeformationMesh(deformationMesh);
       f->SetNumberOfSteps(2);
       f->SetConvergenceTolerance(0.01 * p.scale);
       f->SetHullTargetNumberOfPoints(100);
       return f;
     },
     { "MaxStaticShift", "MaxNewBonePenetrationDepth" }, { "VolumeChangePercent", "SharpEdgeCount" });
+}
+}
+
+TEST(FrameIndependence, InterpolatedMuscleDeformation)
+{
+  ExpectInterpolatedMethodIndependentOfPlacement(vtkInterpolatedMuscleDeformation::MUSCLE_SURFACE);
+}
+
+TEST(FrameIndependence, InterpolatedMuscleDeformationOnTheHull)
+{
+  ExpectInterpolatedMethodIndependentOfPlacement(vtkInterpolatedMuscleDeformation::HULL);
 }
 
 TEST(FrameIndependence, IntersectionResolve)

@@ -40,7 +40,7 @@ class Interpolation(unittest.TestCase):
         method = simple.InterpolatedMuscleDeformation()
         self.assertEqual(method.NumberOfSteps, 4)
         self.assertEqual(method.BoneInterpolationMode, "Rigid")
-        self.assertEqual(method.DeformationMesh, "Hull (paper)")
+        self.assertEqual(method.DeformationMesh, "Muscle surface")
         self.assertEqual(method.HullMode, "Refit")
         self.assertEqual(method.PreserveVolume, 1)
         self.assertAlmostEqual(method.BoneContactWeight, 0.5)
@@ -60,7 +60,11 @@ class Interpolation(unittest.TestCase):
             method.UpdatePipelineInformation()
             self.assertEqual(list(method.TimestepValues), [0.0, 1.0, 2.0])
             method.UpdatePipeline(0)
-        self.assertEqual(messages.text, "")
+        # The phantom's rectus femoris runs from a point fixed below the hip to the knee, so its
+        # action line passes through the femur as the hip flexes: the one thing said, by name.
+        said = [line for line in messages.text.splitlines() if line.strip() and not line.startswith("Warning: In ")]
+        self.assertEqual(len(said), 1, messages.text)
+        self.assertIn("muscle 'RectusFemoris' crosses bone 'Femur'", said[0])
         rest = servermanager.Fetch(simple.OutputPort(self.phantom, 0))
         first = servermanager.Fetch(method)
         for name in MUSCLES:
@@ -81,7 +85,10 @@ class Interpolation(unittest.TestCase):
             displacement = vtk_to_numpy(muscle.GetPointData().GetArray("Displacement"))
             self.assertTrue(numpy.allclose(points(block(rest, name)) + displacement, points(muscle)), name)
             self.assertIsNotNone(muscle.GetPointData().GetArray("StaticShift"), name)
-        self.assertGreater(field(block(last, "RectusFemoris"), "MaxStaticShift"), 0.0)
+        # Solved on the surfaces, contact is a constraint: nothing is left for the static
+        # resolution to move (on the hull it is: see the test below).
+        for name in MUSCLES:
+            self.assertEqual(field(block(last, name), "MaxStaticShift"), 0.0, name)
         # Every step was computed once: the run behind step 2 is the one behind step 0.
         self.assertEqual(field(block(last, "RectusFemoris"), "ElapsedSeconds"), elapsed)
         simple.Delete(method)
@@ -91,7 +98,7 @@ class Interpolation(unittest.TestCase):
         # shorter static resolution than with the paper's step (here 6.5 against 11.5 mm).
         shifts = {}
         for weight in (0.5, 0.0):
-            method = self.method(NumberOfSteps=4, BoneContactWeight=weight)
+            method = self.method(NumberOfSteps=4, DeformationMesh="Hull (paper)", BoneContactWeight=weight)
             method.UpdatePipeline(4)
             muscle = block(servermanager.Fetch(method), "RectusFemoris")
             shifts[weight] = field(muscle, "MaxStaticShift")
