@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <limits>
+#include <utility>
+#include <vector>
 
 namespace md
 {
@@ -28,9 +30,24 @@ struct NearestSegment
   Eigen::Index k = 0;
   double t = 0;
 
+  NearestSegment() = default;
   NearestSegment(const Eigen::Vector3d& p, const std::vector<MatchedLine>& lines)
   {
     double nearest = std::numeric_limits<double>::max();
+    ForEachSegment(p, lines, [&](const NearestSegment& segment, double d) {
+      if (d < nearest)
+      {
+        nearest = d;
+        *this = segment;
+      }
+    });
+  }
+
+  /// Calls visit(segment, distance of p from it) for every segment of `lines` that carries a
+  /// direction in both poses (segments of zero length are skipped), with p's foot on it.
+  template<typename Visit>
+  static void ForEachSegment(const Eigen::Vector3d& p, const std::vector<MatchedLine>& lines, Visit&& visit)
+  {
     for (const MatchedLine& candidate : lines)
     {
       for (Eigen::Index s = 0; s + 1 < candidate.rest.rows(); ++s)
@@ -40,15 +57,11 @@ struct NearestSegment
         {
           continue;
         }
-        const double foot = SegmentFoot(p, a, b);
-        const double d = (a + foot * (b - a) - p).norm();
-        if (d < nearest)
-        {
-          nearest = d;
-          this->line = &candidate;
-          this->k = s;
-          this->t = foot;
-        }
+        NearestSegment segment;
+        segment.line = &candidate;
+        segment.k = s;
+        segment.t = SegmentFoot(p, a, b);
+        visit(segment, (a + segment.t * (b - a) - p).norm());
       }
     }
   }
@@ -78,6 +91,61 @@ struct NearestSegment
       return Eigen::Vector3d(((1 - this->t) * pose.row(this->k) + this->t * pose.row(this->k + 1)).transpose());
     };
     return at(this->line->current) + this->Rotation() * (p - at(this->line->rest));
+  }
+};
+
+/// How the action-line segments near p carry it, blended so that it varies continuously with p
+/// and with the lines: each segment whose distance from p exceeds the nearest one's by less than
+/// `width` weighs (1 - (excess / width)^2)^2, and the rotation (the weighted mean of the
+/// segments' quaternions) and where the motion takes p are the weighted means. The nearest
+/// segment alone jumps where two segments are equally near (between two bundles' lines, at a
+/// via point), and a 1e-7 change of the input then decides which one carries a point. `width` 0:
+/// the nearest segment (segments exactly as near weigh alike).
+struct BlendedSegments
+{
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d follow = Eigen::Vector3d::Zero();
+
+  BlendedSegments(const Eigen::Vector3d& p, const std::vector<MatchedLine>& lines, double width)
+  {
+    std::vector<std::pair<NearestSegment, double>> segments;
+    double nearest = std::numeric_limits<double>::max();
+    NearestSegment::ForEachSegment(p, lines, [&](const NearestSegment& segment, double d) {
+      segments.emplace_back(segment, d);
+      nearest = std::min(nearest, d);
+    });
+    if (segments.empty())
+    {
+      this->follow = p;
+      return;
+    }
+    Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+    Eigen::Vector4d reference = Eigen::Vector4d::Zero();
+    double total = 0;
+    for (const auto& [segment, d] : segments)
+    {
+      const double excess = d - nearest;
+      const double u = width > 0 ? excess / width : (excess > 0 ? 1.0 : 0.0);
+      if (u >= 1)
+      {
+        continue;
+      }
+      const double w = (1 - u * u) * (1 - u * u);
+      Eigen::Vector4d q = Eigen::Quaterniond(segment.Rotation()).coeffs();
+      if (total == 0)
+      {
+        reference = q;
+      }
+      if (q.dot(reference) < 0) // q and -q are the same rotation: average the near ones
+      {
+        q = -q;
+      }
+      sum += w * q;
+      this->follow += w * segment.Follow(p);
+      total += w;
+    }
+    this->follow /= total;
+    this->rotation = Eigen::Quaterniond(Eigen::Vector4d(sum.normalized())).toRotationMatrix();
   }
 };
 }

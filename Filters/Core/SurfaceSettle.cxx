@@ -137,6 +137,7 @@ SurfaceEnergy::SurfaceEnergy(
   const double balance = std::max(1.0, parameters.balancePoints);
   this->ShapeWeight = std::sqrt(static_cast<double>(used) / balance);
   this->FollowWeight = std::max(0.0, parameters.followWeight) * std::sqrt(balance / static_cast<double>(used));
+  this->BlendWidth = std::max(0.0, parameters.blendWidth);
 
   std::vector<Eigen::Triplet<double>> entries;
   for (Eigen::Index i = 0; i < n; ++i)
@@ -487,10 +488,10 @@ Points SurfaceEnergy::RightHandSide(
   for (Eigen::Index i = 0; i < n; ++i)
   {
     const Eigen::Vector3d p = this->RestPoints.row(i).transpose();
-    const NearestSegment nearest(p, lines);
-    targets.row(i) = this->ShapeWeight * (nearest.Rotation() * this->Delta.row(i).transpose()).transpose();
+    const BlendedSegments near(p, lines, this->BlendWidth * this->Span);
+    targets.row(i) = this->ShapeWeight * (near.rotation * this->Delta.row(i).transpose()).transpose();
     targets.row(n + this->SampleCount() + i) =
-      (this->PointUsed[i] ? this->FollowWeight : 1.0) * nearest.Follow(p).transpose();
+      (this->PointUsed[i] ? this->FollowWeight : 1.0) * near.follow.transpose();
   }
   Points restSamples, currentSamples;
   SampleMatchedLines(lines, this->SamplesPerSegment, restSamples, currentSamples);

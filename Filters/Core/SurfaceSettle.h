@@ -32,10 +32,18 @@ struct SettleParameters
   /// A point in contact is held this fraction of its muscle's size outside
   /// the obstacle, so that the surfaces do not touch.
   double contactOffset = 1e-3;
-  /// Rows pulling every point to where its nearest action-line segment's
-  /// motion takes it, relative to the shape rows: they fix the near-null
-  /// modes of the other rows (see DeformationParameters::followWeight).
-  double followWeight = 0.01;
+  /// Rows pulling every point to where the motion of the action-line segments
+  /// near it takes it (BlendedSegments), relative to the shape rows: they fix
+  /// the near-null modes of the other rows (see
+  /// DeformationParameters::followWeight) and hold a muscle pressed between
+  /// obstacles along the contact, where the other rows hold it only weakly
+  /// (docs/DESIGN.md section 7: at 0.01, 1e-7 of input noise moved the LHDL
+  /// gluteus medius by up to 0.019 mm and more triangles turned over).
+  double followWeight = 0.1;
+  /// Each point is turned and carried by the action-line segments whose distance from it exceeds
+  /// the nearest one's by less than this fraction of the muscle's size, blended
+  /// (BlendedSegments), so that no point's target jumps where two segments are equally near.
+  double blendWidth = 0.05;
   int samplesPerSegment = 10;
   /// The shape rows are scaled so that the balance with the action-line rows
   /// is that of a hull of this many points (the hull-based pass's at its
@@ -52,8 +60,8 @@ struct SettleParameters
   /// True when `other` gives the same SurfaceEnergy (the settle's own settings aside).
   bool SameEnergyAs(const SettleParameters& other) const
   {
-    return this->followWeight == other.followWeight && this->samplesPerSegment == other.samplesPerSegment &&
-      this->balancePoints == other.balancePoints;
+    return this->followWeight == other.followWeight && this->blendWidth == other.blendWidth &&
+      this->samplesPerSegment == other.samplesPerSegment && this->balancePoints == other.balancePoints;
   }
 };
 
@@ -152,6 +160,7 @@ private:
   Points Delta; // rest-pose Laplacian coordinates (rows of unused points zero)
   double ShapeWeight = 1;
   double FollowWeight = 0;
+  double BlendWidth = 0;                 ///< SettleParameters::blendWidth
   std::vector<Eigen::Index> SampleIndex; // samples (SampleMatchedLines order) inside the rest muscle
   std::vector<double> SampleClearance;   // their distances from the rest surface
   std::vector<Row> SampleRows;           // their rows (ChordRow)

@@ -9,6 +9,7 @@
 #include "InterpolatedDeformation.h"
 #include "MeshChecks.h"
 #include "MotionCases.h"
+#include "NearestSegment.h"
 #include "RealData.h"
 #include "SurfaceSettle.h"
 #include "TestMeshes.h"
@@ -99,6 +100,40 @@ double Clearance(const md::TriangleTree& tree, const md::Points& points)
   }
   return nearest;
 }
+}
+
+TEST(BlendedSegments, ThePullOfTwoLinesDoesNotJumpHalfwayBetweenThem)
+{
+  // Two parallel lines 10 apart (two bundles of one muscle), turned 20 degrees opposite ways
+  // about y. Halfway between them the nearest segment changes: its rotation jumps by 40 degrees,
+  // and which side a point falls on is a matter of rounding. Blended, the rotation and the place
+  // the lines' motion takes a point vary continuously; away from the halfway plane (farther than
+  // the width) the nearest segment alone carries the point, as before.
+  auto line = [](double x, double degrees) {
+    md::Points rest(2, 3);
+    rest << x, 0, 0, x, 0, 100;
+    const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(degrees * EIGEN_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    md::Points current = rest;
+    current.row(1) = (rest.row(0).transpose() + turn * (rest.row(1) - rest.row(0)).transpose()).transpose();
+    return md::MatchedLine{ rest, current };
+  };
+  const std::vector<md::MatchedLine> lines{ line(0, 20), line(10, -20) };
+  const double tiny = 1e-9;
+  const Eigen::Vector3d left(5 - tiny, 0, 50), right(5 + tiny, 0, 50);
+  const md::BlendedSegments nearestLeft(left, lines, 0), nearestRight(right, lines, 0);
+  EXPECT_GT((nearestLeft.rotation - nearestRight.rotation).norm(), 0.5);
+  EXPECT_GT((nearestLeft.follow - nearestRight.follow).norm(), 10.0);
+  const md::BlendedSegments blendedLeft(left, lines, 5), blendedRight(right, lines, 5);
+  EXPECT_LT((blendedLeft.rotation - blendedRight.rotation).norm(), 1e-8);
+  EXPECT_LT((blendedLeft.follow - blendedRight.follow).norm(), 1e-6);
+  EXPECT_LT((blendedLeft.rotation - Eigen::Matrix3d::Identity()).norm(), 1e-8); // the two turns cancel halfway
+  // Beyond the width the blend is the nearest segment's motion, to rounding.
+  const Eigen::Vector3d near(1, 0, 50);
+  const md::BlendedSegments alone(near, lines, 5);
+  const md::NearestSegment nearest(near, lines);
+  EXPECT_LT((alone.rotation - nearest.Rotation()).norm(), 1e-12);
+  EXPECT_LT((alone.follow - nearest.Follow(near)).norm(), 1e-9);
 }
 
 TEST(SurfaceSettle, TheRestPoseIsItsOwnMinimum)
@@ -363,7 +398,10 @@ TEST(SurfaceSettle, ALineThroughABonePullsTheMuscleBesideItNotIntoIt)
   const md::Points intoTheBone = freeMinimum(40, {});
   const md::Points beside = freeMinimum(40, bones);
   EXPECT_GT(CountInside(bone, intoTheBone), 50);
-  EXPECT_LE(CountInside(bone, beside), 5); // the muscle's own stiffness leaves a few (5 at most, measured)
+  // The muscle's own stiffness leaves a few, and so do the follow rows, which pull each point
+  // with its segments' motion, here into the bone (measured: 16 of 642; 5 with the follow weight
+  // 0.01 of before). Against the bone as an obstacle (the settle) none stays inside.
+  EXPECT_LE(CountInside(bone, beside), 20);
   // The pull moves continuously with the line, also where samples come near the bone or go
   // in: a turn of 1e-5 degrees (the line's end moves 6.3e-6) moves no point further than that
   // twice over.
@@ -542,9 +580,10 @@ TEST(SurfaceSettle, OnThePhantomTheAnswerIsSmoothAndStable)
   ASSERT_NE(rectus, exact.muscles.end());
   // The case is not trivial: without the settle the rectus femoris has sharp edges.
   EXPECT_GT(hullBased.measures.back()[static_cast<size_t>(rectus - exact.muscles.begin())].sharpEdgeCount, 0);
-  // Distances in mm between corresponding points, all muscles (measured: noise 7e-5-0.0017,
-  // split duplicates 1e-4, hulls 0; before the lines' pull was moved out of the bones
-  // 0.46-16 mm).
+  // Distances in mm between corresponding points, all muscles (measured: noise and split
+  // duplicates at most 1e-4, hulls 0; with the nearest segment's pull alone, not blended, 0.0017
+  // and with follow weight 0.1 0.043 (the gluteus maximus's two bundles are equally near many
+  // of its points); before the lines' pull was moved out of the bones 0.46-16 mm).
   auto largest = [&](const md::InterpolationResult& other) {
     double d = 0;
     for (size_t m = 0; m < exact.muscles.size(); ++m)
@@ -555,9 +594,9 @@ TEST(SurfaceSettle, OnThePhantomTheAnswerIsSmoothAndStable)
   };
   for (int seed = 1; seed <= 2; ++seed)
   {
-    EXPECT_LT(largest(run(Perturbed(exact, seed), 250, true)), 0.01) << "1e-7 noise, seed " << seed;
+    EXPECT_LT(largest(run(Perturbed(exact, seed), 250, true)), 0.001) << "1e-7 noise, seed " << seed;
   }
-  EXPECT_LT(largest(run(Perturbed(exact, 1, true), 250, true)), 0.01) << "1e-7 noise, duplicates split";
+  EXPECT_LT(largest(run(Perturbed(exact, 1, true), 250, true)), 0.001) << "1e-7 noise, duplicates split";
   // Each settle goes on from the last step's answer, not from a hull-based pass: no hull is
   // built, and the hull's size is no part of the answer (when the hull-based answer was the
   // settle's start, hull 400 found another minimum 0.44 mm away).
@@ -611,8 +650,9 @@ TEST(SurfaceSettle, OnTheHipTheAnswerDependsOnNeitherRoundingNorTheHull)
   // LHDL hip, flexion 30 degrees (hip_flexion.mot frame 20), four muscles, N = 4. Each step's
   // settle goes on from the last one's answer, so the hull is not part of the answer at all,
   // and the answer moves with the input continuously. Measured at any step: 1e-7 noise
-  // 0.003-0.006 mm, split duplicates 0.016-0.023 mm, hull 200 against 250 0 (issue 13 asks
-  // 0.01, 0.1 and 3 mm). Before, with the hull-based answer as each settle's start, 0.8,
+  // 0.0005 mm, split duplicates 0.0008-0.0010 mm, hull 200 against 250 0 (issue 13 asks
+  // 0.01, 0.1 and 3 mm; with the follow weight 0.01 of before, 0.003-0.006 and 0.016-0.023 mm).
+  // Before, with the hull-based answer as each settle's start, 0.8,
   // 1.7 and 1.0 mm at the last step; and before the straight action lines' fit was made
   // definite, 7-20 mm at the middle steps.
   MotionCase exact;
@@ -621,8 +661,8 @@ TEST(SurfaceSettle, OnTheHipTheAnswerDependsOnNeitherRoundingNorTheHull)
     GTEST_SKIP() << "LHDL data not found (set MUSCLEDEFORMATION_DATA_DIR)";
   }
   const md::InterpolationResult settled = SettledHip(exact);
-  EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 2))), 0.01) << "1e-7 noise";
-  EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 1, true))), 0.1) << "duplicates split";
+  EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 2))), 0.002) << "1e-7 noise";
+  EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 1, true))), 0.005) << "duplicates split";
   EXPECT_LT(LargestAtAnyStep(settled, SettledHip(exact, 200)), 1e-9) << "hull 200";
 }
 
@@ -632,13 +672,18 @@ TEST(SurfaceSettle, OnTheHipTheGluteiPressedTogetherSettle)
   // medius are pressed together. Started from the hull-based answers, some steps' settles did
   // not converge and one diverged (the iliacus moved by 13 times its size in one iteration
   // before such a settle was stopped); going on from the last step's answer every step
-  // settles, and 1e-7 noise moves the answer by 0.008-0.019 mm at any step (measured).
+  // settles, and 1e-7 noise moves the answer by 0.0009-0.0011 mm at any step, 0.0026-0.0038 mm
+  // with split duplicates (measured; 0.008-0.019 and up to 0.1 mm with the follow weight 0.01 of
+  // before, which held the gluteus medius, squeezed between the gluteus maximus and the bones,
+  // only weakly along the contact).
   MotionCase exact;
   if (!LhdlMotion("hip_adduction", 0, exact))
   {
     GTEST_SKIP() << "LHDL data not found (set MUSCLEDEFORMATION_DATA_DIR)";
   }
-  EXPECT_LT(LargestAtAnyStep(SettledHip(exact), SettledHip(Perturbed(exact, 1))), 0.05);
+  const md::InterpolationResult settled = SettledHip(exact);
+  EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 1))), 0.005) << "1e-7 noise";
+  EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 2, true))), 0.01) << "duplicates split";
 }
 
 // Open (issue 13): from the rest pose, with the lines bent towards each other, the settle of
