@@ -197,31 +197,27 @@ void SurfaceEnergy::FindLeaders(const TriangleMesh& rest, const std::vector<std:
 {
   const Eigen::Index n = rest.points.rows();
   const std::vector<char> usedBefore = UsedMask(rest);
+  std::unordered_map<Eigen::Index, size_t> orphan; // points that only degenerate triangles used
   for (Eigen::Index i = 0; i < n; ++i)
   {
     if (this->PointUsed[i] || !usedBefore[i])
     {
       continue;
     }
+    Follower follower;
+    follower.point = i;
     const Eigen::Index twin = representative[static_cast<size_t>(i)];
     if (this->PointUsed[twin])
     {
-      this->Leaders.push_back({ i, { twin } });
+      follower.leaders.push_back(twin);
     }
     else
     {
-      this->Leaders.push_back({ i, {} });
+      orphan.emplace(i, this->Leaders.size());
     }
+    this->Leaders.push_back(std::move(follower));
   }
-  // A point that only degenerate triangles used follows the welded points of its triangles.
-  std::unordered_map<Eigen::Index, size_t> orphan;
-  for (size_t k = 0; k < this->Leaders.size(); ++k)
-  {
-    if (this->Leaders[k].second.empty())
-    {
-      orphan.emplace(this->Leaders[k].first, k);
-    }
-  }
+  // An orphan follows the welded points of its triangles.
   for (Eigen::Index t = 0; t < rest.triangles.rows() && !orphan.empty(); ++t)
   {
     for (int k = 0; k < 3; ++k)
@@ -236,28 +232,62 @@ void SurfaceEnergy::FindLeaders(const TriangleMesh& rest, const std::vector<std:
         const Eigen::Index other = representative[static_cast<size_t>(rest.triangles(t, (k + l) % 3))];
         if (this->PointUsed[other])
         {
-          this->Leaders[found->second].second.push_back(other);
+          this->Leaders[found->second].leaders.push_back(other);
         }
       }
     }
   }
-  for (auto& [point, leaders] : this->Leaders)
+  for (Follower& follower : this->Leaders)
   {
+    std::vector<Eigen::Index>& leaders = follower.leaders;
     std::sort(leaders.begin(), leaders.end());
     leaders.erase(std::unique(leaders.begin(), leaders.end()), leaders.end());
+    const Eigen::Index k = static_cast<Eigen::Index>(leaders.size());
+    const Eigen::RowVector3d p = rest.points.row(follower.point);
+    if (k == 0)
+    {
+      follower.offset = p; // nothing to follow: it stays
+      continue;
+    }
+    // The affine combination of the leaders nearest to the point: least squares on the
+    // leaders' differences from the first (the weights then sum to 1), the smallest such
+    // weights where the leaders are not independent (collinear corners of a degenerate triangle).
+    Eigen::MatrixXd differences(3, k - 1);
+    for (Eigen::Index j = 1; j < k; ++j)
+    {
+      differences.col(j - 1) = (rest.points.row(leaders[j]) - rest.points.row(leaders[0])).transpose();
+    }
+    Eigen::VectorXd rest0 = Eigen::VectorXd::Zero(k - 1);
+    if (k > 1)
+    {
+      rest0 = differences.completeOrthogonalDecomposition().solve(
+        Eigen::Vector3d((p - rest.points.row(leaders[0])).transpose()));
+    }
+    follower.weights.assign(static_cast<size_t>(k), 0.0);
+    follower.weights[0] = 1 - rest0.sum();
+    for (Eigen::Index j = 1; j < k; ++j)
+    {
+      follower.weights[static_cast<size_t>(j)] = rest0(j - 1);
+    }
+    Eigen::RowVector3d combined = Eigen::RowVector3d::Zero();
+    for (Eigen::Index j = 0; j < k; ++j)
+    {
+      combined += follower.weights[static_cast<size_t>(j)] * rest.points.row(leaders[j]);
+    }
+    follower.offset = p - combined;
   }
 }
 
-void SurfaceEnergy::CarryToUnwelded(const Points& start, Points& settled) const
+void SurfaceEnergy::CarryToUnwelded(Points& settled) const
 {
-  for (const auto& [point, leaders] : this->Leaders)
+  for (const Follower& follower : this->Leaders)
   {
-    Eigen::RowVector3d moved = Eigen::RowVector3d::Zero();
-    for (const Eigen::Index leader : leaders)
+    Eigen::RowVector3d place = follower.offset;
+    for (size_t j = 0; j < follower.leaders.size(); ++j)
     {
-      moved += settled.row(leader) - start.row(leader);
+      place += follower.weights[j] * settled.row(follower.leaders[j]);
     }
-    settled.row(point) = start.row(point) + moved / static_cast<double>(std::max<size_t>(1, leaders.size()));
+    settled.row(follower.point) = place;
   }
 }
 
@@ -1069,7 +1099,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   // means nothing; one that ran out of iterations keeps its last.
   for (size_t m = 0; m < count && !diverging; ++m)
   {
-    energies[m]->CarryToUnwelded(muscles[m].points, meshes[m].points);
+    energies[m]->CarryToUnwelded(meshes[m].points);
     muscles[m].points = std::move(meshes[m].points);
   }
   if (motion)

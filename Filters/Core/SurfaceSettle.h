@@ -133,10 +133,14 @@ public:
   /// energy is posed on them, so that a scan's exact and split duplicates give the same energy.
   const Triangles& Surface() const { return this->Welded; }
   /// Writes every point of the muscle that the welded surface does not use but its own
-  /// triangles do into `settled` (the welded surface's points settled from `start`): a welded
-  /// twin moves as the point it was welded to, a point that only dropped (degenerate)
-  /// triangles used moves as the welded points of those triangles do on average.
-  void CarryToUnwelded(const Points& start, Points& settled) const;
+  /// triangles do into `settled` (the welded surface's points settled): a welded twin goes where
+  /// the point it was welded to goes, and a point that only dropped (degenerate) triangles used
+  /// goes to the affine combination of those triangles' welded points that gives it in the rest
+  /// pose (plus what remains of the rest offset). Placed from the rest pose, not moved along
+  /// from the step's start: the static resolution and the volume restore move a twin and its
+  /// point apart a little, and carried from step to step that gap grew until a twin lay inside a
+  /// bone its point was held out of.
+  void CarryToUnwelded(Points& settled) const;
 
   const std::vector<char>& Used() const { return this->PointUsed; }
   Eigen::Index SampleCount() const { return static_cast<Eigen::Index>(this->SampleIndex.size()); }
@@ -153,7 +157,16 @@ private:
 
   Points RestPoints;
   Triangles Welded;
-  std::vector<std::pair<Eigen::Index, std::vector<Eigen::Index>>> Leaders; // unwelded point, whom it follows
+  /// A point of the muscle that the welded surface does not use, and where it goes: the
+  /// combination of welded points `leaders` with `weights` (summing to 1), plus `offset`.
+  struct Follower
+  {
+    Eigen::Index point = 0;
+    std::vector<Eigen::Index> leaders;
+    std::vector<double> weights;
+    Eigen::RowVector3d offset = Eigen::RowVector3d::Zero();
+  };
+  std::vector<Follower> Leaders;
   double Span = 0;
   int SamplesPerSegment = 10;
   std::vector<char> PointUsed;

@@ -626,7 +626,10 @@ double LargestAtAnyStep(const md::InterpolationResult& a, const md::Interpolatio
 }
 
 /// The LHDL motion settled on the full mesh at N = 4, with every muscle settled at every step,
-/// its volume held and no new bone penetration.
+/// its volume held, no new bone penetration and nothing for the static resolution to move (a
+/// scan's duplicate points carried along from step to step drifted from their twins until one
+/// lay 0.0009 mm inside a bone at adduction -40 degrees, and the resolution dented the gluteus
+/// medius by 0.47 mm).
 md::InterpolationResult SettledHip(const MotionCase& c, int hullPoints = 250)
 {
   md::InterpolationParameters parameters;
@@ -639,6 +642,7 @@ md::InterpolationResult SettledHip(const MotionCase& c, int hullPoints = 250)
     const md::MuscleStepMeasures& s = result.measures.back()[m];
     EXPECT_TRUE(s.converged) << c.muscles[m].name; // at every step
     EXPECT_EQ(s.newBonePenetrationCount, 0) << c.muscles[m].name;
+    EXPECT_EQ(s.maxStaticShift, 0.0) << c.muscles[m].name;
     EXPECT_LT(std::abs(s.volumeChangePercent), 1e-4) << c.muscles[m].name;
   }
   return result;
