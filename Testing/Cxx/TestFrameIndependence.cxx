@@ -292,15 +292,15 @@ TEST(FrameIndependence, APureTranslationIsReproducedWhereverTheModelSitsAndWhate
     pass->Update();
     EXPECT_LE(TranslationError(muscles, pass->GetOutputDataObject(0), t), p.tolerance) << "MuscleDeformation";
 
+    const vtkSmartPointer<vtkDataObject> bonesRest = Placed(phantom.port[vtkMusculoskeletalPhantom::BONES_REST], &p);
+    const vtkSmartPointer<vtkDataObject> bonesCurrent = Placed(bonesMoved, &p);
+    const vtkSmartPointer<vtkDataObject> linesRest =
+      Placed(phantom.port[vtkMusculoskeletalPhantom::ACTION_LINES_REST], &p);
+    const vtkSmartPointer<vtkDataObject> linesCurrent = Placed(currentLines, &p);
     for (const int mesh : { vtkInterpolatedMuscleDeformation::MUSCLE_SURFACE, vtkInterpolatedMuscleDeformation::HULL })
     {
       vtkNew<vtkInterpolatedMuscleDeformation> method;
       method->SetInputDataObject(0, muscles);
-      const vtkSmartPointer<vtkDataObject> bonesRest = Placed(phantom.port[vtkMusculoskeletalPhantom::BONES_REST], &p);
-      const vtkSmartPointer<vtkDataObject> bonesCurrent = Placed(bonesMoved, &p);
-      const vtkSmartPointer<vtkDataObject> linesRest =
-        Placed(phantom.port[vtkMusculoskeletalPhantom::ACTION_LINES_REST], &p);
-      const vtkSmartPointer<vtkDataObject> linesCurrent = Placed(currentLines, &p);
       method->SetInputDataObject(1, bonesRest);
       method->SetInputDataObject(2, bonesCurrent);
       method->SetInputDataObject(3, linesRest);
