@@ -7,6 +7,7 @@
 #include "MeshChecks.h"
 #include "MuscleDeformer.h"
 #include "ProgressiveHull.h"
+#include "SurfacePass.h"
 
 #include <vtkCellArray.h>
 #include <vtkDataArray.h>
@@ -20,6 +21,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <map>
 #include <memory>
 
@@ -66,8 +68,8 @@ bool ReadMatchedLines(
 
 namespace
 {
-/// One muscle's rest-pose work: its hull (built or given) and the mean value coordinates of its
-/// points in it, all in the local frame, with what they were made from.
+/// One muscle's rest-pose work on the hull: its hull (built or given) and the mean value
+/// coordinates of its points in it, all in the local frame, with what they were made from.
 struct KeptMuscle
 {
   md::TriangleMesh surface;
@@ -86,12 +88,316 @@ struct KeptMuscle
       (given ? md::SameMesh(this->hull, *givenHull) : this->target == targetNumberOfPoints);
   }
 };
+
+/// One muscle's rest-pose work on its surface: its full-mesh energy, with what it was made from.
+struct KeptEnergy
+{
+  md::TriangleMesh surface;
+  md::LocalFrame frame;
+  std::vector<md::Points> restLines;
+  md::SettleParameters parameters;
+  std::shared_ptr<const md::SurfaceEnergy> energy;
+
+  bool Holds(const md::TriangleMesh& muscle, const md::LocalFrame& now, const std::vector<md::Points>& lines,
+    const md::SettleParameters& settle) const
+  {
+    return this->energy && md::SameMesh(this->surface, muscle) && this->frame.origin == now.origin &&
+      this->frame.unit == now.unit && this->parameters.SameEnergyAs(settle) &&
+      std::equal(this->restLines.begin(), this->restLines.end(), lines.begin(), lines.end(),
+        [](const md::Points& x, const md::Points& y) { return x.rows() == y.rows() && x == y; });
+  }
+};
+
+/// Forgets what blocks no longer among `blocks` kept.
+template<class Entry>
+void EraseOthers(std::map<size_t, Entry>& byBlock, const std::vector<size_t>& blocks)
+{
+  for (auto entry = byBlock.begin(); entry != byBlock.end();)
+  {
+    entry =
+      std::find(blocks.begin(), blocks.end(), entry->first) == blocks.end() ? byBlock.erase(entry) : std::next(entry);
+  }
 }
+}
+
+/// What one muscle's pass gives, on either mesh (in the local frame).
+struct vtkMuscleDeformation::PassOutcome
+{
+  md::Points points;
+  double volumeChangePercent = 0;
+  int iterations = 0;
+  bool converged = false;
+  std::int64_t flippedTriangles = 0;
+  double restSeconds = 0; ///< the hull and its mapping, or the full-mesh energy
+  double deformationSeconds = 0;
+  std::vector<std::string> warnings;
+  std::function<void(vtkFieldData*)> addOwnMeasures; ///< the measures only one mesh has
+};
+
+/// Everything RequestData read, in the local frame: the muscles to deform (`blockOf` their input
+/// blocks) and the obstacles.
+struct vtkMuscleDeformation::PassInput
+{
+  std::vector<md::MuscleToDeform>& toDeform;
+  const std::vector<size_t>& blockOf;
+  const std::vector<md::TriangleMesh>& surfaces;
+  const std::vector<mdvtk::Leaf>& muscles;
+  const std::vector<std::string>& obstacleNames;
+  const std::vector<md::TriangleMesh>& obstacleMeshes;
+  const md::LocalFrame& frame;
+};
 
 struct vtkMuscleDeformation::RestPoseCache
 {
-  std::map<size_t, KeptMuscle> byBlock;
+  std::map<size_t, KeptMuscle> hulls;
+  std::map<size_t, KeptEnergy> energies;
 };
+
+bool vtkMuscleDeformation::PassOnSurface(const PassInput& in, std::vector<std::string>& failures,
+  std::vector<std::string>& reportedBefore, std::vector<PassOutcome>& outcomes, int& result)
+{
+  md::SettleParameters parameters;
+  parameters.samplesPerSegment = this->SamplesPerSegment;
+  std::vector<md::MuscleToSettle> toSettle(in.toDeform.size());
+  for (size_t m = 0; m < in.toDeform.size(); ++m)
+  {
+    const size_t b = in.blockOf[m];
+    this->UpdateProgress(0.3 * m / in.toDeform.size());
+    if (this->CheckAbort())
+    {
+      result = 1; // stopped by the user: the executive empties the output
+      return false;
+    }
+    toSettle[m] = { in.toDeform[m].name, &in.surfaces[b], in.toDeform[m].lines, nullptr };
+    if (!failures[m].empty())
+    {
+      continue;
+    }
+    const auto energyStart = Clock::now();
+    std::vector<md::Points> restLines;
+    for (const md::MatchedLine& line : in.toDeform[m].lines)
+    {
+      restLines.push_back(line.rest);
+    }
+    KeptEnergy& entry = this->Kept->energies[b];
+    if (!entry.Holds(in.surfaces[b], in.frame, restLines, parameters))
+    {
+      entry = KeptEnergy{};
+      std::string failure;
+      if (!mdvtk::CallCore(
+            this, in.muscles[b].label + ": ",
+            [&] {
+              entry.energy = std::make_shared<const md::SurfaceEnergy>(in.surfaces[b], restLines, parameters);
+              ++this->SurfaceEnergyBuildCount;
+            },
+            result, &failure))
+      {
+        if (failure.empty())
+        {
+          return false; // stopped by the user
+        }
+        failures[m] = failure; // reported
+        entry = KeptEnergy{};
+        continue;
+      }
+      entry.surface = in.surfaces[b];
+      entry.frame = in.frame;
+      entry.restLines = restLines;
+      entry.parameters = parameters;
+    }
+    if (entry.energy->PointsNoLineDrives() > 0)
+    {
+      vtkWarningMacro(<< md::PartApartWarning(in.toDeform[m].name, entry.energy->PointsNoLineDrives(),
+                        entry.energy->PointsUsed(), "its surface"));
+    }
+    toSettle[m].energy = entry.energy.get();
+    outcomes[m].restSeconds = SecondsSince(energyStart);
+  }
+  reportedBefore = failures;
+  std::vector<md::SurfacePassResult> settled;
+  if (!mdvtk::CallCore(
+        this, "",
+        [&] {
+          const std::vector<md::Obstacle> obstacles = md::BuildObstacles(in.obstacleNames, in.obstacleMeshes);
+          std::vector<md::FixedObstacle> fixed;
+          for (const md::Obstacle& o : obstacles)
+          {
+            fixed.push_back({ o.name, o.tree.get() });
+          }
+          settled =
+            md::SettleInOnePassThatCan(toSettle, fixed, parameters, failures, mdvtk::ProgressOrCancel(this, 0.3, 0.7));
+        },
+        result))
+  {
+    return false;
+  }
+  for (size_t m = 0; m < settled.size(); ++m)
+  {
+    if (!failures[m].empty())
+    {
+      continue;
+    }
+    md::SurfacePassResult& r = settled[m];
+    PassOutcome& out = outcomes[m];
+    out.points = std::move(r.points);
+    out.volumeChangePercent = r.volumeChangePercent;
+    out.iterations = r.report.iterations;
+    out.converged = r.report.converged;
+    out.flippedTriangles = r.flippedTriangles;
+    out.deformationSeconds = r.report.seconds;
+    out.warnings = std::move(r.warnings);
+    const std::int64_t inContact = r.report.pointsInContact;
+    out.addOwnMeasures = [inContact](vtkFieldData* fieldData) {
+      mdvtk::AddFieldValue(fieldData, "PointsInContact", inContact);
+    };
+  }
+  return true;
+}
+
+bool vtkMuscleDeformation::PassOnHull(const PassInput& in, bool hullGiven, std::vector<md::TriangleMesh>& hulls,
+  const std::vector<mdvtk::Leaf>& hullLeaves, const std::vector<size_t>& hullOf, std::vector<std::string>& failures,
+  std::vector<std::string>& reportedBefore, std::vector<PassOutcome>& outcomes, int& result)
+{
+  auto failMuscle = [&](size_t m, const std::string& message) {
+    vtkErrorMacro(<< message);
+    failures[m] = message;
+  };
+  // Hulls and their mean value coordinates: kept from an earlier run when the muscle (and its
+  // given hull, or the hull size) are the same, else checked (given) or built.
+  for (size_t m = 0; m < in.toDeform.size(); ++m)
+  {
+    const size_t b = in.blockOf[m];
+    const mdvtk::Leaf& leaf = in.muscles[b];
+    this->UpdateProgress(0.3 * m / in.toDeform.size());
+    if (this->CheckAbort())
+    {
+      result = 1; // stopped by the user: the executive empties the output
+      return false;
+    }
+    if (!failures[m].empty())
+    {
+      continue;
+    }
+    const auto hullStart = Clock::now();
+    KeptMuscle& entry = this->Kept->hulls[b];
+    if (!entry.Holds(
+          in.surfaces[b], in.frame, hullGiven, hullGiven ? &hulls[b] : nullptr, this->HullTargetNumberOfPoints))
+    {
+      entry = KeptMuscle{};
+      if (hullGiven)
+      {
+        const mdvtk::Leaf& hullLeaf = hullLeaves[hullOf[b]];
+        if (!md::CheckEdges(hulls[b].triangles).IsClosedOrientedManifold() ||
+          md::SignedVolume(hulls[b].points, hulls[b].triangles) <= 0)
+        {
+          failMuscle(
+            m, hullLeaf.label + " is not a closed, outward-oriented manifold surface: build it with HullDecimation");
+          continue;
+        }
+        const std::int64_t outside = md::CountPointsOutsideHull(hulls[b], in.surfaces[b], in.frame.rounding);
+        if (outside > 0)
+        {
+          failMuscle(m,
+            hullLeaf.label + " does not enclose " + leaf.label + ": " + std::to_string(outside) + " of " +
+              std::to_string(md::UsedPoints(in.surfaces[b]).rows()) +
+              " muscle points are outside it, where mean value coordinates extrapolate; build the "
+              "hull with HullDecimation or leave Hull empty");
+          continue;
+        }
+        entry.hull = hulls[b];
+      }
+      md::HullParameters parameters;
+      parameters.targetNumberOfPoints = this->HullTargetNumberOfPoints;
+      parameters.cancelled = mdvtk::AbortRequested(this);
+      std::string failure;
+      if (!mdvtk::CallCore(
+            this, leaf.label + ": ",
+            [&] {
+              if (!hullGiven)
+              {
+                const md::MuscleHull built = md::BuildMuscleHull(in.surfaces[b], parameters);
+                ++this->HullBuildCount;
+                entry.hull = built.result.hull;
+                if (built.report.Changed())
+                {
+                  entry.repairs = built.report.Describe();
+                }
+              }
+              entry.weights = md::MeanValueCoordinates(entry.hull, in.surfaces[b].points);
+            },
+            result, &failure))
+      {
+        if (failure.empty())
+        {
+          return false; // stopped by the user
+        }
+        failures[m] = failure; // reported
+        entry = KeptMuscle{};  // a hull without its weights is not kept
+        continue;
+      }
+      entry.surface = in.surfaces[b];
+      entry.frame = in.frame;
+      entry.hullGiven = hullGiven;
+      entry.target = this->HullTargetNumberOfPoints;
+    }
+    if (!entry.repairs.empty())
+    {
+      vtkWarningMacro(<< leaf.label << " was repaired to build its hull: " << entry.repairs
+                      << " (the muscle itself is deformed as given)");
+    }
+    in.toDeform[m].hull = &entry.hull;
+    in.toDeform[m].weights = &entry.weights;
+    outcomes[m].restSeconds = SecondsSince(hullStart);
+  }
+
+  md::DeformationParameters parameters;
+  parameters.maximumIterations = this->MaximumNumberOfIterations;
+  parameters.maximumCoarseIterations = this->MaximumCoarseIterations;
+  parameters.convergenceTolerance = in.frame.LengthToLocal(this->ConvergenceTolerance);
+  parameters.stepLength = this->StepLength;
+  parameters.samplesPerSegment = this->SamplesPerSegment;
+  parameters.preserveVolume = this->PreserveVolume;
+  parameters.dynamicIntersections = this->DynamicIntersections;
+  reportedBefore = failures;
+  std::vector<md::DeformationResult> results;
+  if (!mdvtk::CallCore(
+        this, "",
+        [&] {
+          const std::vector<md::Obstacle> obstacles = this->DynamicIntersections
+            ? md::BuildObstacles(in.obstacleNames, in.obstacleMeshes)
+            : std::vector<md::Obstacle>{};
+          results = md::DeformMusclesThatCan(
+            in.toDeform, obstacles, parameters, failures, mdvtk::ProgressOrCancel(this, 0.3, 0.7));
+        },
+        result))
+  {
+    return false;
+  }
+  for (size_t m = 0; m < results.size(); ++m)
+  {
+    if (!failures[m].empty())
+    {
+      continue;
+    }
+    const md::DeformationResult& r = results[m];
+    PassOutcome& out = outcomes[m];
+    out.points = r.points;
+    out.volumeChangePercent = r.volumeChangePercent;
+    out.iterations = r.iterations;
+    out.converged = r.converged;
+    out.flippedTriangles = r.flippedTriangles;
+    out.deformationSeconds = r.seconds;
+    out.warnings = r.warnings;
+    out.addOwnMeasures = [r](vtkFieldData* fieldData) {
+      mdvtk::AddFieldValue(fieldData, "CoarseIterations", r.coarseIterations);
+      mdvtk::AddFieldValue(fieldData, "PointsFrozenInObstacles", r.verticesFrozen);
+      mdvtk::AddFieldValue(fieldData, "PointsStoppedAtObstacles", r.verticesStopped);
+      mdvtk::AddFieldValue(fieldData, "RestActionLineSamplesInside", r.restSamplesInside);
+      mdvtk::AddFieldValue(fieldData, "CurrentActionLineSamplesInside", r.currentSamplesInside);
+    };
+  }
+  return true;
+}
 
 vtkMuscleDeformation::vtkMuscleDeformation()
   : Kept(std::make_unique<RestPoseCache>())
@@ -152,7 +458,6 @@ int vtkMuscleDeformation::RequestData(
   std::vector<md::TriangleMesh> surfaces(count), hulls(count);
   std::vector<md::MuscleToDeform> toDeform;
   std::vector<size_t> blockOf;
-  std::vector<double> hullSeconds(count, 0.0);
   // One muscle's fault is reported and that muscle left out; the others go on.
   std::map<size_t, std::string> failedBlocks;
   auto fail = [&](size_t block, const std::string& message) {
@@ -244,127 +549,33 @@ int vtkMuscleDeformation::RequestData(
     frame.ToLocal(obstacle.points);
   }
 
-  // Hulls and their mean value coordinates: kept from an earlier run when the muscle (and its
-  // given hull, or the hull size) are the same, else checked (given) or built.
-  RestPoseCache& kept = *this->Kept;
-  for (auto entry = kept.byBlock.begin(); entry != kept.byBlock.end();)
-  {
-    entry = std::find(blockOf.begin(), blockOf.end(), entry->first) == blockOf.end() ? kept.byBlock.erase(entry)
-                                                                                     : std::next(entry);
-  }
-  for (size_t m = 0; m < toDeform.size(); ++m)
-  {
-    const size_t b = blockOf[m];
-    const mdvtk::Leaf& leaf = muscles[b];
-    this->UpdateProgress(0.3 * m / toDeform.size());
-    if (this->CheckAbort())
-    {
-      return 1; // stopped by the user: the executive empties the output
-    }
-    if (!failures[m].empty())
-    {
-      continue;
-    }
-    const auto hullStart = Clock::now();
-    KeptMuscle& entry = kept.byBlock[b];
-    if (!entry.Holds(surfaces[b], frame, hullGiven, hullGiven ? &hulls[b] : nullptr, this->HullTargetNumberOfPoints))
-    {
-      entry = KeptMuscle{};
-      if (hullGiven)
-      {
-        const mdvtk::Leaf& hullLeaf = hullLeaves[hullOf[b]];
-        if (!md::CheckEdges(hulls[b].triangles).IsClosedOrientedManifold() ||
-          md::SignedVolume(hulls[b].points, hulls[b].triangles) <= 0)
-        {
-          failMuscle(
-            m, hullLeaf.label + " is not a closed, outward-oriented manifold surface: build it with HullDecimation");
-          continue;
-        }
-        const std::int64_t outside = md::CountPointsOutsideHull(hulls[b], surfaces[b], frame.rounding);
-        if (outside > 0)
-        {
-          failMuscle(m,
-            hullLeaf.label + " does not enclose " + leaf.label + ": " + std::to_string(outside) + " of " +
-              std::to_string(md::UsedPoints(surfaces[b]).rows()) +
-              " muscle points are outside it, where mean value coordinates extrapolate; build the "
-              "hull with HullDecimation or leave Hull empty");
-          continue;
-        }
-        entry.hull = hulls[b];
-      }
-      md::HullParameters parameters;
-      parameters.targetNumberOfPoints = this->HullTargetNumberOfPoints;
-      parameters.cancelled = mdvtk::AbortRequested(this);
-      int result = 1;
-      std::string failure;
-      if (!mdvtk::CallCore(
-            this, leaf.label + ": ",
-            [&] {
-              if (!hullGiven)
-              {
-                const md::MuscleHull built = md::BuildMuscleHull(surfaces[b], parameters);
-                ++this->HullBuildCount;
-                entry.hull = built.result.hull;
-                if (built.report.Changed())
-                {
-                  entry.repairs = built.report.Describe();
-                }
-              }
-              entry.weights = md::MeanValueCoordinates(entry.hull, surfaces[b].points);
-            },
-            result, &failure))
-      {
-        if (failure.empty())
-        {
-          return result; // stopped by the user
-        }
-        failures[m] = failure; // reported
-        entry = KeptMuscle{};  // a hull without its weights is not kept
-        continue;
-      }
-      entry.surface = surfaces[b];
-      entry.frame = frame;
-      entry.hullGiven = hullGiven;
-      entry.target = this->HullTargetNumberOfPoints;
-    }
-    if (!entry.repairs.empty())
-    {
-      vtkWarningMacro(<< leaf.label << " was repaired to build its hull: " << entry.repairs
-                      << " (the muscle itself is deformed as given)");
-    }
-    toDeform[m].hull = &entry.hull;
-    toDeform[m].weights = &entry.weights;
-    hullSeconds[b] = SecondsSince(hullStart);
-  }
+  // Only the muscles that are still in keep what their rest pose made.
+  EraseOthers(this->Kept->hulls, blockOf);
+  EraseOthers(this->Kept->energies, blockOf);
 
-  md::DeformationParameters parameters;
-  parameters.maximumIterations = this->MaximumNumberOfIterations;
-  parameters.maximumCoarseIterations = this->MaximumCoarseIterations;
-  parameters.convergenceTolerance = frame.LengthToLocal(this->ConvergenceTolerance);
-  parameters.stepLength = this->StepLength;
-  parameters.samplesPerSegment = this->SamplesPerSegment;
-  parameters.preserveVolume = this->PreserveVolume;
-  parameters.dynamicIntersections = this->DynamicIntersections;
-  std::vector<md::DeformationResult> results;
-  const std::vector<std::string> reportedBefore = failures;
+  const PassInput in{ toDeform, blockOf, surfaces, muscles, obstacleNames, obstacleMeshes, frame };
+  std::vector<PassOutcome> outcomes(toDeform.size());
+  std::vector<std::string> reportedBefore; // the failures said before the deformation
   int result = 1;
-  if (!mdvtk::CallCore(
-        this, "",
-        [&] {
-          const std::vector<md::Obstacle> obstacles = this->DynamicIntersections
-            ? md::BuildObstacles(obstacleNames, obstacleMeshes)
-            : std::vector<md::Obstacle>{};
-          results = md::DeformMusclesThatCan(
-            toDeform, obstacles, parameters, failures, mdvtk::ProgressOrCancel(this, 0.3, 0.7));
-        },
-        result))
+  if (this->DeformationMesh == MUSCLE_SURFACE)
+  {
+    if (hullGiven)
+    {
+      vtkWarningMacro(<< "the Hull input is not used with DeformationMesh Muscle surface (only with Hull (paper))");
+    }
+    if (!this->PassOnSurface(in, failures, reportedBefore, outcomes, result))
+    {
+      return result;
+    }
+  }
+  else if (!this->PassOnHull(in, hullGiven, hulls, hullLeaves, hullOf, failures, reportedBefore, outcomes, result))
   {
     return result;
   }
   const double seconds = SecondsSince(start);
 
   std::vector<vtkSmartPointer<vtkPolyData>> outputs(count);
-  for (size_t m = 0; m < results.size(); ++m)
+  for (size_t m = 0; m < outcomes.size(); ++m)
   {
     const size_t b = blockOf[m];
     if (!failures[m].empty())
@@ -379,32 +590,27 @@ int vtkMuscleDeformation::RequestData(
       }
       continue;
     }
-    const md::DeformationResult& r = results[m];
+    PassOutcome& r = outcomes[m];
     for (const std::string& warning : r.warnings)
     {
       vtkWarningMacro(<< warning);
     }
     md::Points displacement = r.points - surfaces[b].points;
     frame.VectorsToWorld(displacement);
-    md::Points points = r.points;
-    frame.ToWorld(points);
+    frame.ToWorld(r.points);
     auto output = vtkSmartPointer<vtkPolyData>::New();
     output->ShallowCopy(muscles[b].data);
-    output->SetPoints(mdvtk::ToVtkPoints(points));
+    output->SetPoints(mdvtk::ToVtkPoints(r.points));
     output->GetPointData()->AddArray(mdvtk::ToVtkArray(mdvtk::DisplacementArrayName, displacement));
     vtkNew<vtkFieldData> fieldData;
     fieldData->DeepCopy(muscles[b].data->GetFieldData());
     mdvtk::AddFieldValue(fieldData, mdvtk::VolumeChangeArrayName, r.volumeChangePercent);
     mdvtk::AddFieldValue(fieldData, "NumberOfIterations", r.iterations);
-    mdvtk::AddFieldValue(fieldData, "CoarseIterations", r.coarseIterations);
     mdvtk::AddFieldValue(fieldData, "Converged", r.converged ? 1 : 0);
     mdvtk::AddFieldValue(fieldData, "FlippedTriangleCount", r.flippedTriangles);
-    mdvtk::AddFieldValue(fieldData, "PointsFrozenInObstacles", r.verticesFrozen);
-    mdvtk::AddFieldValue(fieldData, "PointsStoppedAtObstacles", r.verticesStopped);
-    mdvtk::AddFieldValue(fieldData, "RestActionLineSamplesInside", r.restSamplesInside);
-    mdvtk::AddFieldValue(fieldData, "CurrentActionLineSamplesInside", r.currentSamplesInside);
-    mdvtk::AddFieldValue(fieldData, "HullSeconds", hullSeconds[b]);
-    mdvtk::AddFieldValue(fieldData, "DeformationSeconds", r.seconds);
+    r.addOwnMeasures(fieldData);
+    mdvtk::AddFieldValue(fieldData, "HullSeconds", r.restSeconds);
+    mdvtk::AddFieldValue(fieldData, "DeformationSeconds", r.deformationSeconds);
     mdvtk::AddFieldValue(fieldData, "ElapsedSeconds", seconds);
     output->SetFieldData(fieldData);
     outputs[b] = output;
@@ -421,6 +627,7 @@ int vtkMuscleDeformation::RequestData(
 void vtkMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
+  os << indent << "DeformationMesh: " << (this->DeformationMesh == HULL ? "Hull (paper)" : "Muscle surface") << "\n";
   os << indent << "MaximumNumberOfIterations: " << this->MaximumNumberOfIterations << "\n";
   os << indent << "MaximumCoarseIterations: " << this->MaximumCoarseIterations << "\n";
   os << indent << "ConvergenceTolerance: " << this->ConvergenceTolerance << "\n";
@@ -430,4 +637,5 @@ void vtkMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "DynamicIntersections: " << this->DynamicIntersections << "\n";
   os << indent << "HullTargetNumberOfPoints: " << this->HullTargetNumberOfPoints << "\n";
   os << indent << "HullBuildCount: " << this->HullBuildCount << "\n";
+  os << indent << "SurfaceEnergyBuildCount: " << this->SurfaceEnergyBuildCount << "\n";
 }

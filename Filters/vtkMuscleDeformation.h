@@ -3,7 +3,14 @@
  * @class   vtkMuscleDeformation
  * @brief   Deforms muscles from the rest pose to the current pose in one pass.
  *
- * The deformation of Kellnhofer & Kohout (after Huang et al. 2006), the
+ * DeformationMesh MUSCLE_SURFACE solves the pass on every point of the
+ * muscles' own surfaces (md::SettleInOnePass, docs/DESIGN.md section 7): the
+ * energy below posed on the full mesh, contact a constraint (no point ends
+ * inside an obstacle or another muscle), the rest volume held; the answer does
+ * not depend on a hull, and the Hull input and the hull and iteration
+ * properties are not used.
+ *
+ * DeformationMesh HULL (default): the deformation of Kellnhofer & Kohout (after Huang et al. 2006), the
  * paper's "original method": the unknowns are the points of each muscle's
  * coarse hull (input 3, or built as HullDecimation does), the muscle follows
  * by mean value coordinates. Least squares of the hull's cotangent Laplacian
@@ -26,10 +33,11 @@
  *
  * Output: the muscles (same structure, cells and arrays) with moved points,
  * point array Displacement, and field data VolumeChangePercent,
- * NumberOfIterations, CoarseIterations, Converged, FlippedTriangleCount,
- * PointsFrozenInObstacles, PointsStoppedAtObstacles,
- * RestActionLineSamplesInside, CurrentActionLineSamplesInside,
- * HullSeconds, ElapsedSeconds.
+ * NumberOfIterations, Converged, FlippedTriangleCount, HullSeconds (the hull
+ * and its mapping, or the full-mesh energy), DeformationSeconds, ElapsedSeconds;
+ * with HULL also CoarseIterations, PointsFrozenInObstacles,
+ * PointsStoppedAtObstacles, RestActionLineSamplesInside,
+ * CurrentActionLineSamplesInside; with MUSCLE_SURFACE PointsInContact.
  */
 #pragma once
 
@@ -38,6 +46,17 @@
 #include <vtkPassInputTypeAlgorithm.h>
 
 #include <memory>
+#include <string>
+#include <vector>
+
+namespace md
+{
+struct TriangleMesh;
+}
+namespace mdvtk
+{
+struct Leaf;
+}
 
 class MUSCLEDEFORMATIONFILTERS_EXPORT vtkMuscleDeformation : public vtkPassInputTypeAlgorithm
 {
@@ -51,6 +70,17 @@ public:
   void AddObstacleConnection(vtkAlgorithmOutput* output) { this->AddInputConnection(2, output); }
   void RemoveAllObstacles() { this->SetInputConnection(2, nullptr); }
   void SetHullConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(3, output); }
+
+  enum DeformationMeshes
+  {
+    HULL = 0,
+    MUSCLE_SURFACE = 1,
+  };
+  /// HULL (default): solved on a coarse hull the muscle follows, the paper's original method (the
+  /// Hull input and the properties below apply to it only, SamplesPerSegment aside);
+  /// MUSCLE_SURFACE: on the muscles' own surfaces.
+  vtkSetClampMacro(DeformationMesh, int, HULL, MUSCLE_SURFACE);
+  vtkGetMacro(DeformationMesh, int);
 
   /// Iterations of both phases together. Default 200.
   vtkSetClampMacro(MaximumNumberOfIterations, int, 1, 100000);
@@ -92,6 +122,9 @@ public:
   /// action lines or another iteration setting reuses them, a changed muscle or hull size
   /// rebuilds that muscle's.
   vtkGetMacro(HullBuildCount, int);
+  /// Full-mesh energies built so far (DeformationMesh MUSCLE_SURFACE): kept per muscle while its
+  /// rest-pose surface and action lines are the same.
+  vtkGetMacro(SurfaceEnergyBuildCount, int);
 
 protected:
   vtkMuscleDeformation();
@@ -101,6 +134,7 @@ protected:
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
+  int DeformationMesh = HULL;
   int MaximumNumberOfIterations = 200;
   int MaximumCoarseIterations = 100;
   double ConvergenceTolerance = 0.01;
@@ -114,6 +148,17 @@ private:
   vtkMuscleDeformation(const vtkMuscleDeformation&) = delete;
   void operator=(const vtkMuscleDeformation&) = delete;
   int HullBuildCount = 0;
+  int SurfaceEnergyBuildCount = 0;
   struct RestPoseCache;
+  struct PassInput;
+  struct PassOutcome;
+  /// The pass on the muscles' surfaces or on their hulls: each muscle's outcome, or its failure
+  /// in `failures` (`reportedBefore`: the failures already reported when the deformation
+  /// started); false (with RequestData's `result`) when the run stops.
+  bool PassOnSurface(const PassInput& in, std::vector<std::string>& failures, std::vector<std::string>& reportedBefore,
+    std::vector<PassOutcome>& outcomes, int& result);
+  bool PassOnHull(const PassInput& in, bool hullGiven, std::vector<md::TriangleMesh>& hulls,
+    const std::vector<mdvtk::Leaf>& hullLeaves, const std::vector<size_t>& hullOf, std::vector<std::string>& failures,
+    std::vector<std::string>& reportedBefore, std::vector<PassOutcome>& outcomes, int& result);
   std::unique_ptr<RestPoseCache> Kept;
 };

@@ -483,75 +483,6 @@ std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vecto
   return energies;
 }
 
-/// [muscle][line][bone][sample]: whether each sample of the current pose of the muscle's matched
-/// lines (SampleMatchedLines') lies inside the bone, with the bones' trees in that pose.
-using LineSamplesInside = std::vector<std::vector<std::vector<std::vector<char>>>>;
-LineSamplesInside LineSamplesInBones(
-  const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones, int samplesPerSegment)
-{
-  LineSamplesInside inside(lines.size());
-  for (size_t m = 0; m < lines.size(); ++m)
-  {
-    for (const MatchedLine& line : lines[m])
-    {
-      Points restSamples, samples;
-      SampleMatchedLines({ line }, samplesPerSegment, restSamples, samples);
-      std::vector<std::vector<char>> perBone;
-      for (const FixedObstacle& bone : bones)
-      {
-        std::vector<char> in(static_cast<size_t>(samples.rows()), 0);
-        for (Eigen::Index k = 0; k < samples.rows(); ++k)
-        {
-          const Eigen::Vector3d p = samples.row(k).transpose();
-          in[static_cast<size_t>(k)] = bone.tree->InBounds(p) && bone.tree->Inside(p);
-        }
-        perBone.push_back(std::move(in));
-      }
-      inside[m].push_back(std::move(perBone));
-    }
-  }
-  return inside;
-}
-
-/// What to say of every muscle one of whose action lines (`lines[m]`, their current pose the
-/// bones') crosses a bone it did not cross at rest (`atRest`, LineSamplesInBones'): goes into it
-/// and out again, not only ends in it, as a line does at its attachment. Solved on the surface, a
-/// line's pull is moved beside the bone on the side nearest to each sample, so a line that
-/// crosses a bone pulls the muscle round it (docs/DESIGN.md section 7).
-std::vector<std::string> LinesThroughBones(const std::vector<MuscleMotion>& muscles,
-  const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones,
-  const LineSamplesInside& atRest, const InterpolationParameters& parameters)
-{
-  const LineSamplesInside inside = LineSamplesInBones(lines, bones, parameters.settle.samplesPerSegment);
-  std::vector<std::string> warnings;
-  for (size_t m = 0; m < lines.size(); ++m)
-  {
-    for (size_t b = 0; b < bones.size(); ++b)
-    {
-      bool crosses = false;
-      for (size_t l = 0; l < inside[m].size() && !crosses; ++l)
-      {
-        const std::vector<char>& now = inside[m][l][b];
-        const std::vector<char>& rest = atRest[m][l][b];
-        const auto firstOut = std::find(now.begin(), now.end(), 0);
-        const auto lastOut = std::find(now.rbegin(), now.rend(), 0).base(); // one past it
-        for (auto s = firstOut; s < lastOut && !crosses; ++s)
-        {
-          crosses = *s && !rest[static_cast<size_t>(s - now.begin())];
-        }
-      }
-      if (crosses)
-      {
-        warnings.push_back("an action line of muscle '" + muscles[m].name + "' crosses bone '" + bones[b].name +
-          "': solved on the muscle's surface, the line is let go inside the bone and the muscle lies against "
-          "the bone, which can bend a thin muscle round it; check the muscle, give the line a via point, or "
-          "solve on the hull (DeformationMesh Hull)");
-      }
-    }
-  }
-  return warnings;
-}
-
 /// DeformByInterpolation on input already in its local frame.
 InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles, const std::vector<BoneMotion>& bones,
   const InterpolationParameters& parameters, const std::function<void(double)>& progress, RestMappingCache* kept)
@@ -665,6 +596,11 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   std::vector<std::vector<Points>> restLines(count); // the matched lines at step 0
   SettleMotion settleMotion;
   LineSamplesInside linesInBonesAtRest; // the scans' own overlap
+  std::vector<std::string> names;
+  for (const MuscleMotion& m : muscles)
+  {
+    names.push_back(m.name);
+  }
   if (settle)
   {
     energies =
@@ -727,7 +663,8 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       }
       settled = SettleMuscles(next, energyPointers, wholeMotion, restVolumes, fixed, &restOverlap, parameters.settle,
         &settleMotion, [&](double fraction) { report(stepStart + 0.9 * stepShare * fraction); });
-      for (const std::string& warning : LinesThroughBones(muscles, wholeMotion, fixed, linesInBonesAtRest, parameters))
+      for (const std::string& warning :
+        LinesThroughBones(names, wholeMotion, fixed, &linesInBonesAtRest, parameters.settle.samplesPerSegment))
       {
         if (warned.insert(warning).second) // said once, at the first step that has it
         {

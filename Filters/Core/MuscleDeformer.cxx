@@ -1344,22 +1344,10 @@ std::vector<DeformationResult> DeformMusclesThatCan(const std::vector<MuscleToDe
   const std::vector<Obstacle>& bones, const DeformationParameters& parameters, std::vector<std::string>& failures,
   const std::function<void(double)>& progress)
 {
-  failures.resize(muscles.size());
-  const std::function<void(double)> forward = ForwardOnly(progress);
-  return WithoutFailedMuscles(failures, [&](const std::vector<size_t>& active) {
-    std::vector<MuscleToDeform> subset;
-    for (size_t m : active)
-    {
-      subset.push_back(muscles[m]);
-    }
-    std::vector<DeformationResult> some = DeformMuscles(subset, bones, parameters, forward);
-    std::vector<DeformationResult> all(muscles.size());
-    for (size_t k = 0; k < active.size(); ++k)
-    {
-      all[active[k]] = std::move(some[k]);
-    }
-    return all;
-  });
+  return ForMusclesThatCan(muscles, failures, progress,
+    [&](const std::vector<MuscleToDeform>& subset, const std::function<void(double)>& forward) {
+      return DeformMuscles(subset, bones, parameters, forward);
+    });
 }
 
 std::string PartApartWarning(const std::string& muscle, std::int64_t points, std::int64_t of, const std::string& what)

@@ -82,4 +82,29 @@ auto WithoutFailedMuscles(std::vector<std::string>& failures, Run run)
     }
   }
 }
+
+/// `run(subset, progress)` on the muscles of `muscles` whose `failures` entry is empty (resized to
+/// the muscles), as WithoutFailedMuscles: a muscle that fails on its own account is left out and
+/// the others run again. Returns one result per muscle of `muscles`, those of failed muscles empty.
+template<class Muscle, class Run>
+auto ForMusclesThatCan(const std::vector<Muscle>& muscles, std::vector<std::string>& failures,
+  const std::function<void(double)>& progress, Run run)
+{
+  failures.resize(muscles.size());
+  const std::function<void(double)> forward = ForwardOnly(progress);
+  return WithoutFailedMuscles(failures, [&](const std::vector<size_t>& active) {
+    std::vector<Muscle> subset;
+    for (size_t m : active)
+    {
+      subset.push_back(muscles[m]);
+    }
+    auto some = run(subset, forward);
+    decltype(some) all(muscles.size());
+    for (size_t k = 0; k < active.size(); ++k)
+    {
+      all[active[k]] = std::move(some[k]);
+    }
+    return all;
+  });
+}
 }

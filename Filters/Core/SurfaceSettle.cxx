@@ -830,6 +830,66 @@ std::vector<Contact> FindContacts(const std::vector<TriangleMesh>& meshes,
 }
 }
 
+LineSamplesInside LineSamplesInBones(
+  const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones, int samplesPerSegment)
+{
+  LineSamplesInside inside(lines.size());
+  for (size_t m = 0; m < lines.size(); ++m)
+  {
+    for (const MatchedLine& line : lines[m])
+    {
+      Points restSamples, samples;
+      SampleMatchedLines({ line }, samplesPerSegment, restSamples, samples);
+      std::vector<std::vector<char>> perBone;
+      for (const FixedObstacle& bone : bones)
+      {
+        std::vector<char> in(static_cast<size_t>(samples.rows()), 0);
+        for (Eigen::Index k = 0; k < samples.rows(); ++k)
+        {
+          const Eigen::Vector3d p = samples.row(k).transpose();
+          in[static_cast<size_t>(k)] = bone.tree->InBounds(p) && bone.tree->Inside(p);
+        }
+        perBone.push_back(std::move(in));
+      }
+      inside[m].push_back(std::move(perBone));
+    }
+  }
+  return inside;
+}
+
+std::vector<std::string> LinesThroughBones(const std::vector<std::string>& names,
+  const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones,
+  const LineSamplesInside* atRest, int samplesPerSegment)
+{
+  const LineSamplesInside inside = LineSamplesInBones(lines, bones, samplesPerSegment);
+  std::vector<std::string> warnings;
+  for (size_t m = 0; m < lines.size(); ++m)
+  {
+    for (size_t b = 0; b < bones.size(); ++b)
+    {
+      bool crosses = false;
+      for (size_t l = 0; l < inside[m].size() && !crosses; ++l)
+      {
+        const std::vector<char>& now = inside[m][l][b];
+        const auto firstOut = std::find(now.begin(), now.end(), 0);
+        const auto lastOut = std::find(now.rbegin(), now.rend(), 0).base(); // one past it
+        for (auto s = firstOut; s < lastOut && !crosses; ++s)
+        {
+          crosses = *s && !(atRest && (*atRest)[m][l][b][static_cast<size_t>(s - now.begin())]);
+        }
+      }
+      if (crosses)
+      {
+        warnings.push_back("an action line of muscle '" + names[m] + "' crosses bone '" + bones[b].name +
+          "': solved on the muscle's surface, the line is let go inside the bone and the muscle lies against "
+          "the bone, which can bend a thin muscle round it; check the muscle, give the line a via point, or "
+          "solve on the hull (DeformationMesh Hull)");
+      }
+    }
+  }
+  return warnings;
+}
+
 SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::vector<const SurfaceEnergy*>& energies,
   const std::vector<std::vector<Points>>& restLines, const std::vector<FixedObstacle>& restBones)
 {
@@ -894,6 +954,10 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     for (size_t m = 0; m < count; ++m)
     {
       muscles[m].points = motion->points[m] + (free[m] - motion->free[m]);
+      // The points the welded surface does not use go with it, so that the volume the welding
+      // takes away below is that of this start (left where the last step put them, the rest
+      // pose at the first, they took up to 3e-6 of the LHDL iliacus's volume in one pass).
+      energies[m]->CarryToUnwelded(muscles[m].points);
     }
   }
   // Settled on the welded surfaces (the energies' triangles), written back at the end. The

@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <string>
 
 #include <unordered_map>
 #include <vector>
@@ -183,6 +184,23 @@ private:
   Eigen::SimplicialLDLT<SparseMatrix> Factor;
   mutable std::unordered_map<Eigen::Index, Eigen::VectorXd> Columns;
 };
+
+/// [muscle][line][bone][sample]: whether each sample of the current pose of a muscle's matched
+/// lines (SampleMatchedLines') lies inside the bone.
+using LineSamplesInside = std::vector<std::vector<std::vector<std::vector<char>>>>;
+/// LineSamplesInside of `lines[m]` (every muscle's matched lines) with `bones` in that pose.
+LineSamplesInside LineSamplesInBones(
+  const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones, int samplesPerSegment);
+
+/// What to say of every muscle (`names[m]`) one of whose action lines (`lines[m]`, their current
+/// pose the bones') crosses a bone it did not cross at rest (`atRest`, LineSamplesInBones' of the
+/// rest pose; null: the bones' rest pose is not known, and no line crossed one): goes into it and
+/// out again, not only ends in it, as a line does at its attachment. Solved on the surface, a
+/// line's pull is moved beside the bone on the side nearest to each sample, so a line that
+/// crosses a bone pulls the muscle round it (docs/DESIGN.md section 7).
+std::vector<std::string> LinesThroughBones(const std::vector<std::string>& names,
+  const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones,
+  const LineSamplesInside* atRest, int samplesPerSegment);
 
 /// The rest pose's lines as a motion that goes nowhere (rest -> rest).
 std::vector<MatchedLine> StillLines(const std::vector<Points>& restLines);

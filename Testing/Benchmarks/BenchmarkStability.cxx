@@ -11,8 +11,13 @@
 // present, the LHDL hip in four poses. Prints figures; asserts nothing.
 //
 //   BenchmarkStability [data folder] [case: all|phantom|flexion30|flexion60|adduction-40|adduction40]
-//                      [seeds (3)] [methods: all|one-pass|N (1, 4, 8)|settle]
+//                      [seeds (3)] [methods: all|one-pass|filter|N (1, 4, 8)|settle]
 #include "RealData.h"
+
+#include "LocalFrame.h"
+#include "MeanValueCoordinates.h"
+#include "ProgressiveHull.h"
+#include "SurfacePass.h"
 
 #include <chrono>
 #include <cmath>
@@ -30,6 +35,15 @@ struct Method
   int steps;
   double contactWeight;
   bool settleOnSurface = false;
+  /// MuscleDeformation's own computation (one pass, bones in the current pose, hull built and its
+  /// mean value coordinates), on the hull or settled on the muscles' surfaces after it; not the
+  /// interpolation method.
+  enum class Filter
+  {
+    None,
+    PassOnHull,
+    PassOnSurface
+  } filter = Filter::None;
 };
 
 /// Every step's points of every muscle (steps 1..N), or `failure` set.
@@ -41,8 +55,110 @@ struct Output
   int unsettledStep = 0; ///< with the settle: the first step whose settle did not converge, or 0
 };
 
+/// MuscleDeformation's computation at its defaults, in its local frame, as the filter runs it.
+Output RunFilterPass(const MotionCase& c, const Method& method, int hullPoints)
+{
+  Output out;
+  const auto start = std::chrono::steady_clock::now();
+  try
+  {
+    std::vector<const md::Points*> parts;
+    for (const md::MuscleMotion& m : c.muscles)
+    {
+      parts.push_back(&m.muscle.points);
+    }
+    const md::LocalFrame frame = md::LocalFrame::Around(parts);
+    const size_t count = c.muscles.size();
+    std::vector<md::TriangleMesh> surfaces(count), hulls(count);
+    std::vector<md::WeightMatrix> weights(count);
+    std::vector<md::MuscleToDeform> toDeform(count);
+    md::HullParameters hull;
+    hull.targetNumberOfPoints = hullPoints;
+    for (size_t m = 0; m < count; ++m)
+    {
+      surfaces[m] = c.muscles[m].muscle;
+      frame.ToLocal(surfaces[m].points);
+      if (method.filter == Method::Filter::PassOnHull)
+      {
+        hulls[m] = md::BuildMuscleHull(surfaces[m], hull).result.hull;
+        weights[m] = md::MeanValueCoordinates(hulls[m], surfaces[m].points);
+      }
+      toDeform[m] = { c.muscles[m].name, &surfaces[m], &hulls[m], c.muscles[m].lines, &weights[m] };
+      for (md::MatchedLine& line : toDeform[m].lines)
+      {
+        frame.ToLocal(line.rest);
+        frame.ToLocal(line.current);
+      }
+    }
+    std::vector<std::string> names;
+    std::vector<md::TriangleMesh> bones;
+    for (const md::BoneMotion& b : c.bones)
+    {
+      names.push_back(b.name);
+      bones.push_back({ b.current, b.rest.triangles });
+      frame.ToLocal(bones.back().points);
+    }
+    const std::vector<md::Obstacle> obstacles = md::BuildObstacles(names, bones);
+    std::vector<md::Points> points(count);
+    if (method.filter == Method::Filter::PassOnHull)
+    {
+      md::DeformationParameters parameters;
+      parameters.convergenceTolerance = frame.LengthToLocal(0.01); // the filter's default
+      const std::vector<md::DeformationResult> passed = md::DeformMuscles(toDeform, obstacles, parameters);
+      for (size_t m = 0; m < count; ++m)
+      {
+        points[m] = passed[m].points;
+      }
+    }
+    else
+    {
+      std::vector<std::unique_ptr<md::SurfaceEnergy>> energies;
+      std::vector<md::MuscleToSettle> toSettle;
+      for (size_t m = 0; m < count; ++m)
+      {
+        std::vector<md::Points> restLines;
+        for (const md::MatchedLine& line : toDeform[m].lines)
+        {
+          restLines.push_back(line.rest);
+        }
+        energies.push_back(std::make_unique<md::SurfaceEnergy>(surfaces[m], restLines, md::SettleParameters{}));
+        toSettle.push_back({ toDeform[m].name, &surfaces[m], toDeform[m].lines, energies.back().get() });
+      }
+      std::vector<md::FixedObstacle> fixed;
+      for (const md::Obstacle& o : obstacles)
+      {
+        fixed.push_back({ o.name, o.tree.get() });
+      }
+      const std::vector<md::SurfacePassResult> settled = md::SettleInOnePass(toSettle, fixed, md::SettleParameters{});
+      for (size_t m = 0; m < count; ++m)
+      {
+        points[m] = settled[m].points;
+        if (!settled[m].report.converged && out.unsettledStep == 0)
+        {
+          out.unsettledStep = 1;
+        }
+      }
+    }
+    for (md::Points& p : points)
+    {
+      frame.ToWorld(p);
+    }
+    out.points.push_back(std::move(points));
+  }
+  catch (const std::exception& e)
+  {
+    out.failure = e.what();
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
 Output Run(const MotionCase& c, const Method& method, int hullPoints, md::RestMappingCache& cache)
 {
+  if (method.filter != Method::Filter::None)
+  {
+    return RunFilterPass(c, method, hullPoints);
+  }
   md::InterpolationParameters parameters;
   parameters.numberOfSteps = method.steps;
   parameters.deformation.contactWeight = method.contactWeight;
@@ -247,6 +363,11 @@ int main(int argc, char* argv[])
       methods.push_back({ "interpolation N = " + std::to_string(n), n, md::StepDeformationDefaults().contactWeight });
     }
   }
+  if (methodsArg == "all" || methodsArg == "filter") // MuscleDeformation itself
+  {
+    methods.push_back({ "MuscleDeformation, hull (paper)", 1, 0.0, false, Method::Filter::PassOnHull });
+    methods.push_back({ "MuscleDeformation, muscle surface", 1, 0.0, true, Method::Filter::PassOnSurface });
+  }
   if (methodsArg == "settle") // each step solved on the muscles' surfaces (DeformationMesh Muscle surface)
   {
     methods.push_back(
@@ -254,7 +375,7 @@ int main(int argc, char* argv[])
   }
   if (methods.empty())
   {
-    std::fprintf(stderr, "unknown methods '%s': all, one-pass, 1, 4, 8 or settle\n", methodsArg.c_str());
+    std::fprintf(stderr, "unknown methods '%s': all, one-pass, filter, 1, 4, 8 or settle\n", methodsArg.c_str());
     return 2;
   }
   std::printf("Distances (mm) between corresponding points of the last step's muscles (any step: the largest at\n"

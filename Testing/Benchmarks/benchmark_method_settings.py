@@ -8,6 +8,7 @@ each DeformationMesh: solved on the muscles' surfaces (Muscle surface, the defau
 and a change of NumberOfSteps; solved on hulls (Hull (paper)), the first run (rest-pose hulls and mappings
 built), then a change of NumberOfSteps, of BoneContactWeight and of ConvergenceTolerance (hulls
 kept: only the steps are computed), then of HullTargetNumberOfPoints (every hull built again).
+Then MuscleDeformation (one pass) on each DeformationMesh, a first run and a run again.
 Prints each run's seconds (FilterTests counts the hulls:
 InterpolatedMuscleDeformationFilter.RestHullsAreKept...). Asserts nothing.
 """
@@ -55,3 +56,18 @@ for mesh, changes in runs.items():
         seconds = time.perf_counter() - start
         print("  %-36s %6.2f s" % (label, seconds))
     simple.Delete(method)
+
+# The one pass (MuscleDeformation) on each mesh: the first run builds the rest-pose work (hulls
+# and mappings, or full-mesh energies), a second run keeps it.
+matching = simple.ActionLineMatching(Input=inputs["lines_rest"], CurrentPose=inputs["lines_current"])
+for mesh in ("Hull (paper)", "Muscle surface"):
+    deformation = simple.MuscleDeformation(Input=inputs["muscles"], ActionLines=simple.OutputPort(matching, 0),
+                                           Obstacles=[inputs["bones_current"]], DeformationMesh=mesh)
+    print("MuscleDeformation, DeformationMesh %s:" % mesh)
+    for label, iterations in (("first run", 200), ("MaximumNumberOfIterations 200 -> 199", 199)):
+        deformation.MaximumNumberOfIterations = iterations  # the second run keeps the rest-pose work
+        start = time.perf_counter()
+        deformation.UpdatePipeline()
+        seconds = time.perf_counter() - start
+        print("  %-36s %6.2f s" % (label, seconds))
+    simple.Delete(deformation)

@@ -8,6 +8,7 @@ import numpy
 import mdtesting
 from paraview import servermanager, simple
 from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkFiltersModeling import vtkSelectEnclosedPoints
 
 mdtesting.load_plugin()
 
@@ -203,6 +204,47 @@ class Pipeline(unittest.TestCase):
             self.assertFalse(numpy.isnan(points(muscle)).any(), name)
         simple.Delete(deformation)
         simple.Delete(matching)
+
+    def test_muscle_deformation_on_the_surface_through_pvpython(self):
+        # DeformationMesh by its text, as a script sets it: the pass on the muscles' surfaces
+        # holds the volume, keeps every point out of the current-pose bones and says that the
+        # rectus femoris's line crosses the femur; the paper's hull pass leaves points inside.
+        # At 30 degrees: at the class's 60 one pass on the surface does not settle (it says so).
+        phantom = simple.MusculoskeletalPhantom(Flexion=30)
+        matching = simple.ActionLineMatching(Input=simple.OutputPort(phantom, 3),
+                                             CurrentPose=simple.OutputPort(phantom, 4))
+        inputs = dict(Input=simple.OutputPort(phantom, 0), ActionLines=simple.OutputPort(matching, 0),
+                      Obstacles=[simple.OutputPort(phantom, 2)])
+        on_hull = simple.MuscleDeformation(**inputs)
+        on_surface = simple.MuscleDeformation(DeformationMesh="Muscle surface", **inputs)
+        with mdtesting.CapturedMessages() as messages:
+            on_surface.UpdatePipeline()
+        self.assertIn("an action line of muscle 'RectusFemoris' crosses bone 'Femur'", messages.text)
+        self.assertNotIn("ERROR", messages.text)
+        bones = servermanager.Fetch(phantom, idx=2)
+        inside = {}
+        for label, proxy in (("surface", on_surface), ("hull", on_hull)):
+            data = servermanager.Fetch(proxy)
+            selected = vtkSelectEnclosedPoints()
+            selected.SetSurfaceData(block(bones, "Femur"))
+            selected.SetInputData(block(data, "RectusFemoris"))
+            selected.Update()
+            inside[label] = int(vtk_to_numpy(selected.GetOutput().GetPointData().GetArray("SelectedPoints")).sum())
+            if label == "surface":
+                for name in ("Iliopsoas", "GluteusMaximus", "RectusFemoris"):
+                    fields = block(data, name).GetFieldData()
+                    self.assertLess(abs(fields.GetArray("VolumeChangePercent").GetValue(0)), 1e-6, name)
+                    self.assertEqual(fields.GetArray("Converged").GetValue(0), 1, name)
+                    self.assertIsNotNone(fields.GetArray("PointsInContact"), name)
+        self.assertEqual(inside["surface"], 0)
+        self.assertGreater(inside["hull"], 0)
+        on_surface.UpdatePipeline()
+        phantom.Flexion = 60
+        with mdtesting.CapturedMessages() as messages:
+            on_surface.UpdatePipeline()
+        self.assertIn("did not settle within 50 iterations", messages.text)
+        for proxy in (on_surface, on_hull, matching, phantom):
+            simple.Delete(proxy)
 
     def test_muscle_deformation_errors_name_the_input(self):
         # Raw action lines (no CurrentPosition) instead of ActionLineMatching's output.
