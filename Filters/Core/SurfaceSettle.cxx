@@ -349,6 +349,11 @@ Points SurfaceEnergy::Solve(const Points& rhs) const
 
 void SurfaceEnergy::Prepare(const std::vector<Eigen::Index>& keys) const
 {
+  PrepareAll({ this }, { keys });
+}
+
+std::vector<Eigen::Index> SurfaceEnergy::Missing(const std::vector<Eigen::Index>& keys) const
+{
   std::vector<Eigen::Index> missing;
   for (const Eigen::Index p : keys)
   {
@@ -359,48 +364,73 @@ void SurfaceEnergy::Prepare(const std::vector<Eigen::Index>& keys) const
   }
   std::sort(missing.begin(), missing.end());
   missing.erase(std::unique(missing.begin(), missing.end()), missing.end());
-  // In blocks of columns, each block one pass over the factor.
-  constexpr int kBlock = 8;
+  return missing;
+}
+
+void SurfaceEnergy::SolveColumns(const Eigen::Index* keys, size_t width, Eigen::VectorXd* solved) const
+{
+  // One pass over the factor for up to kBlock columns.
   using Block = Eigen::Matrix<double, Eigen::Dynamic, kBlock, Eigen::RowMajor>;
   const Eigen::Index n = this->Normal.rows();
   const auto& order = this->Factor.permutationP().indices();
-  const int blocks = static_cast<int>((missing.size() + kBlock - 1) / kBlock);
-  std::vector<Eigen::VectorXd> solved(missing.size());
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int b = 0; b < blocks; ++b)
+  Block y = Block::Zero(n, kBlock);
+  for (size_t k = 0; k < width; ++k)
   {
-    const size_t first = static_cast<size_t>(b) * kBlock;
-    const size_t width = std::min<size_t>(kBlock, missing.size() - first);
-    Block y = Block::Zero(n, kBlock);
-    for (size_t k = 0; k < width; ++k)
+    const Eigen::Index key = keys[k];
+    if (key >= 0)
     {
-      const Eigen::Index key = missing[first + k];
-      if (key >= 0)
-      {
-        y(order(key), static_cast<Eigen::Index>(k)) = 1.0;
-      }
-      else
-      {
-        for (const auto& [point, weight] : this->SampleRow(-1 - key))
-        {
-          y(order(point), static_cast<Eigen::Index>(k)) += weight;
-        }
-      }
+      y(order(key), static_cast<Eigen::Index>(k)) = 1.0;
     }
-    SolveFactored(this->Factor.matrixL().nestedExpression(), this->Factor.vectorD(), y);
-    for (size_t k = 0; k < width; ++k)
+    else
     {
-      Eigen::VectorXd& column = solved[first + k];
-      column.resize(n);
-      for (Eigen::Index i = 0; i < n; ++i)
+      for (const auto& [point, weight] : this->SampleRow(-1 - key))
       {
-        column(i) = y(order(i), static_cast<Eigen::Index>(k));
+        y(order(point), static_cast<Eigen::Index>(k)) += weight;
       }
     }
   }
-  for (size_t k = 0; k < missing.size(); ++k)
+  SolveFactored(this->Factor.matrixL().nestedExpression(), this->Factor.vectorD(), y);
+  for (size_t k = 0; k < width; ++k)
   {
-    this->Columns.emplace(missing[k], std::move(solved[k]));
+    Eigen::VectorXd& column = solved[k];
+    column.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i)
+    {
+      column(i) = y(order(i), static_cast<Eigen::Index>(k));
+    }
+  }
+}
+
+void SurfaceEnergy::PrepareAll(
+  const std::vector<const SurfaceEnergy*>& energies, const std::vector<std::vector<Eigen::Index>>& keys)
+{
+  // Every muscle's missing columns in blocks, all blocks in one parallel loop: the muscles'
+  // blocks keep both cores busy where one muscle alone has few.
+  std::vector<std::vector<Eigen::Index>> missing(energies.size());
+  std::vector<std::vector<Eigen::VectorXd>> solved(energies.size());
+  std::vector<std::pair<size_t, size_t>> blocks; // (muscle, first column)
+  for (size_t m = 0; m < energies.size(); ++m)
+  {
+    missing[m] = energies[m]->Missing(keys[m]);
+    solved[m].resize(missing[m].size());
+    for (size_t first = 0; first < missing[m].size(); first += kBlock)
+    {
+      blocks.emplace_back(m, first);
+    }
+  }
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int b = 0; b < static_cast<int>(blocks.size()); ++b)
+  {
+    const auto [m, first] = blocks[static_cast<size_t>(b)];
+    const size_t width = std::min<size_t>(kBlock, missing[m].size() - first);
+    energies[m]->SolveColumns(missing[m].data() + first, width, solved[m].data() + first);
+  }
+  for (size_t m = 0; m < energies.size(); ++m)
+  {
+    for (size_t k = 0; k < missing[m].size(); ++k)
+    {
+      energies[m]->Columns.emplace(missing[m][k], std::move(solved[m][k]));
+    }
   }
 }
 
@@ -1058,10 +1088,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     std::vector<Points> gradients(count), along(count);
     Eigen::VectorXd rhs(size);
     std::vector<double> volumeNow(count);
-    for (size_t m = 0; m < count; ++m)
-    {
-      energies[m]->Prepare(needed[m]);
-    }
+    SurfaceEnergy::PrepareAll(energies, needed);
 #pragma omp parallel for schedule(dynamic, 1)
     for (int k = 0; k < static_cast<int>(count); ++k)
     {

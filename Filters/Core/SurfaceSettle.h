@@ -126,6 +126,9 @@ public:
   /// (SampleKey) the inverse applied to that sample's row; computed once and
   /// kept. `Prepare` computes the missing ones of `keys` in parallel.
   void Prepare(const std::vector<Eigen::Index>& keys) const;
+  /// Prepare of every energy with its keys, in one parallel loop over all of them.
+  static void PrepareAll(
+    const std::vector<const SurfaceEnergy*>& energies, const std::vector<std::vector<Eigen::Index>>& keys);
   const Eigen::VectorXd& InverseColumn(Eigen::Index key) const;
   /// The key of action-line sample `sample`'s row among the inverse's columns.
   static Eigen::Index SampleKey(Eigen::Index sample) { return -1 - sample; }
@@ -154,6 +157,11 @@ public:
   std::int64_t PointsUsed() const { return std::count(this->PointUsed.begin(), this->PointUsed.end(), 1); }
 
 private:
+  static constexpr int kBlock = 8; ///< columns solved in one pass over the factor
+  /// The keys of `keys` whose columns are not kept yet, sorted, each once.
+  std::vector<Eigen::Index> Missing(const std::vector<Eigen::Index>& keys) const;
+  /// Columns `keys[0..width)` (width <= kBlock) of the inverse into `solved`.
+  void SolveColumns(const Eigen::Index* keys, size_t width, Eigen::VectorXd* solved) const;
   void FindLeaders(const TriangleMesh& rest, const std::vector<std::int64_t>& representative);
 
   Points RestPoints;
