@@ -663,8 +663,14 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       }
       settled = SettleMuscles(next, energyPointers, wholeMotion, restVolumes, fixed, &restOverlap, parameters.settle,
         &settleMotion, [&](double fraction) { report(stepStart + 0.9 * stepShare * fraction); });
-      for (const std::string& warning :
-        LinesThroughBones(names, wholeMotion, fixed, &linesInBonesAtRest, parameters.settle.samplesPerSegment))
+      std::vector<std::string> said =
+        LinesThroughBones(names, wholeMotion, fixed, &linesInBonesAtRest, parameters.settle.samplesPerSegment);
+      if (std::any_of(settled.begin(), settled.end(), [](const SettleReport& r) { return !r.converged; }))
+      {
+        said.push_back("the muscles did not settle within " + std::to_string(parameters.settle.maximumIterations) +
+          " iterations (the last iterate is kept, with Converged 0): another NumberOfSteps may settle them");
+      }
+      for (const std::string& warning : said)
       {
         if (warned.insert(warning).second) // said once, at the first step that has it
         {
