@@ -89,25 +89,6 @@ struct KeptMuscle
   }
 };
 
-/// One muscle's rest-pose work on its surface: its full-mesh energy, with what it was made from.
-struct KeptEnergy
-{
-  md::TriangleMesh surface;
-  md::LocalFrame frame;
-  std::vector<md::Points> restLines;
-  md::SettleParameters parameters;
-  std::shared_ptr<const md::SurfaceEnergy> energy;
-
-  bool Holds(const md::TriangleMesh& muscle, const md::LocalFrame& now, const std::vector<md::Points>& lines,
-    const md::SettleParameters& settle) const
-  {
-    return this->energy && md::SameMesh(this->surface, muscle) && this->frame.origin == now.origin &&
-      this->frame.unit == now.unit && this->parameters.SameEnergyAs(settle) &&
-      std::equal(this->restLines.begin(), this->restLines.end(), lines.begin(), lines.end(),
-        [](const md::Points& x, const md::Points& y) { return x.rows() == y.rows() && x == y; });
-  }
-};
-
 /// Forgets what blocks no longer among `blocks` kept.
 template<class Entry>
 void EraseOthers(std::map<size_t, Entry>& byBlock, const std::vector<size_t>& blocks)
@@ -150,7 +131,8 @@ struct vtkMuscleDeformation::PassInput
 struct vtkMuscleDeformation::RestPoseCache
 {
   std::map<size_t, KeptMuscle> hulls;
-  std::map<size_t, KeptEnergy> energies;
+  /// Compared in the local frame: the same muscle and lines placed elsewhere keep their energy.
+  std::map<size_t, md::KeptSurfaceEnergy> energies;
 };
 
 bool vtkMuscleDeformation::PassOnSurface(const PassInput& in, std::vector<std::string>& failures,
@@ -179,15 +161,16 @@ bool vtkMuscleDeformation::PassOnSurface(const PassInput& in, std::vector<std::s
     {
       restLines.push_back(line.rest);
     }
-    KeptEnergy& entry = this->Kept->energies[b];
-    if (!entry.Holds(in.surfaces[b], in.frame, restLines, parameters))
+    md::KeptSurfaceEnergy& entry = this->Kept->energies[b];
+    if (!entry.Holds(in.surfaces[b], restLines, parameters))
     {
-      entry = KeptEnergy{};
+      entry = md::KeptSurfaceEnergy{};
       std::string failure;
       if (!mdvtk::CallCore(
             this, in.muscles[b].label + ": ",
             [&] {
-              entry.energy = std::make_shared<const md::SurfaceEnergy>(in.surfaces[b], restLines, parameters);
+              entry.Keep(std::make_shared<const md::SurfaceEnergy>(in.surfaces[b], restLines, parameters),
+                in.surfaces[b], restLines, parameters);
               ++this->SurfaceEnergyBuildCount;
             },
             result, &failure))
@@ -197,13 +180,8 @@ bool vtkMuscleDeformation::PassOnSurface(const PassInput& in, std::vector<std::s
           return false; // stopped by the user
         }
         failures[m] = failure; // reported
-        entry = KeptEnergy{};
         continue;
       }
-      entry.surface = in.surfaces[b];
-      entry.frame = in.frame;
-      entry.restLines = restLines;
-      entry.parameters = parameters;
     }
     if (entry.energy->PointsNoLineDrives() > 0)
     {

@@ -422,12 +422,8 @@ std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vecto
     {
       restLines[m].push_back(line.AtStep(0, steps));
     }
-    const RestMappingCache::Entry& entry = rest.muscles[m];
-    const bool same = entry.energy && SameMesh(entry.energySurface, muscles[m].muscle) &&
-      entry.settle.SameEnergyAs(parameters) && entry.restLines.size() == restLines[m].size() &&
-      std::equal(restLines[m].begin(), restLines[m].end(), entry.restLines.begin(),
-        [](const Points& a, const Points& b) { return a.rows() == b.rows() && a == b; });
-    if (same)
+    const KeptSurfaceEnergy& entry = rest.muscles[m].surfaceEnergy;
+    if (entry.Holds(muscles[m].muscle, restLines[m], parameters))
     {
       energies[m] = entry.energy;
     }
@@ -462,13 +458,10 @@ std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vecto
   }
   for (size_t m = 0; m < count; ++m)
   {
-    RestMappingCache::Entry& entry = rest.muscles[m];
+    KeptSurfaceEnergy& entry = rest.muscles[m].surfaceEnergy;
     if (energies[m] && energies[m] != entry.energy)
     {
-      entry.energy = energies[m];
-      entry.energySurface = muscles[m].muscle;
-      entry.restLines = restLines[m];
-      entry.settle = parameters;
+      entry.Keep(energies[m], muscles[m].muscle, restLines[m], parameters);
       ++rest.energyBuildCount;
     }
   }

@@ -156,12 +156,8 @@ struct RestMappingCache
     HullParameters hull;  ///< and the hull parameters
     TriangleMesh restHull;
     WeightMatrix weights;
-    /// The full-mesh energy, of `energySurface` with its matched action lines `restLines` in the
-    /// rest pose (the local frame's), and the inverse's columns it has kept.
-    std::shared_ptr<const SurfaceEnergy> energy;
-    TriangleMesh energySurface;
-    std::vector<Points> restLines;
-    SettleParameters settle;
+    /// The full-mesh energy, of the rest pose and its matched action lines (the local frame's).
+    KeptSurfaceEnergy surfaceEnergy;
   };
   std::vector<Entry> muscles;
   int hullBuildCount = 0;   ///< rest-pose hulls built so far (not counting HullMode::Rebuild's)

@@ -894,6 +894,23 @@ std::vector<Contact> FindContacts(const std::vector<TriangleMesh>& meshes,
 }
 }
 
+bool KeptSurfaceEnergy::Holds(
+  const TriangleMesh& muscle, const std::vector<Points>& lines, const SettleParameters& parameters) const
+{
+  return this->energy && SameMesh(this->surface, muscle) && this->settle.SameEnergyAs(parameters) &&
+    std::equal(this->restLines.begin(), this->restLines.end(), lines.begin(), lines.end(),
+      [](const Points& a, const Points& b) { return a.rows() == b.rows() && a == b; });
+}
+
+void KeptSurfaceEnergy::Keep(std::shared_ptr<const SurfaceEnergy> built, const TriangleMesh& muscle,
+  const std::vector<Points>& lines, const SettleParameters& parameters)
+{
+  this->energy = std::move(built);
+  this->surface = muscle;
+  this->restLines = lines;
+  this->settle = parameters;
+}
+
 LineSamplesInside LineSamplesInBones(
   const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones, int samplesPerSegment)
 {

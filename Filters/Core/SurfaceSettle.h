@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include <unordered_map>
@@ -191,6 +192,21 @@ private:
   SparseMatrix Normal;                   // Rows^T Rows
   Eigen::SimplicialLDLT<SparseMatrix> Factor;
   mutable std::unordered_map<Eigen::Index, Eigen::VectorXd> Columns;
+};
+
+/// A muscle's SurfaceEnergy kept between runs with what it was made from: it depends on the
+/// rest-pose surface, the matched action lines at rest and the energy's own settings only, so it
+/// holds (with the inverse's columns found so far) while those are the same.
+struct KeptSurfaceEnergy
+{
+  std::shared_ptr<const SurfaceEnergy> energy;
+  TriangleMesh surface;
+  std::vector<Points> restLines;
+  SettleParameters settle;
+
+  bool Holds(const TriangleMesh& muscle, const std::vector<Points>& lines, const SettleParameters& parameters) const;
+  void Keep(std::shared_ptr<const SurfaceEnergy> built, const TriangleMesh& muscle, const std::vector<Points>& lines,
+    const SettleParameters& parameters);
 };
 
 /// [muscle][line][bone][sample]: whether each sample of the current pose of a muscle's matched

@@ -7,6 +7,7 @@
 #include "FilterTestUtilities.h"
 
 #include "MDBlocks.h"
+#include "MuscleDeformer.h"
 #include "TriangleTree.h"
 
 #include "vtkActionLineMatching.h"
@@ -197,13 +198,9 @@ std::int64_t PointsInside(vtkDataObject* muscles, vtkDataObject* bones)
   for (unsigned int k = 0; k < muscleTree->GetNumberOfBlocks(); ++k)
   {
     const md::Points points = mdvtk::ToPoints(vtkPolyData::SafeDownCast(muscleTree->GetBlock(k))->GetPoints());
-    for (Eigen::Index i = 0; i < points.rows(); ++i)
+    for (const md::TriangleTree& tree : trees)
     {
-      const Eigen::Vector3d p = points.row(i).transpose();
-      for (const md::TriangleTree& tree : trees)
-      {
-        inside += tree.InBounds(p) && tree.Inside(p);
-      }
+      inside += md::CountInsideTree(tree, points);
     }
   }
   return inside;

@@ -76,13 +76,9 @@ TEST(SurfacePass, OnThePhantomNoPointEndsInABoneAndRoundingChangesNothing)
     EXPECT_LT(std::abs(r.volumeChangePercent), 1e-6);
     EXPECT_EQ(r.flippedTriangles, 0);
     EXPECT_GT((r.points - exact.muscles[m].muscle.points).rowwise().norm().maxCoeff(), 10.0); // it moved
-    for (Eigen::Index i = 0; i < r.points.rows(); ++i)
+    for (size_t b = 0; b < pass.trees.size(); ++b)
     {
-      const Eigen::Vector3d p = r.points.row(i).transpose();
-      for (const auto& tree : pass.trees)
-      {
-        ASSERT_FALSE(tree->InBounds(p) && tree->Inside(p)) << "point " << i;
-      }
+      EXPECT_EQ(md::CountInsideTree(*pass.trees[b], r.points), 0) << exact.bones[b].name;
     }
     // Only the rectus femoris's line crosses a bone (the femur, by design of the phantom).
     EXPECT_EQ(r.warnings.size(), exact.muscles[m].name == "RectusFemoris" ? 1u : 0u);
