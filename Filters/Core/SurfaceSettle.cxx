@@ -132,7 +132,7 @@ SurfaceEnergy::SurfaceEnergy(
     throw InputError("none of its action-line samples lies inside the muscle");
   }
 
-  const SparseMatrix laplacian = CotangentLaplacian(welded);
+  const SparseMatrix laplacian = CotangentLaplacian(welded, parameters.largestCotangent);
   this->Delta = laplacian * rest.points;
   const double balance = std::max(1.0, parameters.balancePoints);
   this->ShapeWeight = std::sqrt(static_cast<double>(used) / balance);

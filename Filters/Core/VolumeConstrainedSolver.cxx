@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "VolumeConstrainedSolver.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
 namespace md
 {
-SparseMatrix CotangentLaplacian(const TriangleMesh& mesh)
+SparseMatrix CotangentLaplacian(const TriangleMesh& mesh, std::optional<double> largestCotangent)
 {
   const Eigen::Index n = mesh.points.rows();
   std::vector<Eigen::Triplet<double>> cotangents; // c_ij, summed by setFromTriplets
@@ -20,7 +21,11 @@ SparseMatrix CotangentLaplacian(const TriangleMesh& mesh)
       const Eigen::Vector3d u = mesh.points.row(i).transpose() - apex;
       const Eigen::Vector3d v = mesh.points.row(j).transpose() - apex;
       const double sine = u.cross(v).norm();
-      const double cotangent = sine > 0 ? u.dot(v) / sine : 0.0;
+      double cotangent = sine > 0 ? u.dot(v) / sine : 0.0;
+      if (largestCotangent)
+      {
+        cotangent = std::clamp(cotangent, 0.0, *largestCotangent);
+      }
       cotangents.emplace_back(i, j, cotangent);
       cotangents.emplace_back(j, i, cotangent);
       adjacency.emplace_back(i, j, 0.5); // each edge is seen from two triangles

@@ -9,6 +9,8 @@
 #include <Eigen/Cholesky>
 #include <Eigen/SparseCore>
 
+#include <optional>
+
 namespace md
 {
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
@@ -17,7 +19,15 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 /// diagonal and c_ij / sum_k c_ik for each neighbour j, c_ij = cot(alpha) +
 /// cot(beta) of the two angles facing edge ij. Where a point's cotangent sum is
 /// not positive (degenerate triangles) its row falls back to uniform weights.
-SparseMatrix CotangentLaplacian(const TriangleMesh& mesh);
+///
+/// With `largestCotangent`, each angle's cotangent is taken within [0, largestCotangent]
+/// (angles over 90 degrees count as right angles, angles under acot(largestCotangent) as that
+/// angle), for a scanned surface's badly shaped triangles: an obtuse angle's negative weight
+/// lets a point cross its neighbours, and a sliver's tiny angle gives its short edge a weight
+/// that ties the edge's two points to each other and hardly to anything else, so that the pair
+/// turns its triangles over (the LHDL gluteus medius, docs/DESIGN.md section 7). Clamping is
+/// continuous in the points, so the weights still move continuously with the input.
+SparseMatrix CotangentLaplacian(const TriangleMesh& mesh, std::optional<double> largestCotangent = std::nullopt);
 
 /// V = 1/6 sum over triangles (x_a x x_b) . x_c, and dV/dx_i (one row per point).
 double EnclosedVolume(const Points& points, const Triangles& triangles, Points* gradient = nullptr);

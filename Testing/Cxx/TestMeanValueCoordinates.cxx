@@ -16,16 +16,6 @@ using md::Triangles;
 
 namespace
 {
-TriangleMesh Octahedron()
-{
-  TriangleMesh o;
-  o.points.resize(6, 3);
-  o.points << 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1;
-  o.triangles.resize(8, 3);
-  o.triangles << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
-  return o;
-}
-
 /// Mean value coordinates by the pseudo-code of Ju, Schaefer & Warren 2005
 /// (for points well inside: the reference the robust implementation must match).
 Eigen::RowVectorXd ReferenceMeanValueCoordinates(const TriangleMesh& cage, const Eigen::Vector3d& x)

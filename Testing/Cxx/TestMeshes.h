@@ -8,6 +8,17 @@
 #include <cmath>
 #include <vector>
 
+/// The regular octahedron of points (+-1, 0, 0), (0, +-1, 0), (0, 0, +-1): 8 outward-facing triangles.
+inline md::TriangleMesh Octahedron()
+{
+  md::TriangleMesh octahedron;
+  octahedron.points.resize(6, 3);
+  octahedron.points << 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1;
+  octahedron.triangles.resize(8, 3);
+  octahedron.triangles << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
+  return octahedron;
+}
+
 /// The axis-aligned box from `low` to `high`: 8 points, 12 outward-facing triangles.
 inline md::TriangleMesh Box(const Eigen::Vector3d& low, const Eigen::Vector3d& high)
 {

@@ -499,6 +499,29 @@ TEST(SurfaceSettle, AMuscleWhoseLineCrossesABoneLiesAgainstIt)
   }
 }
 
+TEST(SurfaceSettle, BeyondTheFemursSweepNoTriangleTurnsOver)
+{
+  // The phantom at 40, 45 and 50 degrees, N = 4: the rectus femoris is pressed against the
+  // femur that sweeps through its line. With the shape rows' cotangent weights unclamped its
+  // slivers turned over (10, 6 and 27 triangles); clamped (SettleParameters::largestCotangent)
+  // none does, and every step converges.
+  for (double degrees : { 40.0, 45.0, 50.0 })
+  {
+    const MotionCase c = PhantomMotion(degrees);
+    const md::InterpolationResult settled = SettledInFourSteps(c);
+    for (size_t m = 0; m < c.muscles.size(); ++m)
+    {
+      SCOPED_TRACE(c.muscles[m].name + " at " + std::to_string(degrees) + " degrees");
+      for (int step = 1; step <= settled.numberOfSteps; ++step)
+      {
+        EXPECT_TRUE(settled.measures[step][m].converged) << "step " << step;
+      }
+      EXPECT_EQ(settled.measures.back()[m].flippedTriangleCount, 0);
+      EXPECT_EQ(settled.measures.back()[m].newBonePenetrationCount, 0);
+    }
+  }
+}
+
 TEST(SurfaceSettle, ASettleThatSwingsToAndFroIsDamped)
 {
   // The phantom at 55 degrees: the rectus femoris, let go where its line is deep in the femur,

@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Phantom.h"
 #include "ProgressiveHull.h"
+#include "TestMeshes.h"
 #include "VolumeConstrainedSolver.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 using md::Points;
@@ -64,11 +66,7 @@ Problem StretchProblem(const TriangleMesh& hull, double stretch)
 
 TEST(CotangentLaplacian, RowsSumToZeroAndARegularOctahedronHasEqualWeights)
 {
-  TriangleMesh octahedron;
-  octahedron.points.resize(6, 3);
-  octahedron.points << 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1;
-  octahedron.triangles.resize(8, 3);
-  octahedron.triangles << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
+  const TriangleMesh octahedron = Octahedron();
   const SparseMatrix l = md::CotangentLaplacian(octahedron);
   for (Eigen::Index i = 0; i < 6; ++i)
   {
@@ -80,6 +78,52 @@ TEST(CotangentLaplacian, RowsSumToZeroAndARegularOctahedronHasEqualWeights)
   const TriangleMesh hull = CoarseMuscleHull();
   const SparseMatrix m = md::CotangentLaplacian(hull);
   EXPECT_LT((m * Eigen::VectorXd::Ones(hull.points.rows())).cwiseAbs().maxCoeff(), 1e-13);
+}
+
+TEST(CotangentLaplacian, ClampedWeightsAreNeverNegativeAndASliverDoesNotTieItsShortEdge)
+{
+  // A coarse hull has obtuse angles: unclamped, some weights are negative; clamped to [0, 3],
+  // none is, and the rows still sum to zero.
+  auto offDiagonalRange = [](const SparseMatrix& l) {
+    std::pair<double, double> range{ 0, 0 };
+    for (Eigen::Index i = 0; i < l.outerSize(); ++i)
+    {
+      for (SparseMatrix::InnerIterator it(l, i); it; ++it)
+      {
+        if (it.col() != i)
+        {
+          range = { std::min(range.first, it.value()), std::max(range.second, it.value()) };
+        }
+      }
+    }
+    return range;
+  };
+  const TriangleMesh hull = CoarseMuscleHull();
+  EXPECT_LT(offDiagonalRange(md::CotangentLaplacian(hull)).first, -0.1);
+  const SparseMatrix clampedHull = md::CotangentLaplacian(hull, 3.0);
+  EXPECT_EQ(offDiagonalRange(clampedHull).first, 0.0);
+  EXPECT_LT((clampedHull * Eigen::VectorXd::Ones(hull.points.rows())).cwiseAbs().maxCoeff(), 1e-13);
+
+  // An octahedron with its top pulled down next to point 0: the triangles between them are
+  // slivers. Unclamped, point 0's row puts 99 % of its weight on the short edge to the top
+  // and next to none on its other neighbours; clamped, they keep a share.
+  TriangleMesh sliver = Octahedron();
+  sliver.points.row(4) << 0.98, 0, 0.02;
+  const SparseMatrix plain = md::CotangentLaplacian(sliver);
+  const SparseMatrix clamped = md::CotangentLaplacian(sliver, 3.0);
+  EXPECT_GT(plain.coeff(0, 4), 0.98);
+  EXPECT_LT(plain.coeff(0, 2), 0.001);
+  EXPECT_LT(clamped.coeff(0, 4), 0.75);
+  EXPECT_GT(clamped.coeff(0, 2), 0.05);
+  EXPECT_NEAR(clamped.row(0).sum(), 0.0, 1e-15);
+
+  // Well-shaped triangles are left as they are.
+  const TriangleMesh octahedron = Octahedron();
+  EXPECT_LT(
+    (Eigen::MatrixXd(md::CotangentLaplacian(octahedron, 3.0)) - Eigen::MatrixXd(md::CotangentLaplacian(octahedron)))
+      .cwiseAbs()
+      .maxCoeff(),
+    1e-15);
 }
 
 TEST(EnclosedVolume, GradientMatchesFiniteDifferences)

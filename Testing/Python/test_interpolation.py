@@ -48,7 +48,7 @@ class Interpolation(unittest.TestCase):
         self.assertAlmostEqual(resolve.DeformableShare, 0.6)
         simple.Delete(resolve)
         # The phantom opens at 30 degrees, where the method at its default 4 steps turns no
-        # triangle over (at 60 it turned 28 of the rectus femoris's over): the best case first.
+        # triangle over (at 60 it turns 5 of the rectus femoris's over): the best case first.
         phantom = simple.MusculoskeletalPhantom()
         self.assertEqual(phantom.Flexion, 30)
         simple.Delete(phantom)

@@ -209,7 +209,8 @@ class Pipeline(unittest.TestCase):
         # DeformationMesh by its text, as a script sets it: the pass on the muscles' surfaces
         # holds the volume, keeps every point out of the current-pose bones and says that the
         # rectus femoris's line crosses the femur; the paper's hull pass leaves points inside.
-        # At 30 degrees: at the class's 60 one pass on the surface does not settle (it says so).
+        # At 30 degrees; at 65 one pass on the surface does not settle, and it says so (it settles
+        # at 40-60, 70-90).
         phantom = simple.MusculoskeletalPhantom(Flexion=30)
         matching = simple.ActionLineMatching(Input=simple.OutputPort(phantom, 3),
                                              CurrentPose=simple.OutputPort(phantom, 4))
@@ -239,7 +240,7 @@ class Pipeline(unittest.TestCase):
         self.assertEqual(inside["surface"], 0)
         self.assertGreater(inside["hull"], 0)
         on_surface.UpdatePipeline()
-        phantom.Flexion = 60
+        phantom.Flexion = 65
         with mdtesting.CapturedMessages() as messages:
             on_surface.UpdatePipeline()
         self.assertIn("did not settle within 50 iterations", messages.text)
