@@ -848,12 +848,15 @@ std::vector<Contact> FindContacts(const std::vector<TriangleMesh>& meshes,
         }
         const TriangleTree& tree = obstacle(o);
         const bool inside = tree.InBounds(p) && tree.Inside(p);
-        // Outside, a point closer than the offset breaks its constraint too.
-        const TriangleTree::Closest near = inside ? TriangleTree::Closest() : tree.ClosestPoint(p, offset);
-        if (!inside && near.triangle < 0 && before == held.end())
+        // Outside, a point closer than the offset breaks its constraint too. One search as far
+        // as the clearance looks finds the nearest triangle within the offset as well (the same
+        // one: the search visits the nearer triangles in the same order).
+        const TriangleTree::Closest within = inside ? TriangleTree::Closest() : tree.ClosestPoint(p, reach);
+        const bool nearer = within.triangle >= 0 && within.distance * within.distance < offset * offset;
+        const TriangleTree::Closest near = nearer ? within : TriangleTree::Closest();
+        if (!inside && !nearer && before == held.end())
         {
-          const TriangleTree::Closest far = tree.ClosestPoint(p, reach);
-          clear[flag] = (far.triangle < 0 ? reach : far.distance) - offset - margin;
+          clear[flag] = (within.triangle < 0 ? reach : within.distance) - offset - margin;
           continue;
         }
         clear[flag] = 0;
