@@ -476,6 +476,122 @@ std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vecto
   return energies;
 }
 
+/// How many times a settle that does not converge is halved (into 2, then 4 parts): the last
+/// resort after SettleParts. The phantom at 50 degrees in 16 steps swung without end at one
+/// step (10 flipped triangles); halved, every step settles and none turns over.
+constexpr int kSettleHalvings = 2;
+
+/// What the settles of a motion share, step to step: the motions of the bones (whose trees
+/// `obstacles` are refitted to each pose settled to; `fixed` views them) and of the matched
+/// lines, the energies and what the muscles must hold.
+struct SettleInput
+{
+  const std::vector<Obstacle>& obstacles;
+  const std::vector<PoseInterpolator>& boneMotions;
+  const std::vector<std::vector<PoseInterpolator>>& lineMotions;
+  const std::vector<std::vector<Points>>& restLines;
+  const std::vector<const SurfaceEnergy*>& energies;
+  const std::vector<double>& volumes;
+  const std::vector<FixedObstacle>& fixed;
+  const OverlapMasks& restOverlap;
+  const SettleParameters& parameters;
+};
+
+/// The muscles' matched lines from the rest pose to the pose at `fraction` of the motion.
+std::vector<std::vector<MatchedLine>> LinesAt(const SettleInput& in, double fraction)
+{
+  std::vector<std::vector<MatchedLine>> lines(in.lineMotions.size());
+  for (size_t m = 0; m < lines.size(); ++m)
+  {
+    for (size_t l = 0; l < in.lineMotions[m].size(); ++l)
+    {
+      lines[m].push_back({ in.restLines[m][l], in.lineMotions[m][l].AtFraction(fraction) });
+    }
+  }
+  return lines;
+}
+
+/// Adds `more` (a later settle's reports) to `reports`: iterations and seconds add up, the
+/// contacts are the later settle's, and converged is whether both were.
+void AddReports(std::vector<SettleReport>& reports, const std::vector<SettleReport>& more)
+{
+  for (size_t m = 0; m < reports.size(); ++m)
+  {
+    reports[m].iterations += more[m].iterations;
+    reports[m].seconds += more[m].seconds;
+    reports[m].converged = reports[m].converged && more[m].converged;
+    reports[m].pointsInContact = more[m].pointsInContact;
+  }
+}
+
+/// Settles the muscles (`muscles`' points out) from where `motion` is, the pose at fraction
+/// `from` of the motion, to the pose at `to`, the bones' trees refitted there. A settle that
+/// does not converge (it diverged, or swung to the end of its iterations) is done again from
+/// the same start in two halves, through the pose halfway, each halved again while it does not
+/// converge, `halvings` times at most: which iterate a settle stops at is no answer (it moves
+/// with rounding noise by millimetres). The reports add up every attempt's iterations and
+/// seconds; `converged` is that of the settles kept. `progress` runs from 0 to 1 over each
+/// attempt.
+std::vector<SettleReport> SettleToPose(const SettleInput& in, double from, double to, int halvings,
+  std::vector<TriangleMesh>& muscles, SettleMotion& motion, const std::function<void(double)>& progress)
+{
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int b = 0; b < static_cast<int>(in.obstacles.size()); ++b)
+  {
+    in.obstacles[b].tree->Refit(in.boneMotions[b].AtFraction(to));
+  }
+  const SettleMotion start = halvings > 0 ? motion : SettleMotion();
+  std::vector<SettleReport> reports = SettleMuscles(
+    muscles, in.energies, LinesAt(in, to), in.volumes, in.fixed, &in.restOverlap, in.parameters, &motion, progress);
+  if (halvings == 0 || std::all_of(reports.begin(), reports.end(), [](const SettleReport& r) { return r.converged; }))
+  {
+    return reports;
+  }
+  motion = start;
+  const double halfway = 0.5 * (from + to);
+  std::vector<SettleReport> halves = SettleToPose(in, from, halfway, halvings - 1, muscles, motion, progress);
+  AddReports(halves, SettleToPose(in, halfway, to, halvings - 1, muscles, motion, progress));
+  for (size_t m = 0; m < reports.size(); ++m)
+  {
+    halves[m].iterations += reports[m].iterations; // the attempt that did not converge
+    halves[m].seconds += reports[m].seconds;
+  }
+  return halves;
+}
+
+/// Settles the muscles from where `motion` is (the pose at fraction `from` of the motion) to
+/// the pose at `to`, in as many equal parts as SettleParts asks (each by SettleToPose): the
+/// number of parts depends on how far the muscles' minimum moves, continuously in the input,
+/// where SettleToPose's halving depends on whether a settle converged. A step of one part is
+/// settled as it was before either, to the bit.
+std::vector<SettleReport> SettleStep(const SettleInput& in, double from, double to, std::vector<TriangleMesh>& muscles,
+  SettleMotion& motion, const std::function<void(double)>& progress)
+{
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int b = 0; b < static_cast<int>(in.obstacles.size()); ++b)
+  {
+    in.obstacles[b].tree->Refit(in.boneMotions[b].AtFraction(to));
+  }
+  const int parts = SettleParts(motion, in.energies, LinesAt(in, to), in.fixed, in.parameters);
+  std::vector<SettleReport> reports;
+  for (int k = 1; k <= parts; ++k)
+  {
+    const double start = k == 1 ? from : from + (to - from) * (k - 1) / parts;
+    const double end = k == parts ? to : from + (to - from) * k / parts;
+    const std::vector<SettleReport> part = SettleToPose(
+      in, start, end, kSettleHalvings, muscles, motion, [&](double fraction) { progress((k - 1 + fraction) / parts); });
+    if (reports.empty())
+    {
+      reports = part;
+    }
+    else
+    {
+      AddReports(reports, part);
+    }
+  }
+  return reports;
+}
+
 /// DeformByInterpolation on input already in its local frame.
 InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles, const std::vector<BoneMotion>& bones,
   const InterpolationParameters& parameters, const std::function<void(double)>& progress, RestMappingCache* kept)
@@ -632,10 +748,13 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   for (int j = 1; j <= steps; ++j)
   {
     const auto stepClock = Clock::now();
-#pragma omp parallel for schedule(dynamic, 1)
-    for (int b = 0; b < static_cast<int>(bones.size()); ++b)
+    if (!settle) // the settle refits them to each pose it settles to
     {
-      obstacles[b].tree->Refit(boneMotions[b].AtStep(j, steps));
+#pragma omp parallel for schedule(dynamic, 1)
+      for (int b = 0; b < static_cast<int>(bones.size()); ++b)
+      {
+        obstacles[b].tree->Refit(boneMotions[b].AtStep(j, steps));
+      }
     }
 
     std::vector<MuscleStepMeasures> measures(count);
@@ -644,24 +763,24 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
     std::vector<SettleReport> settled(count);
     if (settle)
     {
-      std::vector<std::vector<MatchedLine>> wholeMotion(count); // rest pose -> this step
       for (size_t m = 0; m < count; ++m)
       {
         next[m].triangles = muscles[m].muscle.triangles; // the points come from settleMotion
         next[m].points = current[m].points;
-        for (size_t l = 0; l < lineMotions[m].size(); ++l)
-        {
-          wholeMotion[m].push_back({ restLines[m][l], lineMotions[m][l].AtStep(j, steps) });
-        }
       }
-      settled = SettleMuscles(next, energyPointers, wholeMotion, restVolumes, fixed, &restOverlap, parameters.settle,
-        &settleMotion, [&](double fraction) { report(stepStart + 0.9 * stepShare * fraction); });
+      const SettleInput in{ obstacles, boneMotions, lineMotions, restLines, energyPointers, restVolumes, fixed,
+        restOverlap, parameters.settle };
+      const double to = static_cast<double>(j) / steps; // AtStep(j, steps)'s fraction
+      settled = SettleStep(in, static_cast<double>(j - 1) / steps, to, next, settleMotion,
+        [&](double fraction) { report(stepStart + 0.9 * stepShare * fraction); });
+      const std::vector<std::vector<MatchedLine>> wholeMotion = LinesAt(in, to); // rest pose -> this step
       std::vector<std::string> said =
         LinesThroughBones(names, wholeMotion, fixed, &linesInBonesAtRest, parameters.settle.samplesPerSegment);
       if (std::any_of(settled.begin(), settled.end(), [](const SettleReport& r) { return !r.converged; }))
       {
         said.push_back("the muscles did not settle within " + std::to_string(parameters.settle.maximumIterations) +
-          " iterations (the last iterate is kept, with Converged 0): another NumberOfSteps may settle them");
+          " iterations, not even with the step split into " + std::to_string(1 << kSettleHalvings) +
+          " (the last iterate is kept, with Converged 0): another NumberOfSteps may settle them");
       }
       for (const std::string& warning : said)
       {

@@ -58,8 +58,21 @@ struct SettleParameters
   /// default size): the energy is then comparable with the paper's, and it
   /// depends on the muscle's own mesh only.
   double balancePoints = 250;
-  /// Linearisations of the volume and of the obstacles' surfaces.
-  int maximumIterations = 50;
+  /// A step of a motion whose unconstrained minimum moves by more than this fraction of a
+  /// muscle's size is settled in as many equal parts as keep each part's move within it
+  /// (SettleParts). A settle starts from the last answer moved as that minimum moved; from
+  /// farther the linearised contacts lose their way: LHDL adduction -40 degrees in one step (a
+  /// move of 0.28) diverged or swung without end on three seeds of four, and flexion 60 degrees
+  /// in three parts (0.14 each) settled the gluteus maximus 0.9 mm apart on one seed of three.
+  /// At an eighth, each step of N = 4 on the LHDL hip (at most 0.11) is one part. Measured on
+  /// the minimum, not on whether a settle converged, so that the count changes with the input
+  /// only where the move crosses a multiple of this, not under rounding noise.
+  double largestStartMove = 0.125;
+  /// Linearisations of the volume and of the obstacles' surfaces. The LHDL hip's slowest step
+  /// (flexion 60 degrees, N = 8, step 5) takes about 75 on the exact input and fewer on
+  /// perturbed ones: at 50 the exact one was halved (InterpolatedDeformation) and the others
+  /// not, and that step's answers differed by 0.65 mm.
+  int maximumIterations = 100;
   /// Converged when no point moves more than this fraction of the muscle's
   /// size in an iteration, the contacts are those of the iteration before,
   /// and the volume is within 1e-9 of its target.
@@ -261,6 +274,13 @@ struct SettleMotion
 /// bones `restBones` in the rest pose).
 SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::vector<const SurfaceEnergy*>& energies,
   const std::vector<std::vector<Points>>& restLines, const std::vector<FixedObstacle>& restBones);
+
+/// How many equal parts a motion's step from where `motion` is to the pose `lines[m]` describe
+/// (`bones` in that pose) is settled in: the fewest in which no muscle's unconstrained minimum
+/// moves by more than SettleParameters::largestStartMove of its size (at most 64).
+int SettleParts(const SettleMotion& motion, const std::vector<const SurfaceEnergy*>& energies,
+  const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones,
+  const SettleParameters& parameters);
 
 /// Settles every muscle of `muscles` (their points in, the settled points out) to the minimum
 /// of its full-mesh energy for the pose `lines[m]` describes, holding `volumes[m]`, none of its

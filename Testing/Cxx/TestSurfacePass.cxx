@@ -10,7 +10,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
+#include <string>
 
 namespace
 {
@@ -43,9 +45,9 @@ struct OnePass
       muscles.push_back({ m.name, &m.muscle, m.lines, energies.back().get() });
     }
   }
-  std::vector<md::SurfacePassResult> Run() const
+  std::vector<md::SurfacePassResult> Run(const md::SettleParameters& parameters = {}) const
   {
-    return md::SettleInOnePass(muscles, obstacles, md::SettleParameters());
+    return md::SettleInOnePass(muscles, obstacles, parameters);
   }
 };
 
@@ -124,4 +126,24 @@ TEST(SurfacePass, OnTheHipAModerateMotionIsReproducible)
   }
   EXPECT_LT(Largest(settled, OnePass(Perturbed(exact, 1)).Run()), 0.005) << "1e-7 noise";
   EXPECT_LT(Largest(settled, OnePass(Perturbed(exact, 1, true)).Run()), 0.01) << "duplicates split";
+}
+
+TEST(SurfacePass, AMuscleThatDoesNotSettleIsSaid)
+{
+  // The phantom at 65 degrees settles in one pass in 68 iterations; given 5, no muscle settles,
+  // and each says so by name, with Converged false.
+  const MotionCase c = PhantomMotion(65);
+  const OnePass pass(c);
+  md::SettleParameters parameters;
+  EXPECT_TRUE(pass.Run(parameters)[0].report.converged);
+  parameters.maximumIterations = 5;
+  const std::vector<md::SurfacePassResult> unsettled = pass.Run(parameters);
+  for (size_t m = 0; m < c.muscles.size(); ++m)
+  {
+    EXPECT_FALSE(unsettled[m].report.converged) << c.muscles[m].name;
+    const std::string said = "muscle '" + c.muscles[m].name + "' did not settle within 5 iterations";
+    EXPECT_TRUE(std::any_of(unsettled[m].warnings.begin(), unsettled[m].warnings.end(),
+      [&](const std::string& w) { return w.find(said) != std::string::npos; }))
+      << c.muscles[m].name;
+  }
 }

@@ -209,8 +209,9 @@ class Pipeline(unittest.TestCase):
         # DeformationMesh by its text, as a script sets it: the pass on the muscles' surfaces
         # holds the volume, keeps every point out of the current-pose bones and says that the
         # rectus femoris's line crosses the femur; the paper's hull pass leaves points inside.
-        # At 30 degrees; at 65 one pass on the surface does not settle, and it says so (it settles
-        # at 40-60, 70-90).
+        # At 30 degrees; at 65, the slowest from 60 to 90 (68 iterations of the 100 allowed; with
+        # 50 it did not settle), it settles too and says nothing of it (the warning when a muscle
+        # does not settle: TestSurfacePass.cxx).
         phantom = simple.MusculoskeletalPhantom(Flexion=30)
         matching = simple.ActionLineMatching(Input=simple.OutputPort(phantom, 3),
                                              CurrentPose=simple.OutputPort(phantom, 4))
@@ -243,7 +244,10 @@ class Pipeline(unittest.TestCase):
         phantom.Flexion = 65
         with mdtesting.CapturedMessages() as messages:
             on_surface.UpdatePipeline()
-        self.assertIn("did not settle within 50 iterations", messages.text)
+        self.assertNotIn("did not settle", messages.text)
+        data = servermanager.Fetch(on_surface)
+        for name in ("Iliopsoas", "GluteusMaximus", "RectusFemoris"):
+            self.assertEqual(block(data, name).GetFieldData().GetArray("Converged").GetValue(0), 1, name)
         for proxy in (on_surface, on_hull, matching, phantom):
             simple.Delete(proxy)
 
