@@ -511,6 +511,16 @@ std::vector<std::vector<MatchedLine>> LinesAt(const SettleInput& in, double frac
   return lines;
 }
 
+/// The bones' trees refitted to the pose at `fraction` of the motion.
+void RefitBones(const SettleInput& in, double fraction)
+{
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int b = 0; b < static_cast<int>(in.obstacles.size()); ++b)
+  {
+    in.obstacles[b].tree->Refit(in.boneMotions[b].AtFraction(fraction));
+  }
+}
+
 /// Adds `more` (a later settle's reports) to `reports`: iterations and seconds add up, the
 /// contacts are the later settle's, and converged is whether both were.
 void AddReports(std::vector<SettleReport>& reports, const std::vector<SettleReport>& more)
@@ -525,31 +535,31 @@ void AddReports(std::vector<SettleReport>& reports, const std::vector<SettleRepo
 }
 
 /// Settles the muscles (`muscles`' points out) from where `motion` is, the pose at fraction
-/// `from` of the motion, to the pose at `to`, the bones' trees refitted there. A settle that
+/// `from` of the motion, to the pose at `to`, the bones' trees already refitted there (and
+/// there again on return). A settle that
 /// does not converge (it diverged, or swung to the end of its iterations) is done again from
 /// the same start in two halves, through the pose halfway, each halved again while it does not
 /// converge, `halvings` times at most: which iterate a settle stops at is no answer (it moves
 /// with rounding noise by millimetres). The reports add up every attempt's iterations and
 /// seconds; `converged` is that of the settles kept. `progress` runs from 0 to 1 over each
-/// attempt.
+/// attempt. `freeMinima`: FreeMinima of the pose at `to` when the caller has them (empty: found
+/// by the settle).
 std::vector<SettleReport> SettleToPose(const SettleInput& in, double from, double to, int halvings,
-  std::vector<TriangleMesh>& muscles, SettleMotion& motion, const std::function<void(double)>& progress)
+  std::vector<TriangleMesh>& muscles, SettleMotion& motion, const std::function<void(double)>& progress,
+  std::vector<Points> freeMinima = {})
 {
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int b = 0; b < static_cast<int>(in.obstacles.size()); ++b)
-  {
-    in.obstacles[b].tree->Refit(in.boneMotions[b].AtFraction(to));
-  }
   const SettleMotion start = halvings > 0 ? motion : SettleMotion();
-  std::vector<SettleReport> reports = SettleMuscles(
-    muscles, in.energies, LinesAt(in, to), in.volumes, in.fixed, &in.restOverlap, in.parameters, &motion, progress);
+  std::vector<SettleReport> reports = SettleMuscles(muscles, in.energies, LinesAt(in, to), in.volumes, in.fixed,
+    &in.restOverlap, in.parameters, &motion, progress, std::move(freeMinima));
   if (halvings == 0 || std::all_of(reports.begin(), reports.end(), [](const SettleReport& r) { return r.converged; }))
   {
     return reports;
   }
   motion = start;
   const double halfway = 0.5 * (from + to);
+  RefitBones(in, halfway);
   std::vector<SettleReport> halves = SettleToPose(in, from, halfway, halvings - 1, muscles, motion, progress);
+  RefitBones(in, to);
   AddReports(halves, SettleToPose(in, halfway, to, halvings - 1, muscles, motion, progress));
   for (size_t m = 0; m < reports.size(); ++m)
   {
@@ -567,17 +577,19 @@ std::vector<SettleReport> SettleToPose(const SettleInput& in, double from, doubl
 std::vector<SettleReport> SettleStep(const SettleInput& in, double from, double to, std::vector<TriangleMesh>& muscles,
   SettleMotion& motion, const std::function<void(double)>& progress)
 {
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int b = 0; b < static_cast<int>(in.obstacles.size()); ++b)
+  RefitBones(in, to);
+  std::vector<Points> freeMinima = FreeMinima(in.energies, LinesAt(in, to), in.fixed);
+  const int parts = SettleParts(motion, in.energies, freeMinima, in.parameters);
+  if (parts == 1) // the settle needs those minima too
   {
-    in.obstacles[b].tree->Refit(in.boneMotions[b].AtFraction(to));
+    return SettleToPose(in, from, to, kSettleHalvings, muscles, motion, progress, std::move(freeMinima));
   }
-  const int parts = SettleParts(motion, in.energies, LinesAt(in, to), in.fixed, in.parameters);
   std::vector<SettleReport> reports;
   for (int k = 1; k <= parts; ++k)
   {
     const double start = k == 1 ? from : from + (to - from) * (k - 1) / parts;
     const double end = k == parts ? to : from + (to - from) * k / parts;
+    RefitBones(in, end);
     const std::vector<SettleReport> part = SettleToPose(
       in, start, end, kSettleHalvings, muscles, motion, [&](double fraction) { progress((k - 1 + fraction) / parts); });
     if (reports.empty())

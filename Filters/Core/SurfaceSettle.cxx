@@ -983,41 +983,51 @@ SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::ve
   const std::vector<std::vector<Points>>& restLines, const std::vector<FixedObstacle>& restBones)
 {
   SettleMotion motion;
+  std::vector<std::vector<MatchedLine>> still;
   for (size_t m = 0; m < muscles.size(); ++m)
   {
+    still.push_back(StillLines(restLines[m]));
     motion.points.push_back(muscles[m].points);
-    motion.free.push_back(energies[m]->Solve(energies[m]->RightHandSide(StillLines(restLines[m]), restBones)));
-    motion.restDepths.push_back(energies[m]->SampleDepthsInBones(StillLines(restLines[m]), restBones));
+    motion.restDepths.push_back(energies[m]->SampleDepthsInBones(still.back(), restBones));
   }
+  motion.free = FreeMinima(energies, still, restBones);
   return motion;
 }
 
+std::vector<Points> FreeMinima(const std::vector<const SurfaceEnergy*>& energies,
+  const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones)
+{
+  std::vector<Points> free(energies.size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int m = 0; m < static_cast<int>(energies.size()); ++m)
+  {
+    free[m] = energies[m]->Solve(energies[m]->RightHandSide(lines[m], bones));
+  }
+  return free;
+}
+
 int SettleParts(const SettleMotion& motion, const std::vector<const SurfaceEnergy*>& energies,
-  const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones,
-  const SettleParameters& parameters)
+  const std::vector<Points>& freeMinima, const SettleParameters& parameters)
 {
   constexpr int kMostParts = 64;
   const size_t count = energies.size();
-  if (motion.free.size() != count || !(parameters.largestStartMove > 0))
+  if (motion.free.size() != count || freeMinima.size() != count || !(parameters.largestStartMove > 0))
   {
     return 1;
   }
-  std::vector<double> moves(count, 0.0); // relative to each muscle's size
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int k = 0; k < static_cast<int>(count); ++k)
+  double largest = 0; // relative to each muscle's size
+  for (size_t m = 0; m < count; ++m)
   {
-    const size_t m = static_cast<size_t>(k);
-    const Points free = energies[m]->Solve(energies[m]->RightHandSide(lines[m], bones));
-    moves[m] = (free - motion.free[m]).rowwise().norm().maxCoeff() / energies[m]->Size();
+    largest = std::max(largest, (freeMinima[m] - motion.free[m]).rowwise().norm().maxCoeff() / energies[m]->Size());
   }
-  const double largest = count > 0 ? *std::max_element(moves.begin(), moves.end()) : 0.0;
   return static_cast<int>(std::clamp(std::ceil(largest / parameters.largestStartMove), 1.0, double(kMostParts)));
 }
 
 std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   const std::vector<const SurfaceEnergy*>& energies, const std::vector<std::vector<MatchedLine>>& lines,
   const std::vector<double>& volumes, const std::vector<FixedObstacle>& bones, const OverlapMasks* restOverlap,
-  const SettleParameters& parameters, SettleMotion* motion, const std::function<void(double)>& progress)
+  const SettleParameters& parameters, SettleMotion* motion, const std::function<void(double)>& progress,
+  std::vector<Points> freeMinima)
 {
   // Sequential quadratic programming: at each iteration the volume and the obstacles' surfaces
   // are linearised at the current points, and the quadratic energy is minimised exactly under
@@ -1030,12 +1040,8 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   const auto start = Clock::now();
   const size_t count = muscles.size();
   const size_t obstacles = bones.size() + count;
-  std::vector<Points> free(count); // the minimum without contact and volume
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int m = 0; m < static_cast<int>(count); ++m)
-  {
-    free[m] = energies[m]->Solve(energies[m]->RightHandSide(lines[m], bones));
-  }
+  // The minimum without contact and volume.
+  std::vector<Points> free = freeMinima.size() == count ? std::move(freeMinima) : FreeMinima(energies, lines, bones);
   // The samples let go in this pose (their rows' energy taken partly or wholly away): each is
   // an equality of the dual system per axis, a . x - y / share = target, whose multiplier y
   // takes that share of the row's pull back out.

@@ -275,12 +275,16 @@ struct SettleMotion
 SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::vector<const SurfaceEnergy*>& energies,
   const std::vector<std::vector<Points>>& restLines, const std::vector<FixedObstacle>& restBones);
 
-/// How many equal parts a motion's step from where `motion` is to the pose `lines[m]` describe
-/// (`bones` in that pose) is settled in: the fewest in which no muscle's unconstrained minimum
+/// Every muscle's unconstrained minimum (no contact, no volume) of its full-mesh energy for the
+/// pose `lines[m]` describe, `bones` in that pose; in parallel.
+std::vector<Points> FreeMinima(const std::vector<const SurfaceEnergy*>& energies,
+  const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones);
+
+/// How many equal parts a motion's step from where `motion` is to a pose whose unconstrained
+/// minima are `freeMinima` (FreeMinima's) is settled in: the fewest in which no muscle's minimum
 /// moves by more than SettleParameters::largestStartMove of its size (at most 64).
 int SettleParts(const SettleMotion& motion, const std::vector<const SurfaceEnergy*>& energies,
-  const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones,
-  const SettleParameters& parameters);
+  const std::vector<Points>& freeMinima, const SettleParameters& parameters);
 
 /// Settles every muscle of `muscles` (their points in, the settled points out) to the minimum
 /// of its full-mesh energy for the pose `lines[m]` describes, holding `volumes[m]`, none of its
@@ -297,9 +301,11 @@ int SettleParts(const SettleMotion& motion, const std::vector<const SurfaceEnerg
 /// With `motion` (a step of a motion, StartMotion at the first), the muscles' points in are
 /// not read: the settle starts where `motion` says, and `motion` is moved on to where it ends.
 /// `progress` (optional) receives the share of SettleParameters::maximumIterations done after
-/// each iteration; it may throw (Cancelled) to stop the settle.
+/// each iteration; it may throw (Cancelled) to stop the settle. `freeMinima`: FreeMinima of
+/// `lines` and `bones` when the caller has them already (SettleParts'); empty: found here.
 std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   const std::vector<const SurfaceEnergy*>& energies, const std::vector<std::vector<MatchedLine>>& lines,
   const std::vector<double>& volumes, const std::vector<FixedObstacle>& bones, const OverlapMasks* restOverlap,
-  const SettleParameters& parameters, SettleMotion* motion = nullptr, const std::function<void(double)>& progress = {});
+  const SettleParameters& parameters, SettleMotion* motion = nullptr, const std::function<void(double)>& progress = {},
+  std::vector<Points> freeMinima = {});
 }

@@ -778,7 +778,8 @@ TEST(SurfaceSettle, AStepIsSettledInAsManyPartsAsTheMinimumMovesEighths)
   auto parts = [&](double degrees, double largestStartMove) {
     md::SettleParameters parameters;
     parameters.largestStartMove = largestStartMove;
-    return md::SettleParts(motion, { &energy }, { { { s.line, Bent(s.line, degrees) } } }, {}, parameters);
+    const std::vector<md::Points> free = md::FreeMinima({ &energy }, { { { s.line, Bent(s.line, degrees) } } }, {});
+    return md::SettleParts(motion, { &energy }, free, parameters);
   };
   EXPECT_EQ(parts(0, 0.125), 1);
   EXPECT_EQ(parts(5, 0.125), 1);
