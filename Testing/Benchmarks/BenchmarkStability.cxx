@@ -11,7 +11,7 @@
 // present, the LHDL hip in four poses. Prints figures; asserts nothing.
 //
 //   BenchmarkStability [data folder] [case: all|phantom|flexion30|flexion60|adduction-40|adduction40]
-//                      [seeds (3)] [methods: all|one-pass|filter|N (1, 4, 8)|settle|settle-all]
+//                      [seeds (3)] [methods: all|one-pass|filter|N (1, 4, 8)|settle|settle-N|settle-all]
 #include "RealData.h"
 
 #include "LocalFrame.h"
@@ -369,10 +369,10 @@ int main(int argc, char* argv[])
     methods.push_back({ "MuscleDeformation, muscle surface", 1, 0.0, true, Method::Filter::PassOnSurface });
   }
   // Each step solved on the muscles' surfaces (DeformationMesh Muscle surface, the default):
-  // "settle" is N = 4, "settle-all" N = 1, 4 and 8.
+  // "settle" is N = 4, "settle-all" N = 1, 4 and 8, "settle-8" N = 8 alone (and so on).
   for (int n : { 1, 4, 8 })
   {
-    if (methodsArg == "settle-all" || (methodsArg == "settle" && n == 4))
+    if (methodsArg == "settle-all" || (methodsArg == "settle" && n == 4) || methodsArg == "settle-" + std::to_string(n))
     {
       methods.push_back({ "interpolation N = " + std::to_string(n) + ", settled on the full mesh", n,
         md::StepDeformationDefaults().contactWeight, true });
@@ -380,8 +380,9 @@ int main(int argc, char* argv[])
   }
   if (methods.empty())
   {
-    std::fprintf(
-      stderr, "unknown methods '%s': all, one-pass, filter, 1, 4, 8, settle or settle-all\n", methodsArg.c_str());
+    std::fprintf(stderr,
+      "unknown methods '%s': all, one-pass, filter, 1, 4, 8, settle, settle-1, settle-4, settle-8 or settle-all\n",
+      methodsArg.c_str());
     return 2;
   }
   std::printf("Distances (mm) between corresponding points of the last step's muscles (any step: the largest at\n"

@@ -691,10 +691,12 @@ double LargestAtAnyStep(const md::InterpolationResult& a, const md::Interpolatio
 /// scan's duplicate points carried along from step to step drifted from their twins until one
 /// lay 0.0009 mm inside a bone at adduction -40 degrees, and the resolution dented the gluteus
 /// medius by 0.47 mm).
-md::InterpolationResult SettledHip(const MotionCase& c, int hullPoints = 250, int steps = 4)
+md::InterpolationResult SettledHip(
+  const MotionCase& c, int hullPoints = 250, int steps = 4, double tolerance = md::SettleParameters().tolerance)
 {
   md::InterpolationParameters parameters;
   parameters.numberOfSteps = steps;
+  parameters.settle.tolerance = tolerance;
   parameters.hull.targetNumberOfPoints = hullPoints;
   parameters.settleOnSurface = true;
   md::InterpolationResult result = md::DeformByInterpolation(c.muscles, c.bones, parameters);
@@ -766,6 +768,25 @@ TEST(SurfaceSettle, OnTheHipOneLargeStepIsSettledInPartsAsReproducibly)
   const md::InterpolationResult settled = SettledHip(exact, 250, 1);
   EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 2), 250, 1)), 0.002) << "1e-7 noise";
   EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 1, true), 250, 1)), 0.005) << "duplicates split";
+}
+
+TEST(SurfaceSettle, ASettleThatCreepsIsCarriedToItsEnd)
+{
+  // LHDL hip, flexion 60 degrees (hip_flexion.mot frame 35) in 8 steps: at step 5 the iliacus
+  // and psoas slide along a curved contact, each iteration moving them by 1e-7 of their size,
+  // 0.999 of the move before. The tolerance stopped them about 1e-4 of their size short, after
+  // 53 iterations on the exact input, 11 or more than 100 on perturbed ones (then the step was
+  // halved, to an answer 0.65 mm away). Extended where it creeps (SteadyStep), the settle ends
+  // where it would with a hundred times tighter tolerance, and noise moves no step's answer
+  // by more than 0.004 mm (measured; issue 13 asks 0.01).
+  MotionCase exact;
+  if (!LhdlMotion("hip_flexion", 35, exact))
+  {
+    GTEST_SKIP() << "LHDL data not found (set MUSCLEDEFORMATION_DATA_DIR)";
+  }
+  const md::InterpolationResult settled = SettledHip(exact, 250, 8);
+  EXPECT_LT(LargestAtAnyStep(settled, SettledHip(exact, 250, 8, 1e-9)), 0.002) << "tolerance 1e-9";
+  EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 1), 250, 8)), 0.01) << "1e-7 noise";
 }
 
 TEST(SurfaceSettle, AStepIsSettledInAsManyPartsAsTheMinimumMovesEighths)
