@@ -128,6 +128,33 @@ TEST(SurfacePass, OnTheHipAModerateMotionIsReproducible)
   EXPECT_LT(Largest(settled, OnePass(Perturbed(exact, 1, true)).Run()), 0.01) << "duplicates split";
 }
 
+TEST(SurfacePass, AtALargeAdductionOpposedContactsDoNotBlowTheSettleUp)
+{
+  // LHDL hip, adduction 40 degrees (hip_adduction.mot frame 40) in one pass. Where the gluteus
+  // maximus and medius cross, two contacts can bound the same gap from opposite sides; kept
+  // both, seed 3's settle (duplicates kept and split) blew up at its third iteration and handed
+  // all four muscles back unsettled, 8.2 mm from the exact input's answer. Measured with the
+  // outside contact left out: every run settles, seed 3 within 0.0003 mm. (Seeds 1 and 2 can
+  // still settle on another side, up to 4.6 mm away: a one pass cannot know which way the bones
+  // went, BENCHMARKS.md.)
+  MotionCase exact;
+  if (!LhdlMotion("hip_adduction", 40, exact))
+  {
+    GTEST_SKIP() << "LHDL data not found (set MUSCLEDEFORMATION_DATA_DIR)";
+  }
+  const std::vector<md::SurfacePassResult> settled = OnePass(exact).Run();
+  for (const bool split : { false, true })
+  {
+    const std::vector<md::SurfacePassResult> perturbed = OnePass(Perturbed(exact, 3, split)).Run();
+    for (size_t m = 0; m < perturbed.size(); ++m)
+    {
+      EXPECT_TRUE(perturbed[m].report.converged) << exact.muscles[m].name << (split ? ", split" : "");
+      EXPECT_LT(std::abs(perturbed[m].volumeChangePercent), 1e-4) << exact.muscles[m].name;
+    }
+    EXPECT_LT(Largest(settled, perturbed), 0.005) << (split ? "duplicates split" : "1e-7 noise");
+  }
+}
+
 TEST(SurfacePass, AMuscleThatDoesNotSettleIsSaid)
 {
   // The phantom at 65 degrees settles in one pass in 68 iterations; given 5, no muscle settles,
