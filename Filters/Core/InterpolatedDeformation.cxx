@@ -580,18 +580,17 @@ std::vector<SettleReport> SettleStep(const SettleInput& in, double from, double 
   RefitBones(in, to);
   std::vector<Points> freeMinima = FreeMinima(in.energies, LinesAt(in, to), in.fixed);
   const int parts = SettleParts(motion, in.energies, freeMinima, in.parameters);
-  if (parts == 1) // the settle needs those minima too
-  {
-    return SettleToPose(in, from, to, kSettleHalvings, muscles, motion, progress, std::move(freeMinima));
-  }
   std::vector<SettleReport> reports;
-  for (int k = 1; k <= parts; ++k)
-  {
+  auto settlePart = [&](int k, std::vector<Points> minima) {
     const double start = k == 1 ? from : from + (to - from) * (k - 1) / parts;
     const double end = k == parts ? to : from + (to - from) * k / parts;
-    RefitBones(in, end);
+    if (parts > 1) // one part: the bones are at `to` already
+    {
+      RefitBones(in, end);
+    }
     const std::vector<SettleReport> part = SettleToPose(
-      in, start, end, kSettleHalvings, muscles, motion, [&](double fraction) { progress((k - 1 + fraction) / parts); });
+      in, start, end, kSettleHalvings, muscles, motion, [&](double fraction) { progress((k - 1 + fraction) / parts); },
+      std::move(minima));
     if (reports.empty())
     {
       reports = part;
@@ -600,7 +599,12 @@ std::vector<SettleReport> SettleStep(const SettleInput& in, double from, double 
     {
       AddReports(reports, part);
     }
+  };
+  for (int k = 1; k < parts; ++k)
+  {
+    settlePart(k, {});
   }
+  settlePart(parts, std::move(freeMinima)); // the last part settles to `to`, whose minima are found above
   return reports;
 }
 

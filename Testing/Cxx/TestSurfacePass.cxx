@@ -132,8 +132,9 @@ TEST(SurfacePass, AtALargeAdductionOpposedContactsDoNotBlowTheSettleUp)
 {
   // LHDL hip, adduction 40 degrees (hip_adduction.mot frame 40) in one pass. Where the gluteus
   // maximus and medius cross, two contacts can bound the same gap from opposite sides; kept
-  // both, seed 3's settle (duplicates kept and split) blew up at its third iteration and handed
-  // all four muscles back unsettled, 8.2 mm from the exact input's answer. Measured with the
+  // both, seed 3's settle (duplicates kept and split) blew up (in BenchmarkStability's run, at
+  // its third iteration) and handed all four muscles back unsettled, 8.2 mm from the exact
+  // input's answer. Measured with the
   // outside contact left out: every run settles, seed 3 within 0.0003 mm. (Seeds 1 and 2 can
   // still settle on another side, up to 4.6 mm away: a one pass cannot know which way the bones
   // went, BENCHMARKS.md.)

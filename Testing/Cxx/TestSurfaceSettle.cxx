@@ -819,7 +819,7 @@ TEST(SurfaceSettle, CrossedMusclesSettleApartThoughTheirContactsOppose)
   // in the rest pose together, so each must leave the other. Where their surfaces cross, a
   // point of one inside the other and its nearest point of the other, outside the first, make
   // two contacts that bound the same gap from opposite sides; kept both, the settle's
-  // multipliers blow up at the first iteration and it hands the spindles back where they
+  // multipliers blew up within 7 iterations and it handed the spindles back where they
   // started (measured: 77 and 150 points inside). Measured with the outside one left out: 80
   // iterations, no point inside, volumes within 1e-13.
   const Spindle s;
