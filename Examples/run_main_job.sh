@@ -2,7 +2,10 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Installs what is missing (Debian 12), builds, and runs the main job: the whole interpolation
 # method against the one-pass method on the MusculoskeletalPhantom and, when present, on the real
-# LHDL hip data (60 degrees of hip flexion, 4 steps).
+# LHDL hip data (60 degrees of hip flexion, 4 steps); then whole motions with
+# MotionMuscleDeformation: the phantom through a flexion sweep and, when present, the LHDL hip
+# through every frame of hip_flexion.mot and hip_adduction.mot (time series .pvd, pictures of every
+# frame, a movie, plots of the measures over time).
 #   bash Examples/run_main_job.sh [output folder, default results/]
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../Testing/bootstrap.sh"
@@ -22,5 +25,7 @@ if [ -d "$MD_DATA_DIR/lhdl_hip_r" ]; then
 else
   echo "== Real data not found in $MD_DATA_DIR: ran the phantom only"
 fi
+echo "== Whole motions, every frame deformed from the one before (MotionMuscleDeformation)"
+md_with_display pvpython "$MD_SOURCE_DIR/Examples/motion.py" --output "$OUTPUT/motion" --data "$MD_DATA_DIR"
 echo
-echo "Results (pictures .png, meshes .vtp, figures.json) are in: $OUTPUT"
+echo "Results (pictures .png, meshes .vtp, figures.json; the motions as .pvd time series, frames, movies and plots in motion/) are in: $OUTPUT"

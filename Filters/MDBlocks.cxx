@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "MDBlocks.h"
 
+#include "InterpolatedDeformation.h"
+
 #include <vtkStreamingDemandDrivenPipeline.h>
 
 #include <vtkAOSDataArrayTemplate.h>
@@ -23,6 +25,7 @@
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkStringArray.h>
+#include <vtkTable.h>
 #include <vtkTriangleFilter.h>
 #include <vtkUnsignedCharArray.h>
 
@@ -367,6 +370,32 @@ std::function<bool()> AbortRequested(vtkAlgorithm* filter)
   };
 }
 
+void OutputsFollowInputs(vtkInformationVector** inputVector, vtkInformationVector* outputVector,
+  const std::vector<int>& followed, int tablePort)
+{
+  if (!vtkTable::GetData(outputVector, tablePort))
+  {
+    vtkNew<vtkTable> table;
+    outputVector->GetInformationObject(tablePort)->Set(vtkDataObject::DATA_OBJECT(), table);
+  }
+  for (size_t port = 0; port < followed.size(); ++port)
+  {
+    vtkDataObject* input = vtkDataObject::GetData(inputVector[followed[port]], 0);
+    if (!input)
+    {
+      continue;
+    }
+    vtkInformation* info = outputVector->GetInformationObject(static_cast<int>(port));
+    vtkDataObject* output = vtkDataObject::GetData(info);
+    if (!output || !output->IsA(input->GetClassName()))
+    {
+      vtkSmartPointer<vtkDataObject> made;
+      made.TakeReference(input->NewInstance());
+      info->Set(vtkDataObject::DATA_OBJECT(), made);
+    }
+  }
+}
+
 void ClearOutputs(vtkInformationVector* outputVector)
 {
   for (int port = 0; port < outputVector->GetNumberOfInformationObjects(); ++port)
@@ -686,6 +715,56 @@ bool ReadMeshes(vtkInformationVector* port, const std::string& portName, std::ve
       }
       names.push_back(leaf.name.empty() ? leaf.label : leaf.name);
       meshes.push_back(std::move(mesh));
+    }
+  }
+  return true;
+}
+
+bool ReadBones(vtkObject* reporter, vtkDataObject* rest, const std::string& restName, vtkDataObject* current,
+  const std::string& currentName, std::vector<md::BoneMotion>& bones, std::string& error,
+  std::vector<size_t>* leafOfBone)
+{
+  std::vector<Leaf> restLeaves, currentLeaves;
+  std::vector<size_t> partner;
+  if (!CollectLeaves(rest, restName, restLeaves, error) || !CollectLeaves(current, currentName, currentLeaves, error) ||
+    !PairLeaves(reporter, restLeaves, restName, currentLeaves, currentName, partner, error))
+  {
+    return false;
+  }
+  for (size_t b = 0; b < restLeaves.size(); ++b)
+  {
+    const Leaf& r = restLeaves[b];
+    const Leaf& c = currentLeaves[partner[b]];
+    if (!r.data && !c.data)
+    {
+      continue; // an empty block in both poses
+    }
+    if (!r.data || !c.data)
+    {
+      // Dropping it would silently take an obstacle away.
+      error = (r.data ? c.label : r.label) + " is empty but " + (r.data ? r.label : c.label) +
+        " is not: a bone needs its surface in both poses";
+      return false;
+    }
+    md::BoneMotion bone;
+    bone.name = r.name.empty() ? r.label : r.name;
+    ReadTriangles(r.data, bone.rest);
+    bone.current = ToPoints(c.data->GetPoints());
+    if (bone.rest.points.rows() != bone.current.rows())
+    {
+      error = r.label + " has " + std::to_string(bone.rest.points.rows()) + " points but " + c.label + " has " +
+        std::to_string(bone.current.rows()) + ": a bone must have the same points in both poses";
+      return false;
+    }
+    if (bone.rest.triangles.rows() == 0)
+    {
+      error = r.label + " has no surface (no polygons)";
+      return false;
+    }
+    bones.push_back(std::move(bone));
+    if (leafOfBone)
+    {
+      leafOfBone->push_back(b);
     }
   }
   return true;

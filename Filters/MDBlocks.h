@@ -25,6 +25,11 @@ class vtkObject;
 class vtkPoints;
 class vtkPolyData;
 
+namespace md
+{
+struct BoneMotion;
+}
+
 namespace mdvtk
 {
 using md::Points;
@@ -127,6 +132,11 @@ vtkSmartPointer<vtkPolyData> FailedMuscle(vtkPolyData* input, const std::string&
 /// the flag), for md::HullParameters::cancelled.
 std::function<bool()> AbortRequested(vtkAlgorithm* filter);
 
+/// RequestDataObject of a filter whose output k has the type of input `followed[k]` (when that
+/// input is connected) and whose output `tablePort` is a vtkTable.
+void OutputsFollowInputs(vtkInformationVector** inputVector, vtkInformationVector* outputVector,
+  const std::vector<int>& followed, int tablePort);
+
 /// Empties every output. Called when a filter is about to run again (its update extent is
 /// requested only then): if an input then fails upstream, the pipeline never calls RequestData,
 /// and the outputs would otherwise keep the last result, easy to take for the new one.
@@ -156,4 +166,12 @@ vtkSmartPointer<vtkPolyData> ToPolyLines(const std::vector<Points>& lines);
 /// on a block without triangles or with non-finite coordinates.
 bool ReadMeshes(vtkInformationVector* port, const std::string& portName, std::vector<std::string>& names,
   std::vector<TriangleMesh>& meshes, std::string& error);
+
+/// The bones of `rest` (input `restName`) and `current` (input `currentName`) paired as PairLeaves
+/// pairs them, each with the same points in both; an empty block in both is skipped. Fails, naming
+/// the block, on a bone empty in one pose only, another number of points, or no polygons.
+/// `leafOfBone` (optional) receives the leaf of `rest` of each bone.
+bool ReadBones(vtkObject* reporter, vtkDataObject* rest, const std::string& restName, vtkDataObject* current,
+  const std::string& currentName, std::vector<md::BoneMotion>& bones, std::string& error,
+  std::vector<size_t>* leafOfBone = nullptr);
 }

@@ -45,56 +45,6 @@ namespace
 {
 const char* const PortNames[] = { "Input", "BonesRest", "BonesCurrent", "ActionLinesRest", "ActionLinesCurrent" };
 
-/// The bones in both poses, paired.
-bool ReadBones(vtkObject* reporter, vtkDataObject* rest, vtkDataObject* current, std::vector<md::BoneMotion>& bones,
-  std::string& error, std::vector<size_t>* leafOfBone = nullptr)
-{
-  std::vector<mdvtk::Leaf> restLeaves, currentLeaves;
-  std::vector<size_t> partner;
-  if (!mdvtk::CollectLeaves(rest, PortNames[1], restLeaves, error) ||
-    !mdvtk::CollectLeaves(current, PortNames[2], currentLeaves, error) ||
-    !mdvtk::PairLeaves(reporter, restLeaves, PortNames[1], currentLeaves, PortNames[2], partner, error))
-  {
-    return false;
-  }
-  for (size_t b = 0; b < restLeaves.size(); ++b)
-  {
-    const mdvtk::Leaf& r = restLeaves[b];
-    const mdvtk::Leaf& c = currentLeaves[partner[b]];
-    if (!r.data && !c.data)
-    {
-      continue; // an empty block in both poses
-    }
-    if (!r.data || !c.data)
-    {
-      // Dropping it would silently take an obstacle away.
-      error = (r.data ? c.label : r.label) + " is empty but " + (r.data ? r.label : c.label) +
-        " is not: a bone needs its surface in both poses";
-      return false;
-    }
-    md::BoneMotion bone;
-    bone.name = r.name.empty() ? r.label : r.name;
-    mdvtk::ReadTriangles(r.data, bone.rest);
-    bone.current = mdvtk::ToPoints(c.data->GetPoints());
-    if (bone.rest.points.rows() != bone.current.rows())
-    {
-      error = r.label + " has " + std::to_string(bone.rest.points.rows()) + " points but " + c.label + " has " +
-        std::to_string(bone.current.rows()) + ": a bone must have the same points in both poses";
-      return false;
-    }
-    if (bone.rest.triangles.rows() == 0)
-    {
-      error = r.label + " has no surface (no polygons)";
-      return false;
-    }
-    bones.push_back(std::move(bone));
-    if (leafOfBone)
-    {
-      leafOfBone->push_back(b);
-    }
-  }
-  return true;
-}
 }
 
 vtkInterpolatedMuscleDeformation::vtkInterpolatedMuscleDeformation()
@@ -129,28 +79,7 @@ int vtkInterpolatedMuscleDeformation::RequestDataObject(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   // Each output has the type of the input it follows: muscles, bones, action lines; then the table.
-  if (!vtkTable::GetData(outputVector, 3))
-  {
-    vtkNew<vtkTable> table;
-    outputVector->GetInformationObject(3)->Set(vtkDataObject::DATA_OBJECT(), table);
-  }
-  const int followed[3] = { 0, 1, 3 };
-  for (int port = 0; port < 3; ++port)
-  {
-    vtkDataObject* input = vtkDataObject::GetData(inputVector[followed[port]], 0);
-    if (!input)
-    {
-      continue;
-    }
-    vtkInformation* info = outputVector->GetInformationObject(port);
-    vtkDataObject* output = vtkDataObject::GetData(info);
-    if (!output || !output->IsA(input->GetClassName()))
-    {
-      vtkSmartPointer<vtkDataObject> made;
-      made.TakeReference(input->NewInstance());
-      info->Set(vtkDataObject::DATA_OBJECT(), made);
-    }
-  }
+  mdvtk::OutputsFollowInputs(inputVector, outputVector, { 0, 1, 3 }, 3);
   return 1;
 }
 
@@ -179,8 +108,8 @@ int vtkInterpolatedMuscleDeformation::RequestInformation(
     }
     std::vector<md::BoneMotion> bones;
     std::string error;
-    if (!ReadBones(
-          nullptr, vtkDataObject::GetData(inputVector[1], 0), vtkDataObject::GetData(inputVector[2], 0), bones, error))
+    if (!mdvtk::ReadBones(nullptr, vtkDataObject::GetData(inputVector[1], 0), PortNames[1],
+          vtkDataObject::GetData(inputVector[2], 0), PortNames[2], bones, error))
     {
       vtkErrorMacro(<< error);
       return 0;
@@ -258,7 +187,7 @@ int vtkInterpolatedMuscleDeformation::RequestData(
       !mdvtk::CollectLeaves(inputs[4], PortNames[4], currentLines, error) ||
       !mdvtk::PairLeaves(this, muscles, PortNames[0], restLines, PortNames[3], restLinesOf, error) ||
       !mdvtk::PairLeaves(this, restLines, PortNames[3], currentLines, PortNames[4], currentLinesOf, error) ||
-      !ReadBones(this, inputs[1], inputs[2], bones, error, &cache.boneLeaf))
+      !mdvtk::ReadBones(this, inputs[1], PortNames[1], inputs[2], PortNames[2], bones, error, &cache.boneLeaf))
     {
       vtkErrorMacro(<< error);
       return 0;

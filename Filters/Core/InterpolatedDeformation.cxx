@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "InterpolatedDeformation.h"
 
+#include "SettledSteps.h"
+
 #include "MeshChecks.h"
 #include "MuscleFailures.h"
 #include "VolumeConstrainedSolver.h"
@@ -402,212 +404,6 @@ void RefitHulls(HullPass& pass, const std::vector<TriangleMesh>& resolved,
   }
 }
 
-/// The full-mesh energy of every muscle in the rest pose (SurfaceEnergy), or the one an earlier
-/// run left in `kept` where it still holds; those to build are built in parallel. `restLines[m]`
-/// receives each muscle's matched lines at step 0 and `seconds[m]` the time of its energy.
-std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vector<MuscleMotion>& muscles,
-  const std::vector<std::vector<PoseInterpolator>>& lineMotions, int steps, const SettleParameters& parameters,
-  RestMappingCache* kept, std::vector<std::vector<Points>>& restLines, std::vector<double>& seconds,
-  const std::function<void(double)>& report)
-{
-  const size_t count = muscles.size();
-  RestMappingCache scratch;
-  RestMappingCache& rest = kept ? *kept : scratch;
-  rest.muscles.resize(count);
-  std::vector<std::shared_ptr<const SurfaceEnergy>> energies(count);
-  std::vector<std::exception_ptr> failed(count); // no exception may leave a parallel region
-  for (size_t m = 0; m < count; ++m)
-  {
-    for (const PoseInterpolator& line : lineMotions[m])
-    {
-      restLines[m].push_back(line.AtStep(0, steps));
-    }
-    const KeptSurfaceEnergy& entry = rest.muscles[m].surfaceEnergy;
-    if (entry.Holds(muscles[m].muscle, restLines[m], parameters))
-    {
-      energies[m] = entry.energy;
-    }
-  }
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int k = 0; k < static_cast<int>(count); ++k)
-  {
-    const size_t m = static_cast<size_t>(k);
-    if (energies[m])
-    {
-      continue;
-    }
-    const auto energyStart = Clock::now();
-    try
-    {
-      energies[m] = std::make_shared<const SurfaceEnergy>(muscles[m].muscle, restLines[m], parameters);
-    }
-    catch (const InputError& e)
-    {
-      failed[m] = std::make_exception_ptr(OfMuscle(InputError("muscle '" + muscles[m].name + "': " + e.what()), m));
-    }
-    catch (const ComputationError& e)
-    {
-      failed[m] =
-        std::make_exception_ptr(OfMuscle(ComputationError("muscle '" + muscles[m].name + "': " + e.what()), m));
-    }
-    catch (...)
-    {
-      failed[m] = std::current_exception();
-    }
-    seconds[m] += SecondsSince(energyStart);
-  }
-  for (size_t m = 0; m < count; ++m)
-  {
-    KeptSurfaceEnergy& entry = rest.muscles[m].surfaceEnergy;
-    if (energies[m] && energies[m] != entry.energy)
-    {
-      entry.Keep(energies[m], muscles[m].muscle, restLines[m], parameters);
-      ++rest.energyBuildCount;
-    }
-  }
-  for (const std::exception_ptr& failure : failed)
-  {
-    if (failure)
-    {
-      std::rethrow_exception(failure);
-    }
-  }
-  report(0.2);
-  return energies;
-}
-
-/// How many times a settle that does not converge is halved (into 2, then 4 parts): the last
-/// resort after SettleParts. The phantom at 50 degrees in 16 steps swung without end at one
-/// step (10 flipped triangles); halved, every step settles and none turns over.
-constexpr int kSettleHalvings = 2;
-
-/// What the settles of a motion share, step to step: the motions of the bones (whose trees
-/// `obstacles` are refitted to each pose settled to; `fixed` views them) and of the matched
-/// lines, the energies and what the muscles must hold.
-struct SettleInput
-{
-  const std::vector<Obstacle>& obstacles;
-  const std::vector<PoseInterpolator>& boneMotions;
-  const std::vector<std::vector<PoseInterpolator>>& lineMotions;
-  const std::vector<std::vector<Points>>& restLines;
-  const std::vector<const SurfaceEnergy*>& energies;
-  const std::vector<double>& volumes;
-  const std::vector<FixedObstacle>& fixed;
-  const OverlapMasks& restOverlap;
-  const SettleParameters& parameters;
-};
-
-/// The muscles' matched lines from the rest pose to the pose at `fraction` of the motion.
-std::vector<std::vector<MatchedLine>> LinesAt(const SettleInput& in, double fraction)
-{
-  std::vector<std::vector<MatchedLine>> lines(in.lineMotions.size());
-  for (size_t m = 0; m < lines.size(); ++m)
-  {
-    for (size_t l = 0; l < in.lineMotions[m].size(); ++l)
-    {
-      lines[m].push_back({ in.restLines[m][l], in.lineMotions[m][l].AtFraction(fraction) });
-    }
-  }
-  return lines;
-}
-
-/// The bones' trees refitted to the pose at `fraction` of the motion.
-void RefitBones(const SettleInput& in, double fraction)
-{
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int b = 0; b < static_cast<int>(in.obstacles.size()); ++b)
-  {
-    in.obstacles[b].tree->Refit(in.boneMotions[b].AtFraction(fraction));
-  }
-}
-
-/// Adds `more` (a later settle's reports) to `reports`: iterations and seconds add up, the
-/// contacts are the later settle's, and converged is whether both were.
-void AddReports(std::vector<SettleReport>& reports, const std::vector<SettleReport>& more)
-{
-  for (size_t m = 0; m < reports.size(); ++m)
-  {
-    reports[m].iterations += more[m].iterations;
-    reports[m].seconds += more[m].seconds;
-    reports[m].converged = reports[m].converged && more[m].converged;
-    reports[m].pointsInContact = more[m].pointsInContact;
-  }
-}
-
-/// Settles the muscles (`muscles`' points out) from where `motion` is, the pose at fraction
-/// `from` of the motion, to the pose at `to`, the bones' trees already refitted there (and
-/// there again on return). A settle that
-/// does not converge (it diverged, or swung to the end of its iterations) is done again from
-/// the same start in two halves, through the pose halfway, each halved again while it does not
-/// converge, `halvings` times at most: which iterate a settle stops at is no answer (it moves
-/// with rounding noise by millimetres). The reports add up every attempt's iterations and
-/// seconds; `converged` is that of the settles kept. `progress` runs from 0 to 1 over each
-/// attempt. `freeMinima`: FreeMinima of the pose at `to` when the caller has them (empty: found
-/// by the settle).
-std::vector<SettleReport> SettleToPose(const SettleInput& in, double from, double to, int halvings,
-  std::vector<TriangleMesh>& muscles, SettleMotion& motion, const std::function<void(double)>& progress,
-  std::vector<Points> freeMinima = {})
-{
-  const SettleMotion start = halvings > 0 ? motion : SettleMotion();
-  std::vector<SettleReport> reports = SettleMuscles(muscles, in.energies, LinesAt(in, to), in.volumes, in.fixed,
-    &in.restOverlap, in.parameters, &motion, progress, std::move(freeMinima));
-  if (halvings == 0 || std::all_of(reports.begin(), reports.end(), [](const SettleReport& r) { return r.converged; }))
-  {
-    return reports;
-  }
-  motion = start;
-  const double halfway = 0.5 * (from + to);
-  RefitBones(in, halfway);
-  std::vector<SettleReport> halves = SettleToPose(in, from, halfway, halvings - 1, muscles, motion, progress);
-  RefitBones(in, to);
-  AddReports(halves, SettleToPose(in, halfway, to, halvings - 1, muscles, motion, progress));
-  for (size_t m = 0; m < reports.size(); ++m)
-  {
-    halves[m].iterations += reports[m].iterations; // the attempt that did not converge
-    halves[m].seconds += reports[m].seconds;
-  }
-  return halves;
-}
-
-/// Settles the muscles from where `motion` is (the pose at fraction `from` of the motion) to
-/// the pose at `to`, in as many equal parts as SettleParts asks (each by SettleToPose): the
-/// number of parts depends on how far the muscles' minimum moves, continuously in the input,
-/// where SettleToPose's halving depends on whether a settle converged. A step of one part is
-/// settled as it was before either, to the bit.
-std::vector<SettleReport> SettleStep(const SettleInput& in, double from, double to, std::vector<TriangleMesh>& muscles,
-  SettleMotion& motion, const std::function<void(double)>& progress)
-{
-  RefitBones(in, to);
-  std::vector<Points> freeMinima = FreeMinima(in.energies, LinesAt(in, to), in.fixed);
-  const int parts = SettleParts(motion, in.energies, freeMinima, in.parameters);
-  std::vector<SettleReport> reports;
-  auto settlePart = [&](int k, std::vector<Points> minima) {
-    const double start = k == 1 ? from : from + (to - from) * (k - 1) / parts;
-    const double end = k == parts ? to : from + (to - from) * k / parts;
-    if (parts > 1) // one part: the bones are at `to` already
-    {
-      RefitBones(in, end);
-    }
-    const std::vector<SettleReport> part = SettleToPose(
-      in, start, end, kSettleHalvings, muscles, motion, [&](double fraction) { progress((k - 1 + fraction) / parts); },
-      std::move(minima));
-    if (reports.empty())
-    {
-      reports = part;
-    }
-    else
-    {
-      AddReports(reports, part);
-    }
-  };
-  for (int k = 1; k < parts; ++k)
-  {
-    settlePart(k, {});
-  }
-  settlePart(parts, std::move(freeMinima)); // the last part settles to `to`, whose minima are found above
-  return reports;
-}
-
 /// DeformByInterpolation on input already in its local frame.
 InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles, const std::vector<BoneMotion>& bones,
   const InterpolationParameters& parameters, const std::function<void(double)>& progress, RestMappingCache* kept)
@@ -728,8 +524,15 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   }
   if (settle)
   {
-    energies =
-      BuildEnergies(muscles, lineMotions, steps, parameters.settle, kept, restLines, result.restHullSeconds, report);
+    for (size_t m = 0; m < count; ++m)
+    {
+      for (const PoseInterpolator& line : lineMotions[m])
+      {
+        restLines[m].push_back(line.AtStep(0, steps));
+      }
+    }
+    energies = BuildEnergies(muscles, restLines, parameters.settle, kept, result.restHullSeconds);
+    report(0.2);
     for (size_t m = 0; m < count; ++m)
     {
       energyPointers.push_back(energies[m].get());
@@ -789,21 +592,9 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       const double to = static_cast<double>(j) / steps; // AtStep(j, steps)'s fraction
       settled = SettleStep(in, static_cast<double>(j - 1) / steps, to, next, settleMotion,
         [&](double fraction) { report(stepStart + 0.9 * stepShare * fraction); });
-      const std::vector<std::vector<MatchedLine>> wholeMotion = LinesAt(in, to); // rest pose -> this step
-      std::vector<std::string> said =
-        LinesThroughBones(names, wholeMotion, fixed, &linesInBonesAtRest, parameters.settle.samplesPerSegment);
-      if (std::any_of(settled.begin(), settled.end(), [](const SettleReport& r) { return !r.converged; }))
+      for (const std::string& warning : SettleWarnings(in, to, names, linesInBonesAtRest, settled, warned))
       {
-        said.push_back("the muscles did not settle within " + std::to_string(parameters.settle.maximumIterations) +
-          " iterations, not even with the step split into " + std::to_string(1 << kSettleHalvings) +
-          " (the last iterate is kept, with Converged 0): another NumberOfSteps may settle them");
-      }
-      for (const std::string& warning : said)
-      {
-        if (warned.insert(warning).second) // said once, at the first step that has it
-        {
-          result.warnings.push_back("step " + std::to_string(j) + ": " + warning);
-        }
+        result.warnings.push_back("step " + std::to_string(j) + ": " + warning);
       }
     }
     else
@@ -822,55 +613,22 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
         }
       }
     }
-    StaticResolveResult resolved = ResolveStaticIntersections(next, fixed, &restOverlap, parameters.staticResolve);
-    // The volume is given back over the whole surface, except at the overlap
-    // the rest pose has (which stays where it is); a point against an obstacle
-    // cannot move outwards through it anyway.
-    std::vector<std::vector<char>> held(count);
+    std::vector<StepOutcome> outcomes(count);
     for (size_t m = 0; m < count; ++m)
     {
-      next[m].points = resolved.points[m];
-      held[m].assign(static_cast<size_t>(next[m].points.rows()), 0);
-      for (const std::vector<char>& overlap : restOverlap[m])
-      {
-        for (size_t i = 0; i < overlap.size(); ++i)
-        {
-          held[m][i] = held[m][i] || overlap[i];
-        }
-      }
+      outcomes[m] = settle
+        ? StepOutcome{ settled[m].iterations, settled[m].converged, 0, settled[m].seconds }
+        : StepOutcome{ deformed[m].iterations, deformed[m].converged, deformed[m].verticesFrozen, deformed[m].seconds };
     }
-    if (parameters.deformation.preserveVolume)
-    {
-      RestoreVolumes(next, restVolumes, fixed, held);
-    }
+    measures =
+      ResolveAndMeasure(next, muscles, fixed, restOverlap, restVolumes, parameters, outcomes, previous, measures);
     if (!settle)
     {
       RefitHulls(hullPass, next, deformed, muscles, parameters, measures);
     }
-    const std::vector<Penetration> penetration = MeasureNewPenetration(next, fixed, &restOverlap);
-
     std::vector<Points> stepPoints(count);
     for (size_t m = 0; m < count; ++m)
     {
-      MuscleStepMeasures& s = measures[m];
-      const TriangleMesh& rest = muscles[m].muscle;
-      s.volumeChangePercent =
-        100.0 * (EnclosedVolume(next[m].points, rest.triangles) - restVolumes[m]) / restVolumes[m];
-      s.newPenetrationCount = penetration[m].count;
-      s.maxNewPenetrationDepth = penetration[m].maxDepth;
-      s.newBonePenetrationCount = penetration[m].fixedCount;
-      s.maxNewBonePenetrationDepth = penetration[m].fixedMaxDepth;
-      s.stepStaticShift = resolved.reports[m].maxShift;
-      s.maxStaticShift = std::max(previous[m].maxStaticShift, s.stepStaticShift);
-      s.staticallyMovedPoints = resolved.reports[m].penetratingPoints;
-      s.sharpEdgeCount = CountNewSharpEdges(rest.points, next[m].points, rest.triangles);
-      s.flippedTriangleCount = CountFlippedTriangles(rest.points, next[m].points, rest.triangles);
-      s.stepIterations = settle ? settled[m].iterations : deformed[m].iterations;
-      s.iterations = previous[m].iterations + s.stepIterations;
-      s.converged = previous[m].converged && (settle ? settled[m].converged : deformed[m].converged);
-      s.pointsFrozenInObstacles = deformed[m].verticesFrozen;
-      s.deformationSeconds = settle ? settled[m].seconds : deformed[m].seconds;
-      s.staticShift = std::move(resolved.shift[m]);
       stepPoints[m] = next[m].points;
     }
     current = std::move(next);
@@ -1009,12 +767,7 @@ void ResultToWorld(const LocalFrame& frame, const std::vector<const Points*>& re
       {
         frame.ToWorld(result.points[j][m]);
       }
-      MuscleStepMeasures& s = result.measures[j][m];
-      s.maxNewPenetrationDepth = frame.LengthToWorld(s.maxNewPenetrationDepth);
-      s.maxNewBonePenetrationDepth = frame.LengthToWorld(s.maxNewBonePenetrationDepth);
-      s.stepStaticShift = frame.LengthToWorld(s.stepStaticShift);
-      s.maxStaticShift = frame.LengthToWorld(s.maxStaticShift);
-      frame.VectorsToWorld(s.staticShift);
+      MeasuresToWorld(frame, result.measures[j][m]);
     }
   }
 }

@@ -9,6 +9,7 @@
 #include "vtkHullDecimation.h"
 #include "vtkInterpolatedMuscleDeformation.h"
 #include "vtkIntersectionResolve.h"
+#include "vtkMotionMuscleDeformation.h"
 #include "vtkMoveWithBodies.h"
 #include "vtkMuscleDeformation.h"
 #include "vtkMusculoskeletalPhantom.h"
@@ -44,6 +45,7 @@ const std::map<std::string, std::function<vtkSmartPointer<vtkObject>()>> Classes
   { "vtkHullDecimation", Make<vtkHullDecimation> },
   { "vtkInterpolatedMuscleDeformation", Make<vtkInterpolatedMuscleDeformation> },
   { "vtkIntersectionResolve", Make<vtkIntersectionResolve> },
+  { "vtkMotionMuscleDeformation", Make<vtkMotionMuscleDeformation> },
   { "vtkMoveWithBodies", Make<vtkMoveWithBodies> },
   { "vtkMuscleDeformation", Make<vtkMuscleDeformation> },
   { "vtkMusculoskeletalPhantom", Make<vtkMusculoskeletalPhantom> },
@@ -94,7 +96,7 @@ TEST(ServerManagerXml, EveryNumericDefaultIsTheConstructorsDefault)
     }
   }
   std::sort(files.begin(), files.end());
-  ASSERT_EQ(files.size(), 10u) << "one file per proxy";
+  ASSERT_EQ(files.size(), 11u) << "one file per proxy";
   for (const std::string& file : files)
   {
     std::ifstream in(file);

@@ -68,5 +68,31 @@ class PhantomExample(unittest.TestCase):
         self.assertGreater(reader.GetOutput().GetNumberOfPolys(), 1000)
 
 
+class MotionExample(unittest.TestCase):
+    def test_the_phantom_through_a_sweep_writes_a_time_series_pictures_plots_and_figures(self):
+        output = mdtesting.output_dir("example-motion")
+        result = run_example("motion.py", output, "--case", "phantom")
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        folder = os.path.join(output, "phantom")
+        with open(os.path.join(folder, "figures.json")) as f:
+            figures = json.load(f)
+        self.assertEqual(figures["frames"], 16)
+        self.assertEqual(figures["frames_computed"], 16)  # each frame once, the pictures and plots from the cache
+        self.assertLess(figures["largest_abs_volume_change_percent"], 1e-4)
+        self.assertEqual(figures["largest_bone_penetration"], 0.0)
+        self.assertTrue(figures["every_frame_converged"])
+        self.assertLess(figures["largest_smoothness_ratio"], 6.0)  # measured 4.2: the rectus femoris at 28-30 degrees
+        pictures = sorted(glob.glob(os.path.join(folder, "frames", "phantom_*.png")))
+        self.assertEqual(len(pictures), 16)
+        for picture in pictures[::5] + figures["plots"]:
+            self.assertGreater(non_white_fraction(picture), 0.01, picture)
+        with open(os.path.join(folder, "phantom.pvd")) as f:
+            series = f.read()
+        self.assertEqual(series.count("<DataSet "), 32)  # the muscles and the bones at every frame
+        for name in ("phantom_muscles_015.vtm", "phantom_bones_015.vtm"):
+            self.assertTrue(os.path.isfile(os.path.join(folder, name)), name)
+        self.assertEqual(len(figures["measures"]["Time"]), 16)
+
+
 if __name__ == "__main__":
     mdtesting.main()

@@ -23,7 +23,7 @@ class ServerManagerXML(unittest.TestCase):
         proxies = []
         for file_name in sorted(os.listdir(folder)):
             proxies += ElementTree.parse(os.path.join(folder, file_name)).getroot().findall("./ProxyGroup/SourceProxy")
-        self.assertEqual(len(proxies), 10)
+        self.assertEqual(len(proxies), 11)
         for proxy in proxies:
             name = proxy.get("name")
             self.assertTrue((proxy.findtext("Documentation") or "").strip(), name)
@@ -82,7 +82,7 @@ class ServerManagerXML(unittest.TestCase):
 
     def test_proxies_have_the_names_users_rely_on(self):
         for name in ("MusculoskeletalPhantom", "ActionLineMatching", "BoneInterpolation", "HullDecimation",
-                     "MuscleDeformation"):
+                     "MuscleDeformation", "InterpolatedMuscleDeformation", "MotionMuscleDeformation"):
             self.assertTrue(hasattr(simple, name), name)
         matching = simple.ActionLineMatching()
         self.assertAlmostEqual(matching.Tolerance, 0.01)

@@ -1,0 +1,788 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkMotionMuscleDeformation.h"
+
+#include "InterpolatedDeformation.h"
+#include "MDBlocks.h"
+#include "MotionDeformation.h"
+
+#include <vtkDemandDrivenPipeline.h>
+#include <vtkDoubleArray.h>
+#include <vtkExecutive.h>
+#include <vtkFieldData.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
+#include <vtkObjectFactory.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
+#include <vtkTable.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+vtkStandardNewMacro(vtkMotionMuscleDeformation);
+
+namespace
+{
+using SDDP = vtkStreamingDemandDrivenPipeline;
+const char* const PortNames[] = { "Input", "BonesRest", "BonesMotion", "ActionLinesRest", "ActionLinesMotion" };
+constexpr int kMotionPorts[] = { 2, 4 };
+
+/// What the frames were computed from: when any of it changes, the motion starts again.
+struct Signature
+{
+  vtkMTimeType restInputs = 0;     ///< the rest-pose inputs' data
+  vtkMTimeType motionPipeline = 0; ///< the time-varying inputs' pipelines (their sources' settings)
+  std::vector<double> times;
+  int numberOfSteps = 0;
+  double maximumStepDisplacement = 0;
+  int interpolationMode = 0;
+  double deformableShare = 0;
+  bool preserveVolume = true;
+  bool operator==(const Signature& o) const
+  {
+    return restInputs == o.restInputs && motionPipeline == o.motionPipeline && times == o.times &&
+      numberOfSteps == o.numberOfSteps && maximumStepDisplacement == o.maximumStepDisplacement &&
+      interpolationMode == o.interpolationMode && deformableShare == o.deformableShare &&
+      preserveVolume == o.preserveVolume;
+  }
+};
+
+/// The time steps advertised on an input (none: empty).
+std::vector<double> TimesOf(vtkInformation* info)
+{
+  if (!info || !info->Has(SDDP::TIME_STEPS()))
+  {
+    return {};
+  }
+  const double* values = info->Get(SDDP::TIME_STEPS());
+  return std::vector<double>(values, values + info->Length(SDDP::TIME_STEPS()));
+}
+
+/// Index of the time nearest `time`.
+int NearestFrame(const std::vector<double>& times, double time)
+{
+  const auto after = std::lower_bound(times.begin(), times.end(), time);
+  size_t k = static_cast<size_t>(after - times.begin());
+  if (k == times.size() || (k > 0 && time - times[k - 1] < times[k] - time))
+  {
+    k = k == 0 ? 0 : k - 1;
+  }
+  return static_cast<int>(k);
+}
+
+double Bytes(const md::Points& p)
+{
+  return static_cast<double>(p.size()) * sizeof(double);
+}
+}
+
+/// One frame computed: the muscles, the pose that drove them and where the motion stood.
+struct FrameKept
+{
+  std::vector<md::Points> points; ///< [muscle given to the core]
+  md::MotionPose pose;            ///< in the data's coordinates
+  std::shared_ptr<const md::MotionDeformation::State> state;
+  double bytes = 0;
+};
+
+/// The measures of one frame (kept for every frame computed, whatever the cache drops).
+struct FrameMeasures
+{
+  std::vector<md::MuscleStepMeasures> measures; ///< staticShift dropped
+  std::vector<double> secondDifference;         ///< per muscle; NaN before the third frame
+  std::vector<double> smoothnessRatio;
+  int steps = 0;
+  double seconds = 0;
+};
+
+struct vtkMotionMuscleDeformation::Internals
+{
+  Signature signature;
+  std::unique_ptr<md::MotionDeformation> deformation;
+  md::RestMappingCache kept;
+  std::vector<size_t> blockOf;                    // muscle block of each muscle given to the core
+  std::map<size_t, std::string> failedBlocks;     // muscle blocks left out, and why
+  std::vector<size_t> restLinesOf;                // ActionLinesRest leaf of each muscle block
+  std::vector<size_t> boneLeaf;                   // BonesRest leaf of each bone
+  std::vector<md::Points> restPoints;             // [muscle given]: as given, in the data's coordinates
+  std::vector<std::vector<md::Points>> restLines; // [muscle given]
+  std::map<int, FrameKept> frames;
+  std::map<int, FrameMeasures> measures;
+  int gather = -1;      ///< the frame the time-varying inputs are asked for; -1: none
+  bool looping = false; ///< RequestData asked the executive to go on (CONTINUE_EXECUTING)
+  int target = 0;       ///< the frame asked for
+  double upstreamTime = 0;
+  bool upstreamAsked = false;
+  int framesComputed = 0;
+
+  void Restart()
+  {
+    this->deformation.reset();
+    this->blockOf.clear();
+    this->failedBlocks.clear();
+    this->restLinesOf.clear();
+    this->boneLeaf.clear();
+    this->restPoints.clear();
+    this->restLines.clear();
+    this->frames.clear();
+    this->measures.clear();
+  }
+  double CacheBytes() const
+  {
+    double bytes = 0;
+    for (const auto& entry : this->frames)
+    {
+      bytes += entry.second.bytes;
+    }
+    return bytes;
+  }
+  /// Within `megabytes`: drops the frames farthest from the one asked for (never it, nor `last`,
+  /// the last computed, from which the motion goes on).
+  void Evict(double megabytes, int last)
+  {
+    while (this->CacheBytes() > megabytes * 1024.0 * 1024.0 && this->frames.size() > 2)
+    {
+      auto farthest = this->frames.end();
+      for (auto it = this->frames.begin(); it != this->frames.end(); ++it)
+      {
+        if (it->first != last && it->first != this->target &&
+          (farthest == this->frames.end() ||
+            std::abs(it->first - this->target) > std::abs(farthest->first - this->target)))
+        {
+          farthest = it;
+        }
+      }
+      if (farthest == this->frames.end())
+      {
+        break;
+      }
+      this->frames.erase(farthest);
+    }
+  }
+  /// The frame to compute first for `target`: after the last one kept before it.
+  int FirstMissing(int target) const
+  {
+    auto kept = this->frames.lower_bound(target);
+    if (kept != this->frames.end() && kept->first == target)
+    {
+      return -1;
+    }
+    return kept == this->frames.begin() ? 0 : std::prev(kept)->first + 1;
+  }
+};
+
+vtkMotionMuscleDeformation::vtkMotionMuscleDeformation()
+  : In(std::make_unique<Internals>())
+{
+  this->SetNumberOfInputPorts(5);
+  this->SetNumberOfOutputPorts(4);
+}
+
+vtkMotionMuscleDeformation::~vtkMotionMuscleDeformation() = default;
+
+int vtkMotionMuscleDeformation::GetFramesComputed() const
+{
+  return this->In->framesComputed;
+}
+
+int vtkMotionMuscleDeformation::GetFramesKept() const
+{
+  return static_cast<int>(this->In->frames.size());
+}
+
+double vtkMotionMuscleDeformation::GetCacheMegabytes() const
+{
+  return this->In->CacheBytes() / (1024.0 * 1024.0);
+}
+
+int vtkMotionMuscleDeformation::GetSurfaceEnergyBuildCount() const
+{
+  return this->In->kept.energyBuildCount;
+}
+
+int vtkMotionMuscleDeformation::FillInputPortInformation(int, vtkInformation* info)
+{
+  mdvtk::AcceptPolyDataOrMultiBlock(info);
+  return 1;
+}
+
+int vtkMotionMuscleDeformation::FillOutputPortInformation(int port, vtkInformation* info)
+{
+  if (port == 3)
+  {
+    info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkTable");
+    return 1;
+  }
+  return this->Superclass::FillOutputPortInformation(port, info);
+}
+
+int vtkMotionMuscleDeformation::RequestDataObject(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  // Each output has the type of the input it follows: muscles, bones, action lines; then the table.
+  mdvtk::OutputsFollowInputs(inputVector, outputVector, { 0, 1, 3 }, 3);
+  return 1;
+}
+
+int vtkMotionMuscleDeformation::RequestInformation(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  const std::vector<double> bones = TimesOf(inputVector[2]->GetInformationObject(0));
+  const std::vector<double> lines = TimesOf(inputVector[4]->GetInformationObject(0));
+  for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
+  {
+    outputVector->GetInformationObject(port)->Remove(SDDP::TIME_STEPS());
+    outputVector->GetInformationObject(port)->Remove(SDDP::TIME_RANGE());
+  }
+  if (bones.empty() || lines.empty())
+  {
+    vtkErrorMacro(<< (bones.empty() ? PortNames[2] : PortNames[4])
+                  << " has no time steps: connect a time-varying source (OpenSimModelReader with PlayMotion on, "
+                     "and MoveWithBodies and ActionLineGrouping after it); for one pose use "
+                     "InterpolatedMuscleDeformation");
+    return 0;
+  }
+  const double scale = std::max(std::abs(bones.front()), std::abs(bones.back())) + 1.0;
+  bool agree = bones.size() == lines.size();
+  for (size_t k = 0; agree && k < bones.size(); ++k)
+  {
+    agree = std::abs(bones[k] - lines[k]) <= 1e-9 * scale;
+  }
+  if (!agree)
+  {
+    vtkErrorMacro(<< PortNames[2] << " has " << bones.size() << " time steps (" << bones.front() << " to "
+                  << bones.back() << ") but " << PortNames[4] << " has " << lines.size() << " (" << lines.front()
+                  << " to " << lines.back()
+                  << "): the bones and the action lines must come from the same motion, at the same times");
+    return 0;
+  }
+  if (bones.size() < 2)
+  {
+    vtkErrorMacro(<< "the motion has one frame (time " << bones.front()
+                  << "): a motion needs two frames or more; for one pose use InterpolatedMuscleDeformation");
+    return 0;
+  }
+  for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
+  {
+    vtkInformation* info = outputVector->GetInformationObject(port);
+    info->Set(SDDP::TIME_STEPS(), bones.data(), static_cast<int>(bones.size()));
+    const double range[2] = { bones.front(), bones.back() };
+    info->Set(SDDP::TIME_RANGE(), range, 2);
+  }
+  return 1;
+}
+
+int vtkMotionMuscleDeformation::RequestUpdateExtent(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  Internals& in = *this->In;
+  const std::vector<double> times = TimesOf(inputVector[2]->GetInformationObject(0));
+  if (!in.looping && !times.empty())
+  {
+    mdvtk::ClearOutputs(outputVector);
+    vtkInformation* outInfo = outputVector->GetInformationObject(0);
+    in.target = outInfo->Has(SDDP::UPDATE_TIME_STEP()) ? NearestFrame(times, outInfo->Get(SDDP::UPDATE_TIME_STEP()))
+                                                       : static_cast<int>(times.size()) - 1;
+    in.gather = in.signature.times == times ? in.FirstMissing(in.target) : 0;
+  }
+  // The time-varying inputs at the frame to compute; when none is to be computed, at the time
+  // they were last asked for, so that their sources do not run again.
+  if (in.gather >= 0 && in.gather < static_cast<int>(times.size()))
+  {
+    in.upstreamTime = times[in.gather];
+    in.upstreamAsked = true;
+  }
+  else if (!in.upstreamAsked && !times.empty())
+  {
+    in.upstreamTime = times[std::min<size_t>(in.target, times.size() - 1)];
+    in.upstreamAsked = true;
+  }
+  for (int port = 0; port < 5; ++port)
+  {
+    const bool motion = port == kMotionPorts[0] || port == kMotionPorts[1];
+    for (int i = 0; i < inputVector[port]->GetNumberOfInformationObjects(); ++i)
+    {
+      vtkInformation* info = inputVector[port]->GetInformationObject(i);
+      if (motion)
+      {
+        info->Set(SDDP::UPDATE_TIME_STEP(), in.upstreamTime);
+      }
+      else
+      {
+        info->Remove(SDDP::UPDATE_TIME_STEP());
+      }
+    }
+  }
+  return 1;
+}
+
+namespace
+{
+/// The leaves of the inputs, read and paired the same way at every frame.
+struct Leaves
+{
+  std::vector<mdvtk::Leaf> muscles, restLines, motionLines, restBones, motionBones;
+  std::vector<size_t> restLinesOf, motionLinesOf;
+};
+
+bool CollectInputs(vtkMotionMuscleDeformation* self, vtkDataObject* const inputs[5], Leaves& leaves, std::string& error)
+{
+  return mdvtk::CollectLeaves(inputs[0], PortNames[0], leaves.muscles, error) &&
+    mdvtk::CollectLeaves(inputs[3], PortNames[3], leaves.restLines, error) &&
+    mdvtk::CollectLeaves(inputs[4], PortNames[4], leaves.motionLines, error) &&
+    mdvtk::CollectLeaves(inputs[1], PortNames[1], leaves.restBones, error) &&
+    mdvtk::PairLeaves(self, leaves.muscles, PortNames[0], leaves.restLines, PortNames[3], leaves.restLinesOf, error) &&
+    mdvtk::PairLeaves(
+      self, leaves.restLines, PortNames[3], leaves.motionLines, PortNames[4], leaves.motionLinesOf, error);
+}
+}
+
+int vtkMotionMuscleDeformation::RequestData(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  Internals& in = *this->In;
+  auto stop = [&](int result) {
+    in.gather = -1;
+    in.looping = false;
+    request->Remove(SDDP::CONTINUE_EXECUTING());
+    return result;
+  };
+  vtkDataObject* inputs[5];
+  Signature signature;
+  for (int port = 0; port < 5; ++port)
+  {
+    inputs[port] = vtkDataObject::GetData(inputVector[port], 0);
+    if (port != kMotionPorts[0] && port != kMotionPorts[1])
+    {
+      signature.restInputs = std::max(signature.restInputs, inputs[port] ? inputs[port]->GetMTime() : 0);
+    }
+    else if (auto* executive = vtkDemandDrivenPipeline::SafeDownCast(this->GetInputExecutive(port, 0)))
+    {
+      signature.motionPipeline = std::max(signature.motionPipeline, executive->GetPipelineMTime());
+    }
+  }
+  signature.times = TimesOf(inputVector[2]->GetInformationObject(0));
+  signature.numberOfSteps = this->NumberOfSteps;
+  signature.maximumStepDisplacement = this->MaximumStepDisplacement;
+  signature.interpolationMode = this->BoneInterpolationMode;
+  signature.deformableShare = this->DeformableShare;
+  signature.preserveVolume = this->PreserveVolume;
+  const std::vector<double>& times = signature.times;
+  if (times.size() < 2)
+  {
+    return stop(0); // RequestInformation said why
+  }
+  Leaves leaves;
+  std::string error;
+  if (!CollectInputs(this, inputs, leaves, error))
+  {
+    vtkErrorMacro(<< error);
+    return stop(0);
+  }
+  if (!(signature == in.signature))
+  {
+    in.Restart();
+    in.signature = signature;
+    if (in.gather != 0)
+    {
+      // The inputs of this pass may be of another time: start the motion from its first frame.
+      in.gather = 0;
+      request->Set(SDDP::CONTINUE_EXECUTING(), 1);
+      in.looping = true;
+      return 1;
+    }
+  }
+
+  if (!in.deformation)
+  {
+    // The rest pose: muscles, their action lines, bones. One muscle's fault leaves it out.
+    auto fail = [&](size_t block, const std::string& message, bool reported = false) {
+      if (!reported)
+      {
+        vtkErrorMacro(<< message);
+      }
+      in.failedBlocks[block] = message;
+    };
+    std::vector<md::MotionDeformation::Muscle> muscles;
+    for (size_t b = 0; b < leaves.muscles.size(); ++b)
+    {
+      const mdvtk::Leaf& leaf = leaves.muscles[b];
+      if (!leaf.data)
+      {
+        continue;
+      }
+      md::MotionDeformation::Muscle muscle;
+      muscle.name = leaf.name.empty() ? leaf.label : leaf.name;
+      mdvtk::ReadTriangles(leaf.data, muscle.rest);
+      const mdvtk::Leaf& lines = leaves.restLines[leaves.restLinesOf[b]];
+      if (muscle.rest.triangles.rows() == 0)
+      {
+        fail(b, leaf.label + " has no surface (no polygons); a muscle must be a closed triangle surface");
+        continue;
+      }
+      muscle.restLines = lines.data ? mdvtk::ToPolylines(lines.data) : std::vector<md::Points>{};
+      if (muscle.restLines.empty())
+      {
+        fail(b,
+          lines.label + " has no polylines: muscle " + leaf.label +
+            " needs its action lines, or nothing says where it goes");
+        continue;
+      }
+      in.blockOf.push_back(b);
+      in.restPoints.push_back(muscle.rest.points);
+      in.restLines.push_back(muscle.restLines);
+      muscles.push_back(std::move(muscle));
+    }
+    std::vector<md::MotionDeformation::Bone> bones;
+    for (size_t b = 0; b < leaves.restBones.size(); ++b)
+    {
+      const mdvtk::Leaf& leaf = leaves.restBones[b];
+      if (!leaf.data)
+      {
+        continue;
+      }
+      md::MotionDeformation::Bone bone;
+      bone.name = leaf.name.empty() ? leaf.label : leaf.name;
+      mdvtk::ReadTriangles(leaf.data, bone.rest);
+      if (bone.rest.triangles.rows() == 0)
+      {
+        vtkErrorMacro(<< leaf.label << " has no surface (no polygons)");
+        in.Restart();
+        return stop(0);
+      }
+      bones.push_back(std::move(bone));
+      in.boneLeaf.push_back(b);
+    }
+    if (muscles.empty())
+    {
+      if (in.failedBlocks.empty())
+      {
+        vtkErrorMacro(<< PortNames[0] << " has no muscle");
+      }
+      in.Restart();
+      return stop(0);
+    }
+    md::InterpolationParameters parameters;
+    parameters.numberOfSteps = this->NumberOfSteps;
+    parameters.maximumStepDisplacement = this->MaximumStepDisplacement;
+    parameters.interpolationMode = static_cast<md::InterpolationMode>(this->BoneInterpolationMode);
+    parameters.staticResolve.deformableShare = this->DeformableShare;
+    parameters.deformation.preserveVolume = this->PreserveVolume;
+    int result = 1;
+    if (!mdvtk::CallCore(
+          this, "",
+          [&] { in.deformation = std::make_unique<md::MotionDeformation>(muscles, bones, parameters, &in.kept); },
+          result))
+    {
+      in.Restart();
+      return stop(result);
+    }
+    for (size_t m = 0; m < muscles.size(); ++m)
+    {
+      const std::string& failure = in.deformation->Failures()[m];
+      if (!failure.empty())
+      {
+        fail(in.blockOf[m], leaves.muscles[in.blockOf[m]].label + ": " + failure);
+      }
+    }
+    for (const std::string& warning : in.deformation->Warnings())
+    {
+      vtkWarningMacro(<< warning);
+    }
+  }
+
+  if (in.gather < 0 && in.FirstMissing(in.target) >= 0)
+  {
+    in.gather = in.FirstMissing(in.target); // dropped from the cache since the request was made
+    request->Set(SDDP::CONTINUE_EXECUTING(), 1);
+    in.looping = true;
+    return 1;
+  }
+  if (in.gather >= 0)
+  {
+    // This pass's time-varying inputs hold frame `gather`: read its pose and deform to it.
+    const int k = in.gather;
+    std::vector<mdvtk::Leaf> motionBones;
+    std::vector<size_t> partner;
+    if (!mdvtk::CollectLeaves(inputs[2], PortNames[2], motionBones, error) ||
+      !mdvtk::PairLeaves(this, leaves.restBones, PortNames[1], motionBones, PortNames[2], partner, error))
+    {
+      vtkErrorMacro(<< "at time " << times[k] << ": " << error);
+      return stop(0);
+    }
+    md::MotionPose pose;
+    for (size_t leaf : in.boneLeaf)
+    {
+      const mdvtk::Leaf& moving = motionBones[partner[leaf]];
+      pose.bones.push_back(moving.data ? mdvtk::ToPoints(moving.data->GetPoints()) : md::Points(0, 3));
+      if (pose.bones.back().rows() != leaves.restBones[leaf].data->GetNumberOfPoints())
+      {
+        vtkErrorMacro(<< moving.label << " has " << pose.bones.back().rows() << " points at time " << times[k]
+                      << " but " << leaves.restBones[leaf].label << " has "
+                      << leaves.restBones[leaf].data->GetNumberOfPoints()
+                      << ": a bone must keep its points through the motion");
+        return stop(0);
+      }
+    }
+    pose.lines.resize(in.blockOf.size());
+    for (size_t m = 0; m < in.blockOf.size(); ++m)
+    {
+      if (!in.deformation->Failures()[m].empty())
+      {
+        continue;
+      }
+      const size_t restLeaf = leaves.restLinesOf[in.blockOf[m]];
+      const mdvtk::Leaf& moving = leaves.motionLines[leaves.motionLinesOf[restLeaf]];
+      const std::vector<md::Points> lines = moving.data ? mdvtk::ToPolylines(moving.data) : std::vector<md::Points>{};
+      if (lines.size() != in.restLines[m].size())
+      {
+        vtkErrorMacro(<< moving.label << " has " << lines.size() << " action lines at time " << times[k] << " but "
+                      << leaves.restLines[restLeaf].label << " has " << in.restLines[m].size()
+                      << ": the lines of a muscle pair by order through the motion");
+        return stop(0);
+      }
+      int result = 1;
+      if (!mdvtk::CallCore(
+            this, moving.label + " at time " + std::to_string(times[k]) + ": ",
+            [&] {
+              for (size_t l = 0; l < lines.size(); ++l)
+              {
+                pose.lines[m].push_back(md::AtRestParameters(in.restLines[m][l], lines[l]));
+              }
+            },
+            result))
+      {
+        return stop(result);
+      }
+    }
+    // From the frame before (the rest pose before the first), wherever the motion stands now.
+    const auto before = in.frames.find(k - 1);
+    md::MotionFrameResult advanced;
+    int result = 1;
+    const int first = in.FirstMissing(in.target) < 0 ? k : std::min(k, in.FirstMissing(in.target));
+    const double share = 1.0 / std::max(1, in.target - first + 1);
+    if (!mdvtk::CallCore(
+          this, "at time " + std::to_string(times[k]) + ": ",
+          [&] {
+            if (k > 0 && before == in.frames.end())
+            {
+              throw md::ComputationError("frame " + std::to_string(k - 1) + " is not kept"); // not reached
+            }
+            in.deformation->Resume(k > 0 ? before->second.state : nullptr);
+            advanced = in.deformation->Advance(pose, mdvtk::ProgressOrCancel(this, (k - first) * share, share));
+          },
+          result))
+    {
+      return stop(result);
+    }
+    ++in.framesComputed;
+    for (const std::string& warning : advanced.warnings)
+    {
+      vtkWarningMacro(<< "at time " << times[k] << ": " << warning);
+    }
+    FrameKept kept;
+    kept.pose = pose;
+    kept.state = in.deformation->Save();
+    kept.points.resize(in.blockOf.size());
+    FrameMeasures measures;
+    measures.steps = advanced.steps;
+    measures.seconds = advanced.seconds;
+    const auto older = in.frames.find(k - 2);
+    for (size_t m = 0; m < in.blockOf.size(); ++m)
+    {
+      kept.points[m] = advanced.points[m];
+      md::MuscleStepMeasures s = advanced.measures[m];
+      s.staticShift = md::Points(0, 3);
+      measures.measures.push_back(s);
+      double second = std::nan(""), ratio = std::nan("");
+      if (k >= 2 && before != in.frames.end() && older != in.frames.end() && kept.points[m].rows() > 0)
+      {
+        second = md::LargestSecondDifference(older->second.points[m], before->second.points[m], kept.points[m]);
+        const double driven = md::LargestSecondDifference(older->second.pose, before->second.pose, pose);
+        ratio = driven > 0 ? second / driven : std::nan("");
+      }
+      measures.secondDifference.push_back(second);
+      measures.smoothnessRatio.push_back(ratio);
+      kept.bytes += Bytes(kept.points[m]);
+    }
+    for (const md::Points& p : pose.bones)
+    {
+      kept.bytes += Bytes(p);
+    }
+    kept.bytes += static_cast<double>(md::MotionDeformation::StateBytes(*kept.state));
+    in.frames[k] = std::move(kept);
+    in.measures[k] = std::move(measures);
+    in.Evict(this->CacheMemoryLimit, k);
+    if (k < in.target)
+    {
+      in.gather = k + 1;
+      request->Set(SDDP::CONTINUE_EXECUTING(), 1);
+      in.looping = true;
+      return 1;
+    }
+    stop(1);
+  }
+
+  // The frame asked for, from the cache (kept within a limit that may have been lowered).
+  const int k = in.target;
+  in.Evict(this->CacheMemoryLimit, k);
+  const FrameKept& frame = in.frames.at(k);
+  const FrameMeasures& measures = in.measures.at(k);
+  std::vector<vtkSmartPointer<vtkPolyData>> outputs(leaves.muscles.size());
+  std::map<size_t, size_t> muscleOfBlock;
+  for (size_t m = 0; m < in.blockOf.size(); ++m)
+  {
+    if (in.deformation->Failures()[m].empty())
+    {
+      muscleOfBlock[in.blockOf[m]] = m;
+    }
+  }
+  for (size_t b = 0; b < leaves.muscles.size(); ++b)
+  {
+    const auto failed = in.failedBlocks.find(b);
+    if (failed != in.failedBlocks.end())
+    {
+      outputs[b] = mdvtk::FailedMuscle(leaves.muscles[b].data, failed->second);
+      continue;
+    }
+    const auto found = muscleOfBlock.find(b);
+    if (found == muscleOfBlock.end())
+    {
+      continue; // an empty block
+    }
+    const size_t m = found->second;
+    const md::MuscleStepMeasures& s = measures.measures[m];
+    auto output = vtkSmartPointer<vtkPolyData>::New();
+    output->ShallowCopy(leaves.muscles[b].data);
+    output->SetPoints(mdvtk::ToVtkPoints(frame.points[m]));
+    output->GetPointData()->AddArray(
+      mdvtk::ToVtkArray(mdvtk::DisplacementArrayName, frame.points[m] - in.restPoints[m]));
+    vtkNew<vtkFieldData> fieldData;
+    fieldData->DeepCopy(leaves.muscles[b].data->GetFieldData());
+    mdvtk::AddFieldValue(fieldData, mdvtk::VolumeChangeArrayName, s.volumeChangePercent);
+    mdvtk::AddFieldValue(fieldData, "NewPenetrationCount", s.newPenetrationCount);
+    mdvtk::AddFieldValue(fieldData, "MaxNewPenetrationDepth", s.maxNewPenetrationDepth);
+    mdvtk::AddFieldValue(fieldData, "NewBonePenetrationCount", s.newBonePenetrationCount);
+    mdvtk::AddFieldValue(fieldData, "MaxNewBonePenetrationDepth", s.maxNewBonePenetrationDepth);
+    mdvtk::AddFieldValue(fieldData, "MaxStaticShift", s.maxStaticShift);
+    mdvtk::AddFieldValue(fieldData, "SharpEdgeCount", s.sharpEdgeCount);
+    mdvtk::AddFieldValue(fieldData, "FlippedTriangleCount", s.flippedTriangleCount);
+    mdvtk::AddFieldValue(fieldData, "NumberOfIterations", s.stepIterations);
+    mdvtk::AddFieldValue(fieldData, "Converged", s.converged ? 1 : 0);
+    mdvtk::AddFieldValue(fieldData, "SecondDifference", measures.secondDifference[m]);
+    mdvtk::AddFieldValue(fieldData, "SmoothnessRatio", measures.smoothnessRatio[m]);
+    mdvtk::AddFieldValue(fieldData, "FrameSeconds", measures.seconds);
+    mdvtk::AddFieldValue(fieldData, "Frame", k);
+    mdvtk::AddFieldValue(fieldData, "Time", times[k]);
+    output->SetFieldData(fieldData);
+    outputs[b] = output;
+  }
+  mdvtk::AssignLeaves(inputs[0], vtkDataObject::GetData(outputVector, 0), outputs, mdvtk::Role::Muscle);
+
+  // Outputs 1 and 2: the bones and the action lines of this frame, as the method used them.
+  std::vector<vtkSmartPointer<vtkPolyData>> boneOutputs(leaves.restBones.size());
+  for (size_t b = 0; b < in.boneLeaf.size(); ++b)
+  {
+    auto bone = vtkSmartPointer<vtkPolyData>::New();
+    bone->ShallowCopy(leaves.restBones[in.boneLeaf[b]].data);
+    bone->SetPoints(mdvtk::ToVtkPoints(frame.pose.bones[b]));
+    boneOutputs[in.boneLeaf[b]] = bone;
+  }
+  mdvtk::AssignLeaves(inputs[1], vtkDataObject::GetData(outputVector, 1), boneOutputs, mdvtk::Role::Bone);
+  std::vector<vtkSmartPointer<vtkPolyData>> lineOutputs(leaves.restLines.size());
+  for (size_t m = 0; m < in.blockOf.size(); ++m)
+  {
+    if (!frame.pose.lines[m].empty())
+    {
+      lineOutputs[leaves.restLinesOf[in.blockOf[m]]] = mdvtk::ToPolyLines(frame.pose.lines[m]);
+    }
+  }
+  mdvtk::AssignLeaves(inputs[3], vtkDataObject::GetData(outputVector, 2), lineOutputs, mdvtk::Role::ActionLine);
+
+  // Output 3: the measures of every frame computed so far, one row per frame.
+  vtkTable* table = vtkTable::GetData(outputVector, 3);
+  std::vector<std::pair<std::string, std::function<double(const FrameMeasures&, size_t)>>> perMuscle = {
+    { mdvtk::VolumeChangeArrayName,
+      [](const FrameMeasures& f, size_t m) {
+        return f.measures[m].volumeChangePercent;
+      } },
+    { "NewPenetrationCount",
+      [](const FrameMeasures& f, size_t m) {
+        return static_cast<double>(f.measures[m].newPenetrationCount);
+      } },
+    { "MaxNewBonePenetrationDepth",
+      [](const FrameMeasures& f, size_t m) {
+        return f.measures[m].maxNewBonePenetrationDepth;
+      } },
+    { "MaxStaticShift",
+      [](const FrameMeasures& f, size_t m) {
+        return f.measures[m].maxStaticShift;
+      } },
+    { "SharpEdgeCount",
+      [](const FrameMeasures& f, size_t m) {
+        return static_cast<double>(f.measures[m].sharpEdgeCount);
+      } },
+    { "FlippedTriangleCount",
+      [](const FrameMeasures& f, size_t m) {
+        return static_cast<double>(f.measures[m].flippedTriangleCount);
+      } },
+    { "NumberOfIterations",
+      [](const FrameMeasures& f, size_t m) {
+        return static_cast<double>(f.measures[m].stepIterations);
+      } },
+    { "Converged",
+      [](const FrameMeasures& f, size_t m) {
+        return f.measures[m].converged ? 1.0 : 0.0;
+      } },
+    { "SecondDifference",
+      [](const FrameMeasures& f, size_t m) {
+        return f.secondDifference[m];
+      } },
+    { "SmoothnessRatio",
+      [](const FrameMeasures& f, size_t m) {
+        return f.smoothnessRatio[m];
+      } },
+  };
+  auto column = [&](const std::string& name, auto value) {
+    vtkNew<vtkDoubleArray> array;
+    array->SetName(name.c_str());
+    for (const auto& [frameIndex, frameMeasures] : in.measures)
+    {
+      array->InsertNextValue(value(frameIndex, frameMeasures));
+    }
+    table->AddColumn(array);
+  };
+  column("Time", [&](int f, const FrameMeasures&) { return times[f]; });
+  column("Frame", [](int f, const FrameMeasures&) { return static_cast<double>(f); });
+  column("Steps", [](int, const FrameMeasures& f) { return static_cast<double>(f.steps); });
+  column("FrameSeconds", [](int, const FrameMeasures& f) { return f.seconds; });
+  for (const auto& [b, m] : muscleOfBlock)
+  {
+    const std::string name = leaves.muscles[b].name.empty() ? leaves.muscles[b].label : leaves.muscles[b].name;
+    for (const auto& [measure, value] : perMuscle)
+    {
+      column(measure + " (" + name + ")", [&, m = m](int, const FrameMeasures& f) { return value(f, m); });
+    }
+  }
+  for (int p = 0; p < this->GetNumberOfOutputPorts(); ++p)
+  {
+    vtkDataObject::GetData(outputVector, p)->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), times[k]);
+  }
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+void vtkMotionMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "NumberOfSteps: " << this->NumberOfSteps << "\n";
+  os << indent << "MaximumStepDisplacement: " << this->MaximumStepDisplacement << "\n";
+  os << indent << "BoneInterpolationMode: " << this->BoneInterpolationMode << "\n";
+  os << indent << "DeformableShare: " << this->DeformableShare << "\n";
+  os << indent << "PreserveVolume: " << this->PreserveVolume << "\n";
+  os << indent << "CacheMemoryLimit: " << this->CacheMemoryLimit << "\n";
+  os << indent << "FramesComputed: " << this->GetFramesComputed() << "\n";
+  os << indent << "FramesKept: " << this->GetFramesKept() << "\n";
+}

@@ -1,0 +1,113 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   vtkMotionMuscleDeformation
+ * @brief   Deforms muscles through a whole motion: each frame from the one before it.
+ *
+ * Inputs: 0 Input, the muscles in the rest pose; 1 BonesRest, the bones in the rest pose;
+ * 2 BonesMotion, the same bones over time (a time-varying source: OpenSimModelReader with
+ * PlayMotion and MoveWithBodies, or any source with time steps); 3 ActionLinesRest, the raw
+ * action lines in the rest pose, one block per muscle; 4 ActionLinesMotion, the same lines over
+ * time. Blocks pair by name, else by order, as in InterpolatedMuscleDeformation. Each frame's
+ * action line is taken at the rest line's points (the point at each rest point's normalised arc
+ * length), so a path that gains or loses a point keeps its points.
+ *
+ * The filter advertises the motion's times. The muscles at frame k are deformed from those at
+ * frame k - 1 (the first from the rest pose) by the interpolation method's steps on the muscles'
+ * surfaces (docs/DESIGN.md section 8): as many steps as keep each bone point's move within
+ * MaximumStepDisplacement (the first frame: NumberOfSteps when not 0), all muscles together,
+ * with contact, the static resolution and the volume restore.
+ *
+ * Frames are computed once and kept (up to CacheMemoryLimit megabytes; the measures of every
+ * frame are kept whatever the limit): a request for frame k computes what is missing from the
+ * last frame kept before k, and going back to a kept frame computes nothing. A change of an input
+ * or of a property other than CacheMemoryLimit starts the motion again (the muscles' energies,
+ * which depend on the rest pose alone, are kept). Stopping a run keeps the frames done.
+ *
+ * Outputs: 0 the muscles at the requested time (point array Displacement from the rest pose;
+ * field data per muscle: VolumeChangePercent, NewPenetrationCount, MaxNewPenetrationDepth,
+ * NewBonePenetrationCount, MaxNewBonePenetrationDepth, MaxStaticShift, SharpEdgeCount,
+ * FlippedTriangleCount, NumberOfIterations and FrameSeconds of this frame, Converged,
+ * SecondDifference and SmoothnessRatio, Frame, Time); 1 the bones and 2 the action lines at that
+ * time, as the method used them; 3 MeasuresOverTime, a table with one row per frame computed so
+ * far (Time, Frame, Steps, FrameSeconds, and each muscle's measures as "<measure> (<muscle>)").
+ */
+#pragma once
+
+#include "MuscleDeformationFiltersModule.h"
+
+#include <vtkPassInputTypeAlgorithm.h>
+
+#include <memory>
+
+class MUSCLEDEFORMATIONFILTERS_EXPORT vtkMotionMuscleDeformation : public vtkPassInputTypeAlgorithm
+{
+public:
+  static vtkMotionMuscleDeformation* New();
+  vtkTypeMacro(vtkMotionMuscleDeformation, vtkPassInputTypeAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  void SetBonesRestConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(1, output); }
+  void SetBonesMotionConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(2, output); }
+  void SetActionLinesRestConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(3, output); }
+  void SetActionLinesMotionConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(4, output); }
+
+  enum InterpolationModes
+  {
+    LINEAR = 0,
+    RIGID = 1,
+  };
+
+  /// Steps from the rest pose to the first frame; 0 (default): as MaximumStepDisplacement says.
+  vtkSetClampMacro(NumberOfSteps, int, 0, 10000);
+  vtkGetMacro(NumberOfSteps, int);
+  /// Largest move of a bone point in one step (data units); frames farther apart get more
+  /// steps. Default 20.
+  vtkSetClampMacro(MaximumStepDisplacement, double, 1e-9, VTK_DOUBLE_MAX);
+  vtkGetMacro(MaximumStepDisplacement, double);
+  /// Between two frames, bones and action lines move RIGID (default) or LINEAR.
+  vtkSetClampMacro(BoneInterpolationMode, int, LINEAR, RIGID);
+  vtkGetMacro(BoneInterpolationMode, int);
+  /// Share of the static correction each muscle takes against another. Default 0.6.
+  vtkSetClampMacro(DeformableShare, double, 0.0, 1.0);
+  vtkGetMacro(DeformableShare, double);
+  /// Default on.
+  vtkSetMacro(PreserveVolume, bool);
+  vtkGetMacro(PreserveVolume, bool);
+  vtkBooleanMacro(PreserveVolume, bool);
+  /// Megabytes the kept frames may take (the muscles, the bones and where the motion stood);
+  /// beyond it the frames farthest from the one shown are dropped. Changing it keeps the frames.
+  /// Default 2048.
+  vtkSetClampMacro(CacheMemoryLimit, double, 1.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(CacheMemoryLimit, double);
+
+  /// Frames computed so far (a frame shown again from the cache does not count).
+  int GetFramesComputed() const;
+  /// Frames kept, and the megabytes they take.
+  int GetFramesKept() const;
+  double GetCacheMegabytes() const;
+  /// Full-mesh energies built so far (kept across changes of the motion or the properties).
+  int GetSurfaceEnergyBuildCount() const;
+
+protected:
+  vtkMotionMuscleDeformation();
+  ~vtkMotionMuscleDeformation() override;
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int FillOutputPortInformation(int port, vtkInformation* info) override;
+  int RequestDataObject(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  int NumberOfSteps = 0;
+  double MaximumStepDisplacement = 20.0;
+  int BoneInterpolationMode = RIGID;
+  double DeformableShare = 0.6;
+  bool PreserveVolume = true;
+  double CacheMemoryLimit = 2048.0;
+
+private:
+  vtkMotionMuscleDeformation(const vtkMotionMuscleDeformation&) = delete;
+  void operator=(const vtkMotionMuscleDeformation&) = delete;
+  struct Internals;
+  std::unique_ptr<Internals> In;
+};

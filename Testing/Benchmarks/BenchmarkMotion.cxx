@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Muscles through a whole motion in the core (Filters/Core/MotionDeformation.h): the four LHDL
+// hip muscles through every frame of hip_flexion or hip_adduction (iliac bone, sacrum and femur),
+// or the phantom through a flexion sweep. Per frame: steps, settle iterations, time, the largest
+// |VolumeChangePercent|, new bone penetration, flipped triangles, new sharp edges and the
+// frame-to-frame smoothness (the largest second difference of a muscle point over three frames,
+// and its ratio to the bones' own). At the frame nearest 60 degrees of flexion (hip_flexion frame
+// 35), the distance to InterpolatedMuscleDeformation's answer for that pose from the rest pose.
+// Prints figures; asserts nothing (see the tests).
+//
+//   BenchmarkMotion [data folder] [hip_flexion|hip_adduction|phantom] [seed: -1 none, 0 float, s > 0 noise]
+#include "MotionFrames.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+namespace
+{
+double LargestDistance(const md::Points& a, const md::Points& b)
+{
+  return a.rows() == b.rows() && a.rows() > 0 ? (a - b).rowwise().norm().maxCoeff() : -1.0;
+}
+}
+
+int main(int argc, char** argv)
+{
+  const std::string folder = argc > 1 ? argv[1] : "";
+  const std::string motion = argc > 2 ? argv[2] : "hip_flexion";
+  const int seed = argc > 3 ? std::atoi(argv[3]) : -1;
+  MotionFrames frames;
+  if (motion == "phantom")
+  {
+    PhantomFrames(frames);
+  }
+  else if (!LhdlFrames(folder, motion, seed, frames))
+  {
+    std::printf("SKIPPED: the LHDL data (lhdl_hip_r) was not found in '%s'\n", folder.c_str());
+    return 0;
+  }
+  std::printf("%s: %zu frames, %zu muscles, %zu bones, seed %d\n", frames.name.c_str(), frames.poses.size(),
+    frames.muscles.size(), frames.bones.size(), seed);
+  md::InterpolationParameters parameters;
+  parameters.numberOfSteps = 0; // the first frame from the rest pose: automatic
+  const auto start = std::chrono::steady_clock::now();
+  md::MotionDeformation deformation(frames.muscles, frames.bones, parameters);
+  std::printf("prepared in %.3f s\n", deformation.PreparationSeconds());
+  std::printf("%5s %7s %5s %6s %8s %9s %7s %6s %6s %9s %7s\n", "frame", "flexion", "steps", "iter", "ms", "max|dV|%",
+    "bonePen", "flips", "sharp", "2nd diff", "ratio");
+  std::vector<std::vector<md::Points>> points;
+  double framesSeconds = 0, worstRatio = 0, worstDepth = 0, worstVolume = 0;
+  for (size_t k = 0; k < frames.poses.size(); ++k)
+  {
+    const md::MotionFrameResult r = deformation.Advance(frames.poses[k]);
+    if (k > 0)
+    {
+      framesSeconds += r.seconds; // the first frame comes from the rest pose in several steps
+    }
+    points.push_back(r.points);
+    int iterations = 0;
+    double volume = 0, depth = 0;
+    std::int64_t flips = 0, sharp = 0;
+    for (const md::MuscleStepMeasures& s : r.measures)
+    {
+      iterations += s.stepIterations;
+      volume = std::max(volume, std::abs(s.volumeChangePercent));
+      depth = std::max(depth, s.maxNewBonePenetrationDepth);
+      flips += s.flippedTriangleCount;
+      sharp += s.sharpEdgeCount;
+    }
+    double second = 0, boneSecond = 0;
+    if (k >= 2)
+    {
+      for (size_t m = 0; m < points[k].size(); ++m)
+      {
+        second = std::max(second, md::LargestSecondDifference(points[k - 2][m], points[k - 1][m], points[k][m]));
+      }
+      boneSecond = md::LargestSecondDifference(frames.poses[k - 2], frames.poses[k - 1], frames.poses[k]);
+    }
+    const double ratio = boneSecond > 0 ? second / boneSecond : 0.0;
+    if (k >= 2)
+    {
+      worstRatio = std::max(worstRatio, ratio);
+    }
+    worstDepth = std::max(worstDepth, depth);
+    worstVolume = std::max(worstVolume, volume);
+    std::printf("%5zu %7.1f %5d %6d %8.1f %9.1e %7.3f %6lld %6lld %9.4f %7.2f\n", k, frames.flexion[k], r.steps,
+      iterations, 1000 * r.seconds, volume, depth, static_cast<long long>(flips), static_cast<long long>(sharp), second,
+      ratio);
+    for (const std::string& w : r.warnings)
+    {
+      std::printf("      warning: %s\n", w.c_str());
+    }
+  }
+  const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("total %.2f s; frames after the first %.1f ms on average; largest |dV| %.1e %%, bone penetration "
+              "%.3f, smoothness ratio %.2f\n",
+    total, frames.poses.size() > 1 ? 1000 * framesSeconds / (frames.poses.size() - 1) : 0.0, worstVolume, worstDepth,
+    worstRatio);
+
+  // The frame nearest 60 degrees of flexion against the interpolation method from the rest pose.
+  if (motion != "hip_adduction")
+  {
+    size_t nearest = 0;
+    for (size_t k = 0; k < frames.flexion.size(); ++k)
+    {
+      if (std::abs(frames.flexion[k] - 60) < std::abs(frames.flexion[nearest] - 60))
+      {
+        nearest = k;
+      }
+    }
+    md::InterpolationParameters direct;
+    const md::InterpolationResult r =
+      md::DeformByInterpolation(frames.cases[nearest].muscles, frames.cases[nearest].bones, direct);
+    std::printf("frame %zu (%.1f degrees) against InterpolatedMuscleDeformation (N = %d) from the rest pose:", nearest,
+      frames.flexion[nearest], r.numberOfSteps);
+    for (size_t m = 0; m < frames.muscles.size(); ++m)
+    {
+      const md::Points& a = points[nearest][m];
+      const md::Points& b = r.points.back()[m];
+      const double rms = a.rows() == b.rows() ? std::sqrt((a - b).rowwise().squaredNorm().mean()) : -1.0;
+      std::printf(" %s %.2f (RMS %.2f) mm;", frames.muscles[m].name.c_str(), LargestDistance(a, b), rms);
+    }
+    std::printf("\n");
+    // The same with the motion's own lines at that frame (the rest lines' points): what the way
+    // through the motion changes, apart from how the lines are sampled.
+    std::vector<md::MuscleMotion> same;
+    for (size_t m = 0; m < frames.muscles.size(); ++m)
+    {
+      same.push_back({ frames.muscles[m].name, frames.muscles[m].rest, {} });
+      for (size_t l = 0; l < frames.muscles[m].restLines.size(); ++l)
+      {
+        same.back().lines.push_back({ frames.muscles[m].restLines[l], frames.poses[nearest].lines[m][l] });
+      }
+    }
+    const md::InterpolationResult sameLines = md::DeformByInterpolation(same, frames.cases[nearest].bones, direct);
+    std::printf("  with the motion's lines (the rest lines' points):");
+    for (size_t m = 0; m < frames.muscles.size(); ++m)
+    {
+      std::printf(" %s %.2f mm;", frames.muscles[m].name.c_str(),
+        LargestDistance(points[nearest][m], sameLines.points.back()[m]));
+    }
+    std::printf("\n");
+  }
+  return 0;
+}

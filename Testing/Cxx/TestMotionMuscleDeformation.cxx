@@ -1,0 +1,268 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// MotionMuscleDeformation as a pipeline drives it, data-free: the phantom's bones and action
+// lines made time-varying by BoneInterpolation (times 0 ... N, the rest pose to 30 degrees of
+// flexion), every frame deformed from the one before.
+#include "FilterTestUtilities.h"
+
+#include "vtkBoneInterpolation.h"
+#include "vtkMotionMuscleDeformation.h"
+#include "vtkMusculoskeletalPhantom.h"
+
+#include <vtkDataArray.h>
+#include <vtkFieldData.h>
+#include <vtkInformationVector.h>
+#include <vtkObjectFactory.h>
+#include <vtkPassInputTypeAlgorithm.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
+#include <vtkTable.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace
+{
+using SDDP = vtkStreamingDemandDrivenPipeline;
+
+/// A time-varying copy of its input at the given times; from `dropFrom` on (a time), its
+/// polydata gain a point: bad input to test.
+class TimedCopy : public vtkPassInputTypeAlgorithm
+{
+public:
+  static TimedCopy* New();
+  vtkTypeMacro(TimedCopy, vtkPassInputTypeAlgorithm);
+  std::vector<double> Times{ 0.0, 1.0 };
+  double DropFrom = 1e300;
+
+protected:
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector* out) override
+  {
+    vtkInformation* info = out->GetInformationObject(0);
+    info->Set(SDDP::TIME_STEPS(), this->Times.data(), static_cast<int>(this->Times.size()));
+    const double range[2] = { this->Times.front(), this->Times.back() };
+    info->Set(SDDP::TIME_RANGE(), range, 2);
+    return 1;
+  }
+  int RequestData(vtkInformation*, vtkInformationVector** in, vtkInformationVector* out) override
+  {
+    vtkInformation* info = out->GetInformationObject(0);
+    const double time = info->Has(SDDP::UPDATE_TIME_STEP()) ? info->Get(SDDP::UPDATE_TIME_STEP()) : 0.0;
+    vtkDataObject* output = vtkDataObject::GetData(out, 0);
+    output->DeepCopy(vtkDataObject::GetData(in[0], 0));
+    if (time >= this->DropFrom)
+    {
+      auto* tree = vtkMultiBlockDataSet::SafeDownCast(output);
+      for (unsigned int b = 0; tree && b < tree->GetNumberOfBlocks(); ++b)
+      {
+        if (auto* poly = vtkPolyData::SafeDownCast(tree->GetBlock(b)))
+        {
+          poly->GetPoints()->InsertNextPoint(0.0, 0.0, 0.0);
+        }
+      }
+    }
+    output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), time);
+    return 1;
+  }
+};
+vtkStandardNewMacro(TimedCopy);
+
+/// The phantom carried from the rest pose to `flexion` degrees in `frames` + 1 frames.
+struct PhantomMotionPipeline
+{
+  vtkNew<vtkMusculoskeletalPhantom> phantom;
+  vtkNew<vtkBoneInterpolation> bones, lines;
+  vtkNew<vtkMotionMuscleDeformation> motion;
+  PhantomMotionPipeline(double flexion, int frames, int lineFrames = -1)
+  {
+    this->phantom->SetFlexion(flexion);
+    this->phantom->SetResolution(16);
+    this->bones->SetInputConnection(0, this->phantom->GetOutputPort(1));
+    this->bones->SetInputConnection(1, this->phantom->GetOutputPort(2));
+    this->bones->SetNumberOfSteps(frames);
+    this->lines->SetInputConnection(0, this->phantom->GetOutputPort(3));
+    this->lines->SetInputConnection(1, this->phantom->GetOutputPort(4));
+    this->lines->SetNumberOfSteps(lineFrames < 0 ? frames : lineFrames);
+    this->motion->SetInputConnection(0, this->phantom->GetOutputPort(0));
+    this->motion->SetBonesRestConnection(this->phantom->GetOutputPort(1));
+    this->motion->SetBonesMotionConnection(this->bones->GetOutputPort());
+    this->motion->SetActionLinesRestConnection(this->phantom->GetOutputPort(3));
+    this->motion->SetActionLinesMotionConnection(this->lines->GetOutputPort());
+  }
+  int At(double time)
+  {
+    this->motion->UpdateInformation();
+    return this->motion->UpdateTimeStep(time);
+  }
+  vtkPolyData* Muscle(unsigned int b)
+  {
+    return vtkPolyData::SafeDownCast(
+      vtkMultiBlockDataSet::SafeDownCast(this->motion->GetOutputDataObject(0))->GetBlock(b));
+  }
+};
+
+double Field(vtkPolyData* muscle, const char* name)
+{
+  vtkDataArray* array = muscle->GetFieldData()->GetArray(name);
+  return array ? array->GetTuple1(0) : std::nan("");
+}
+
+double LargestDifference(vtkPoints* a, vtkPoints* b)
+{
+  double largest = a->GetNumberOfPoints() == b->GetNumberOfPoints() ? 0.0 : 1e300;
+  for (vtkIdType i = 0; largest < 1e300 && i < a->GetNumberOfPoints(); ++i)
+  {
+    double pa[3], pb[3];
+    a->GetPoint(i, pa);
+    b->GetPoint(i, pb);
+    largest = std::max(largest, std::sqrt(vtkMath::Distance2BetweenPoints(pa, pb)));
+  }
+  return largest;
+}
+}
+
+TEST(MotionMuscleDeformation, ComputesEachFrameOnceWhicheverOrderTheyAreAskedIn)
+{
+  PhantomMotionPipeline p(30, 6);
+  ASSERT_EQ(p.At(6), 1);
+  EXPECT_EQ(p.motion->GetFramesComputed(), 7); // frames 0 ... 6, each from the one before
+  vtkInformation* info = p.motion->GetOutputInformation(0);
+  ASSERT_EQ(info->Length(SDDP::TIME_STEPS()), 7);
+  const unsigned int muscles =
+    vtkMultiBlockDataSet::SafeDownCast(p.motion->GetOutputDataObject(0))->GetNumberOfBlocks();
+  ASSERT_GE(muscles, 2u);
+
+  // Scrubbing back and forth computes nothing.
+  ASSERT_EQ(p.At(2), 1);
+  vtkNew<vtkPoints> atTwo;
+  atTwo->SetDataTypeToDouble();
+  atTwo->DeepCopy(p.Muscle(0)->GetPoints());
+  EXPECT_EQ(Field(p.Muscle(0), "Frame"), 2);
+  ASSERT_EQ(p.At(5), 1);
+  ASSERT_EQ(p.At(0), 1);
+  EXPECT_EQ(p.motion->GetFramesComputed(), 7);
+  EXPECT_EQ(p.motion->GetFramesKept(), 7);
+
+  // A frame is the same however it was reached: a new filter asked for frame 2 first.
+  PhantomMotionPipeline fresh(30, 6);
+  ASSERT_EQ(fresh.At(2), 1);
+  EXPECT_EQ(fresh.motion->GetFramesComputed(), 3);
+  EXPECT_EQ(LargestDifference(fresh.Muscle(0)->GetPoints(), atTwo), 0.0);
+
+  // A memory limit of a few frames keeps those nearest the one shown; a frame dropped is computed
+  // again, the same.
+  p.motion->SetCacheMemoryLimit(1.0);
+  ASSERT_EQ(p.At(6), 1);
+  EXPECT_EQ(p.motion->GetFramesComputed(), 7); // a limit changes no result: frame 6 is still kept
+  EXPECT_LE(p.motion->GetCacheMegabytes(), 1.0);
+  EXPECT_LT(p.motion->GetFramesKept(), 7);
+  ASSERT_EQ(p.At(2), 1);
+  EXPECT_GT(p.motion->GetFramesComputed(), 7);
+  EXPECT_EQ(LargestDifference(p.Muscle(0)->GetPoints(), atTwo), 0.0);
+
+  // A property that changes the result starts the motion again.
+  const int before = p.motion->GetFramesComputed();
+  p.motion->SetMaximumStepDisplacement(5.0);
+  ASSERT_EQ(p.At(1), 1);
+  EXPECT_EQ(p.motion->GetFramesComputed(), before + 2);
+}
+
+TEST(MotionMuscleDeformation, EveryFrameHoldsTheVolumeStaysOutOfTheBonesAndMovesSmoothly)
+{
+  PhantomMotionPipeline p(30, 6);
+  ASSERT_EQ(p.At(6), 1);
+  vtkTable* table = vtkTable::SafeDownCast(p.motion->GetOutputDataObject(3));
+  ASSERT_NE(table, nullptr);
+  ASSERT_EQ(table->GetNumberOfRows(), 7); // a row per frame computed
+  ASSERT_NE(table->GetColumnByName("Time"), nullptr);
+  const unsigned int muscles =
+    vtkMultiBlockDataSet::SafeDownCast(p.motion->GetOutputDataObject(0))->GetNumberOfBlocks();
+  for (unsigned int b = 0; b < muscles; ++b)
+  {
+    const std::string name = BlockName(vtkMultiBlockDataSet::SafeDownCast(p.motion->GetOutputDataObject(0)), b);
+    auto column = [&](const std::string& measure) {
+      vtkAbstractArray* array = table->GetColumnByName((measure + " (" + name + ")").c_str());
+      EXPECT_NE(array, nullptr) << measure << " of " << name;
+      return vtkDataArray::SafeDownCast(array);
+    };
+    vtkDataArray* volume = column("VolumeChangePercent");
+    vtkDataArray* depth = column("MaxNewBonePenetrationDepth");
+    vtkDataArray* converged = column("Converged");
+    vtkDataArray* ratio = column("SmoothnessRatio");
+    ASSERT_TRUE(volume && depth && converged && ratio);
+    for (vtkIdType k = 0; k < table->GetNumberOfRows(); ++k)
+    {
+      EXPECT_LT(std::abs(volume->GetTuple1(k)), 1e-4) << name << " frame " << k;
+      EXPECT_EQ(depth->GetTuple1(k), 0.0) << name << " frame " << k;
+      EXPECT_EQ(converged->GetTuple1(k), 1.0) << name << " frame " << k;
+      if (k < 2)
+      {
+        EXPECT_TRUE(std::isnan(ratio->GetTuple1(k))); // needs three frames
+      }
+      else
+      {
+        // Measured 0.0-1.5 (docs/DESIGN.md section 8): no pop.
+        EXPECT_LE(ratio->GetTuple1(k), 3.0) << name << " frame " << k;
+      }
+    }
+  }
+  // The bones and action lines shown are those of the frame.
+  vtkNew<vtkBoneInterpolation> reference;
+  reference->SetInputConnection(0, p.phantom->GetOutputPort(1));
+  reference->SetInputConnection(1, p.phantom->GetOutputPort(2));
+  reference->SetNumberOfSteps(6);
+  reference->UpdateTimeStep(6);
+  auto block = [](vtkDataObject* data, unsigned int b) {
+    return vtkPolyData::SafeDownCast(vtkMultiBlockDataSet::SafeDownCast(data)->GetBlock(b));
+  };
+  EXPECT_EQ(LargestDifference(block(p.motion->GetOutputDataObject(1), 1)->GetPoints(),
+              block(reference->GetOutputDataObject(0), 1)->GetPoints()),
+    0.0);
+}
+
+TEST(MotionMuscleDeformation, BadMotionsGiveClearErrorsAndNoCrash)
+{
+  {
+    CapturedMessages messages;
+    PhantomMotionPipeline p(30, 6, 5); // the lines have other times than the bones
+    EXPECT_EQ(p.At(6), 0);
+    EXPECT_TRUE(messages.Contains("BonesMotion has 7 time steps")) << messages.Text();
+    EXPECT_TRUE(messages.Contains("must come from the same motion")) << messages.Text();
+  }
+  vtkNew<vtkMusculoskeletalPhantom> phantom;
+  phantom->SetResolution(16);
+  phantom->SetFlexion(20);
+  auto pipeline = [&](TimedCopy* bones, TimedCopy* lines, vtkMotionMuscleDeformation* motion) {
+    bones->SetInputConnection(phantom->GetOutputPort(2));
+    lines->SetInputConnection(phantom->GetOutputPort(4));
+    motion->SetInputConnection(0, phantom->GetOutputPort(0));
+    motion->SetBonesRestConnection(phantom->GetOutputPort(1));
+    motion->SetBonesMotionConnection(bones->GetOutputPort());
+    motion->SetActionLinesRestConnection(phantom->GetOutputPort(3));
+    motion->SetActionLinesMotionConnection(lines->GetOutputPort());
+    motion->UpdateInformation();
+  };
+  {
+    CapturedMessages messages;
+    vtkNew<TimedCopy> bones, lines;
+    bones->Times = lines->Times = { 0.5 };
+    vtkNew<vtkMotionMuscleDeformation> motion;
+    pipeline(bones, lines, motion);
+    EXPECT_EQ(motion->UpdateTimeStep(0.5), 0);
+    EXPECT_TRUE(messages.Contains("the motion has one frame (time 0.5)")) << messages.Text();
+  }
+  {
+    CapturedMessages messages;
+    vtkNew<TimedCopy> bones, lines;
+    bones->Times = lines->Times = { 0.0, 1.0, 2.0 };
+    bones->DropFrom = 2.0; // the bones gain a point at the last frame
+    vtkNew<vtkMotionMuscleDeformation> motion;
+    pipeline(bones, lines, motion);
+    EXPECT_EQ(motion->UpdateTimeStep(1.0), 1) << messages.Text();
+    EXPECT_EQ(motion->UpdateTimeStep(2.0), 0);
+    EXPECT_TRUE(messages.Contains("points at time 2")) << messages.Text();
+    EXPECT_TRUE(messages.Contains("a bone must keep its points through the motion")) << messages.Text();
+    EXPECT_EQ(motion->GetFramesComputed(), 2); // the frames before are kept
+    EXPECT_EQ(motion->UpdateTimeStep(1.0), 1);
+    EXPECT_EQ(motion->GetFramesComputed(), 2);
+  }
+}
