@@ -539,7 +539,17 @@ Points ToPoints(vtkDataArray* array)
   {
     return out;
   }
-  // One call into VTK per array rather than per point: VTK here is built -O0.
+  // One call into VTK per array rather than per point: VTK here is built -O0. Scans are usually
+  // float: read from its memory directly (a DeepCopy into doubles goes value by value).
+  if (auto* floats = vtkAOSDataArrayTemplate<float>::FastDownCast(array))
+  {
+    if (floats->GetNumberOfComponents() == 3)
+    {
+      const float* values = floats->GetPointer(0);
+      std::copy(values, values + 3 * n, out.data());
+      return out;
+    }
+  }
   vtkSmartPointer<vtkDoubleArray> doubles = vtkDoubleArray::SafeDownCast(array);
   if (!doubles)
   {

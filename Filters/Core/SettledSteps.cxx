@@ -182,8 +182,11 @@ std::vector<MuscleStepMeasures> ResolveAndMeasure(std::vector<TriangleMesh>& nex
     RestoreVolumes(next, restVolumes, fixed, held);
   }
   const std::vector<Penetration> penetration = MeasureNewPenetration(next, fixed, &restOverlap);
-  for (size_t m = 0; m < count; ++m)
+  // The muscles' measures in parallel (each its own; counts and sums within one muscle as before).
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int k = 0; k < static_cast<int>(count); ++k)
   {
+    const size_t m = static_cast<size_t>(k);
     MuscleStepMeasures& s = measures[m];
     const TriangleMesh& rest = muscles[m].muscle;
     s.volumeChangePercent = 100.0 * (EnclosedVolume(next[m].points, rest.triangles) - restVolumes[m]) / restVolumes[m];

@@ -47,8 +47,8 @@ int main(int argc, char** argv)
   const auto start = std::chrono::steady_clock::now();
   md::MotionDeformation deformation(frames.muscles, frames.bones, parameters);
   std::printf("prepared in %.3f s\n", deformation.PreparationSeconds());
-  std::printf("%5s %7s %5s %6s %8s %9s %7s %6s %6s %9s %7s\n", "frame", "flexion", "steps", "iter", "ms", "max|dV|%",
-    "bonePen", "flips", "sharp", "2nd diff", "ratio");
+  std::printf("%5s %7s %5s %6s %8s %9s %7s %6s %6s %9s %7s %s\n", "frame", "flexion", "steps", "iter", "ms", "max|dV|%",
+    "bonePen", "flips", "sharp", "2nd diff", "ratio", "muscle");
   std::vector<std::vector<md::Points>> points;
   double framesSeconds = 0, worstRatio = 0, worstDepth = 0, worstVolume = 0;
   for (size_t k = 0; k < frames.poses.size(); ++k)
@@ -71,11 +71,17 @@ int main(int argc, char** argv)
       sharp += s.sharpEdgeCount;
     }
     double second = 0, boneSecond = 0;
+    std::string popping; // the muscle with the largest second difference
     if (k >= 2)
     {
       for (size_t m = 0; m < points[k].size(); ++m)
       {
-        second = std::max(second, md::LargestSecondDifference(points[k - 2][m], points[k - 1][m], points[k][m]));
+        const double own = md::LargestSecondDifference(points[k - 2][m], points[k - 1][m], points[k][m]);
+        if (own > second)
+        {
+          second = own;
+          popping = frames.muscles[m].name;
+        }
       }
       boneSecond = md::LargestSecondDifference(frames.poses[k - 2], frames.poses[k - 1], frames.poses[k]);
     }
@@ -86,9 +92,9 @@ int main(int argc, char** argv)
     }
     worstDepth = std::max(worstDepth, depth);
     worstVolume = std::max(worstVolume, volume);
-    std::printf("%5zu %7.1f %5d %6d %8.1f %9.1e %7.3f %6lld %6lld %9.4f %7.2f\n", k, frames.flexion[k], r.steps,
+    std::printf("%5zu %7.1f %5d %6d %8.1f %9.1e %7.3f %6lld %6lld %9.4f %7.2f %s\n", k, frames.flexion[k], r.steps,
       iterations, 1000 * r.seconds, volume, depth, static_cast<long long>(flips), static_cast<long long>(sharp), second,
-      ratio);
+      ratio, popping.c_str());
     for (const std::string& w : r.warnings)
     {
       std::printf("      warning: %s\n", w.c_str());

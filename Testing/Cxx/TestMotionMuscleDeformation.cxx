@@ -8,6 +8,8 @@
 #include "vtkMotionMuscleDeformation.h"
 #include "vtkMusculoskeletalPhantom.h"
 
+#include <vtkCallbackCommand.h>
+#include <vtkCommand.h>
 #include <vtkDataArray.h>
 #include <vtkFieldData.h>
 #include <vtkInformationVector.h>
@@ -265,4 +267,35 @@ TEST(MotionMuscleDeformation, BadMotionsGiveClearErrorsAndNoCrash)
     EXPECT_EQ(motion->UpdateTimeStep(1.0), 1);
     EXPECT_EQ(motion->GetFramesComputed(), 2);
   }
+}
+
+TEST(MotionMuscleDeformation, AStoppedRunKeepsTheFramesDoneAndTheNextGoesOnFromThem)
+{
+  PhantomMotionPipeline p(30, 6);
+  // ParaView's cancel sets AbortExecute; here an observer does, once the run is half through.
+  vtkNew<vtkCallbackCommand> stop;
+  stop->SetCallback([](vtkObject* caller, unsigned long, void*, void*) {
+    auto* filter = vtkAlgorithm::SafeDownCast(caller);
+    if (!filter->GetAbortExecute() && filter->GetProgress() > 0.5)
+    {
+      filter->SetAbortExecute(1);
+    }
+  });
+  const unsigned long observer = p.motion->AddObserver(vtkCommand::ProgressEvent, stop);
+  {
+    CapturedMessages messages;
+    p.At(6);
+    EXPECT_FALSE(messages.Contains("ERROR")) << messages.Text();
+  }
+  const int done = p.motion->GetFramesComputed();
+  EXPECT_GE(done, 2);
+  EXPECT_LT(done, 7);
+  EXPECT_EQ(p.motion->GetFramesKept(), done);
+  EXPECT_EQ(vtkCompositeDataSet::SafeDownCast(p.motion->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
+  p.motion->RemoveObserver(observer);
+  p.motion->SetAbortExecute(0);
+  p.motion->Modified();
+  ASSERT_EQ(p.At(6), 1);
+  EXPECT_EQ(p.motion->GetFramesComputed(), 7); // the frames kept are not computed again
+  EXPECT_GT(vtkCompositeDataSet::SafeDownCast(p.motion->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
 }
