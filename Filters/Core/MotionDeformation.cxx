@@ -241,6 +241,7 @@ MotionDeformation::MotionDeformation(const std::vector<Muscle>& muscles, const s
   }
   in.restOverlap = FindOverlaps(state->current, in.fixed);
   state->settle = StartMotion(state->current, in.energyPointers, in.restLines, in.fixed);
+  state->settle.carryContacts = true; // a frame's contacts are the last frame's, moved on
   std::vector<std::vector<MatchedLine>> still;
   for (const std::vector<Points>& lines : in.restLines)
   {
@@ -304,6 +305,7 @@ size_t MotionDeformation::StateBytes(const State& state)
   {
     add(p);
   }
+  bytes += state.settle.held.size() * sizeof(state.settle.held[0]);
   for (const MuscleStepMeasures& s : state.previous)
   {
     add(s.staticShift);

@@ -1162,7 +1162,14 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   }
   std::vector<SettleReport> reports(count);
   std::vector<std::unique_ptr<TriangleTree>> trees(count);
-  HeldContacts held; // the contacts active at the last iteration
+  HeldContacts held; // the contacts active at the last iteration (the last settle's at the first)
+  if (motion && motion->carryContacts)
+  {
+    for (const auto& [m, point, obstacle, triangle] : motion->held)
+    {
+      held[{ static_cast<size_t>(m), point, static_cast<size_t>(obstacle) }].push_back(triangle);
+    }
+  }
   // Which obstacles each point was inside at the last iteration (at the start: as if it were
   // inside them all, so that a point inside at the start goes out the nearest way) and where it was.
   std::vector<std::vector<char>> wasInside(count);
@@ -1370,6 +1377,15 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       motion->points.push_back(muscles[m].points);
     }
     motion->free = std::move(free);
+    motion->held.clear();
+    for (const auto& [key, triangles] : motion->carryContacts && !diverging ? held : HeldContacts())
+    {
+      for (const Eigen::Index t : triangles)
+      {
+        motion->held.push_back({ static_cast<Eigen::Index>(std::get<0>(key)), std::get<1>(key),
+          static_cast<Eigen::Index>(std::get<2>(key)), t });
+      }
+    }
   }
   // The muscles are settled together: the time is shared.
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();

@@ -20,6 +20,7 @@
 #include <Eigen/SparseCholesky>
 
 #include <algorithm>
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -268,6 +269,14 @@ struct SettleMotion
   /// Per muscle, its action-line samples' depths in the bones at rest
   /// (SurfaceEnergy::SampleDepthsInBones): a sample is let go only deeper than that.
   std::vector<std::vector<double>> restDepths;
+  /// Whether each settle starts with the contacts that held the muscles where the last one ended
+  /// (`held`) active, rather than with none: a motion's frames are small pose changes, whose
+  /// contacts persist, so the active set is found in fewer iterations, and the contacts are
+  /// carried along the motion rather than found anew at every frame (MotionDeformation).
+  bool carryContacts = false;
+  /// The contacts that held the muscles where the last settle ended (with carryContacts), each
+  /// as (muscle, point, obstacle, triangle), the obstacles the bones first and then the muscles.
+  std::vector<std::array<Eigen::Index, 4>> held;
 };
 
 /// The start of a motion: `muscles` in the rest pose (their action lines `restLines`, the

@@ -204,10 +204,12 @@ TEST(MotionDeformation, OnTheHipEveryFrameOfBothMotionsIsSound)
         }
       }
     }
-    // Measured: 7.3 (hip_flexion, the frame after the iliacus's conditional path point goes) and
-    // 8.9 (hip_adduction, two frames where a muscle jumps by 4.5 mm); elsewhere up to 3.4.
+    // Measured: 1.96 (hip_flexion) and 3.01 (hip_adduction). Each frame's settle starts with the
+    // last frame's contacts (SettleMotion::carryContacts); started with none, the iliacus and psoas
+    // pressed together jumped by 4.5 mm at two frames of hip_adduction (8.9) and the iliacus by
+    // 3.7 mm at hip_flexion's frame 35 (7.3), each to another equilibrium of their contact.
     std::printf("[ measured ] %s: largest smoothness ratio %.2f\n", motion.c_str(), largestRatio);
-    EXPECT_LE(largestRatio, 10.0) << motion;
+    EXPECT_LE(largestRatio, 4.0) << motion;
     if (motion == "hip_flexion")
     {
       // Frame 35 (60 degrees) against the interpolation method from the rest pose with the same lines.
@@ -224,9 +226,14 @@ TEST(MotionDeformation, OnTheHipEveryFrameOfBothMotionsIsSound)
         md::DeformByInterpolation(same, frames.cases[35].bones, md::InterpolationParameters{});
       for (size_t m = 0; m < frames.muscles.size(); ++m)
       {
-        // Measured: 0.00 for the glutei, 0.92 and 0.78 mm for the iliacus and psoas.
-        EXPECT_LT((direct.points.back()[m] - results[35].points[m]).rowwise().norm().maxCoeff(), 2.0)
-          << frames.muscles[m].name;
+        // Measured: 0.00 for the glutei, 0.40 mm for the psoas, 7.26 mm for the iliacus: the
+        // motion's iliacus keeps the contacts it had through the frames since its path point went
+        // (frame 33), the method from the rest pose finds another equilibrium against the iliac
+        // bone and the psoas (the same muscles' answer depends on the way to it, as contact does).
+        const double largest = (direct.points.back()[m] - results[35].points[m]).rowwise().norm().maxCoeff();
+        std::printf("[ measured ] frame 35, %s: %.2f mm from the interpolation method's answer\n",
+          frames.muscles[m].name.c_str(), largest);
+        EXPECT_LT(largest, frames.muscles[m].name == "iliacus_r" ? 10.0 : 1.0) << frames.muscles[m].name;
       }
     }
   }

@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdio>
 #include <map>
 
 namespace
@@ -382,6 +383,53 @@ TEST(SurfaceSettle, ABoneStopsTheMuscle)
   EXPECT_LT((a - b).rowwise().norm().maxCoeff(), 1e-5 * s.Size());
   const double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
   EXPECT_NEAR(md::EnclosedVolume(a, s.muscle.triangles), volume, 1e-8 * volume);
+}
+
+TEST(SurfaceSettle, AMotionsContactsAreCarriedToItsNextStep)
+{
+  // With carryContacts (MotionDeformation's), a settle starts with the contacts that held the
+  // muscle where the last one ended active. The spindle against the box bone, its line bent 25
+  // and then 28 degrees, and back to straight, where nothing touches: carried, each settle ends
+  // where the same settle started with no contacts ends, a contact that no longer holds is let
+  // go, and nothing is kept without carryContacts (the interpolation method's settles).
+  const SpindleBesideABox setup;
+  const auto& [s, energy, bone, bones] = setup;
+  const double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
+  auto settle = [&](md::SettleMotion& motion, double degrees, md::SettleReport& report) {
+    std::vector<md::TriangleMesh> meshes{ s.muscle };
+    report = md::SettleMuscles(meshes, { &energy }, { { { s.line, Bent(s.line, degrees) } } }, { volume }, bones,
+      nullptr, md::SettleParameters(), &motion)[0];
+    return meshes[0].points;
+  };
+  md::SettleMotion carried = md::StartMotion({ s.muscle }, { &energy }, { { s.line } }, bones);
+  carried.carryContacts = true;
+  md::SettleReport first, warm, cold;
+  settle(carried, 25, first);
+  ASSERT_TRUE(first.converged);
+  ASSERT_GT(first.pointsInContact, 0);
+  ASSERT_EQ(carried.held.size(), static_cast<size_t>(first.pointsInContact)); // one triangle each here
+  for (const auto& [muscle, point, obstacle, triangle] : carried.held)
+  {
+    EXPECT_EQ(muscle, 0);
+    EXPECT_EQ(obstacle, 0); // the box
+  }
+  for (const double degrees : { 28.0, 0.0 })
+  {
+    md::SettleMotion fresh = carried;
+    fresh.held.clear();
+    const md::Points a = settle(carried, degrees, warm);
+    const md::Points b = settle(fresh, degrees, cold);
+    ASSERT_TRUE(warm.converged) << degrees;
+    ASSERT_TRUE(cold.converged) << degrees;
+    EXPECT_LE(warm.iterations, cold.iterations) << degrees;
+    EXPECT_LT((a - b).rowwise().norm().maxCoeff(), 1e-5 * s.Size()) << degrees;
+    EXPECT_EQ(CountInside(bone, a), 0) << degrees;
+    EXPECT_EQ(carried.held.size(), static_cast<size_t>(warm.pointsInContact)) << degrees;
+  }
+  EXPECT_EQ(warm.pointsInContact, 0); // straight, the spindle is clear of the box: all let go
+  md::SettleMotion plain = md::StartMotion({ s.muscle }, { &energy }, { { s.line } }, bones);
+  settle(plain, 25, first);
+  EXPECT_TRUE(plain.held.empty());
 }
 
 TEST(SurfaceSettle, ALineThroughABonePullsTheMuscleBesideItNotIntoIt)
