@@ -31,8 +31,19 @@ void AddReports(std::vector<SettleReport>& reports, const std::vector<SettleRepo
   }
 }
 
+/// Adds an attempt that did not converge (`failed`) to the reports of the settles that replaced
+/// it: its iterations and seconds were spent too.
+void AddFailedAttempt(std::vector<SettleReport>& reports, const std::vector<SettleReport>& failed)
+{
+  for (size_t m = 0; m < reports.size(); ++m)
+  {
+    reports[m].iterations += failed[m].iterations;
+    reports[m].seconds += failed[m].seconds;
+  }
+}
+
 /// A settle that starts with the last one's contacts (SettleMotion::carryContacts) converges in
-/// 5 to 16 iterations through the LHDL hip's motions; one that has not in this many started from
+/// 5 to 23 iterations through the LHDL hip's motions; one that has not in this many started from
 /// contacts that no longer hold (where an OpenSim path point comes or goes, a muscle's line
 /// jumps) and is done again from none, as every settle that carries none is.
 constexpr int kCarriedContactIterations = 30;
@@ -66,11 +77,7 @@ std::vector<SettleReport> SettleToPose(const SettleInput& in, double from, doubl
     motion.held.clear();
     std::vector<SettleReport> again =
       SettleToPose(in, from, to, halvings, muscles, motion, progress, std::move(freeMinima));
-    for (size_t m = 0; m < again.size(); ++m)
-    {
-      again[m].iterations += tried[m].iterations; // the attempt that did not converge
-      again[m].seconds += tried[m].seconds;
-    }
+    AddFailedAttempt(again, tried);
     return again;
   }
   const SettleMotion start = halvings > 0 ? motion : SettleMotion();
@@ -86,11 +93,7 @@ std::vector<SettleReport> SettleToPose(const SettleInput& in, double from, doubl
   std::vector<SettleReport> halves = SettleToPose(in, from, halfway, halvings - 1, muscles, motion, progress);
   RefitBones(in, to);
   AddReports(halves, SettleToPose(in, halfway, to, halvings - 1, muscles, motion, progress));
-  for (size_t m = 0; m < reports.size(); ++m)
-  {
-    halves[m].iterations += reports[m].iterations; // the attempt that did not converge
-    halves[m].seconds += reports[m].seconds;
-  }
+  AddFailedAttempt(halves, reports);
   return halves;
 }
 

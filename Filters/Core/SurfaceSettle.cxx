@@ -1378,12 +1378,15 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     }
     motion->free = std::move(free);
     motion->held.clear();
-    for (const auto& [key, triangles] : motion->carryContacts && !diverging ? held : HeldContacts())
+    if (motion->carryContacts && !diverging) // a diverged settle's contacts hold nothing
     {
-      for (const Eigen::Index t : triangles)
+      for (const auto& [key, triangles] : held)
       {
-        motion->held.push_back({ static_cast<Eigen::Index>(std::get<0>(key)), std::get<1>(key),
-          static_cast<Eigen::Index>(std::get<2>(key)), t });
+        for (const Eigen::Index t : triangles)
+        {
+          motion->held.push_back({ static_cast<Eigen::Index>(std::get<0>(key)), std::get<1>(key),
+            static_cast<Eigen::Index>(std::get<2>(key)), t });
+        }
       }
     }
   }
