@@ -196,8 +196,10 @@ std::vector<MuscleStepMeasures> ResolveAndMeasure(std::vector<TriangleMesh>& nex
   // the rest pose has (which stays where it is); a point against an obstacle
   // cannot move outwards through it anyway.
   std::vector<std::vector<char>> held(count);
+  std::vector<Points> given(count); // the points the static resolution found its penetration at
   for (size_t m = 0; m < count; ++m)
   {
+    given[m] = std::move(next[m].points);
     next[m].points = resolved.points[m];
     held[m].assign(static_cast<size_t>(next[m].points.rows()), 0);
     for (const std::vector<char>& overlap : restOverlap[m])
@@ -212,7 +214,15 @@ std::vector<MuscleStepMeasures> ResolveAndMeasure(std::vector<TriangleMesh>& nex
   {
     RestoreVolumes(next, restVolumes, fixed, held);
   }
-  const std::vector<Penetration> penetration = MeasureNewPenetration(next, fixed, &restOverlap);
+  // Where nothing moved (a settle leaves nothing inside an obstacle and the volume held), the
+  // penetration is what the static resolution found at the same points.
+  bool moved = false;
+  for (size_t m = 0; m < count && !moved; ++m)
+  {
+    moved = given[m] != next[m].points;
+  }
+  const std::vector<Penetration> penetration =
+    moved ? MeasureNewPenetration(next, fixed, &restOverlap) : std::move(resolved.found);
   // The muscles' measures in parallel (each its own; counts and sums within one muscle as before).
 #pragma omp parallel for schedule(dynamic, 1)
   for (int k = 0; k < static_cast<int>(count); ++k)

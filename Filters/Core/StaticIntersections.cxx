@@ -94,6 +94,26 @@ Deepest FindDeepest(
   }
   return d;
 }
+
+/// The new penetration FindDeepest found.
+Penetration PenetrationOf(const Deepest& d, size_t fixedCount)
+{
+  Penetration p;
+  for (size_t i = 0; i < d.obstacle.size(); ++i)
+  {
+    if (d.obstacle[i] >= 0)
+    {
+      ++p.count;
+      p.maxDepth = std::max(p.maxDepth, d.depth[i]);
+      if (d.obstacle[i] < static_cast<int>(fixedCount))
+      {
+        ++p.fixedCount;
+        p.fixedMaxDepth = std::max(p.fixedMaxDepth, d.depth[i]);
+      }
+    }
+  }
+  return p;
+}
 }
 
 namespace
@@ -235,21 +255,7 @@ std::vector<Penetration> MeasureNewPenetration(
   std::vector<Penetration> result(meshes.size());
   for (size_t m = 0; m < meshes.size(); ++m)
   {
-    const Deepest d = FindDeepest(meshes[m], m, set, fixed.size(), existing);
-    Penetration& p = result[m];
-    for (size_t i = 0; i < d.obstacle.size(); ++i)
-    {
-      if (d.obstacle[i] >= 0)
-      {
-        ++p.count;
-        p.maxDepth = std::max(p.maxDepth, d.depth[i]);
-        if (d.obstacle[i] < static_cast<int>(fixed.size()))
-        {
-          ++p.fixedCount;
-          p.fixedMaxDepth = std::max(p.fixedMaxDepth, d.depth[i]);
-        }
-      }
-    }
+    result[m] = PenetrationOf(FindDeepest(meshes[m], m, set, fixed.size(), existing), fixed.size());
   }
   return result;
 }
@@ -264,6 +270,7 @@ StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& 
     const TriangleMesh& mesh = meshes[m];
     const Eigen::Index n = mesh.points.rows();
     const Deepest d = FindDeepest(mesh, m, set, fixed.size(), existing);
+    result.found.push_back(PenetrationOf(d, fixed.size()));
     const double backOff = 1e-5 * BoxDiagonal(mesh.points);
     Points shift = Points::Zero(n, 3);
     // Of each penetrating point: the obstacle's outward normal where it goes
@@ -435,12 +442,26 @@ std::vector<double> RestoreVolumes(std::vector<TriangleMesh>& meshes, const std:
   const std::vector<FixedObstacle>& fixed, const std::vector<std::vector<char>>& held)
 {
   constexpr int taperRings = 3;
-  const ObstacleSet set(meshes, fixed);
+  constexpr double restored = 1e-7; // of the target volume: near enough, nothing moves
+  // The obstacles are the meshes as given: built at the first mesh that must move, before any has.
+  std::unique_ptr<const ObstacleSet> set;
   std::vector<double> left(meshes.size(), 0.0);
   for (size_t m = 0; m < meshes.size(); ++m)
   {
     TriangleMesh& mesh = meshes[m];
     const Eigen::Index n = mesh.points.rows();
+    // After a settle that held the volume (every step of the full-mesh deformation) there is
+    // nothing to give back: the neighbours, the taper and the obstacles' trees are not needed.
+    const double given = EnclosedVolume(mesh.points, mesh.triangles);
+    if (std::abs(targetVolumes[m] - given) <= restored * std::abs(targetVolumes[m]))
+    {
+      left[m] = 100.0 * (given - targetVolumes[m]) / targetVolumes[m];
+      continue;
+    }
+    if (!set)
+    {
+      set = std::make_unique<const ObstacleSet>(meshes, fixed);
+    }
     const std::vector<std::vector<std::int64_t>> neighbours = PointNeighbours(mesh.triangles, n);
     // How far each point takes part: 1 where it is free, tapering to 0 over
     // a few rings towards the held points (Jacobi steps with them fixed at 0).
@@ -494,7 +515,7 @@ std::vector<double> RestoreVolumes(std::vector<TriangleMesh>& meshes, const std:
         }
       }
       const double error = targetVolumes[m] - volume;
-      if (rate == 0 || std::abs(error) <= 1e-7 * std::abs(targetVolumes[m]))
+      if (rate == 0 || std::abs(error) <= restored * std::abs(targetVolumes[m]))
       {
         break;
       }
@@ -510,9 +531,9 @@ std::vector<double> RestoreVolumes(std::vector<TriangleMesh>& meshes, const std:
         const Eigen::Vector3d to = from + distance * way.row(i).transpose();
         const double length = (to - from).norm();
         double first = 2;
-        for (size_t o = 0; o < set.all.size(); ++o)
+        for (size_t o = 0; o < set->all.size(); ++o)
         {
-          const TriangleTree* tree = set.For(m, o, fixed.size());
+          const TriangleTree* tree = set->For(m, o, fixed.size());
           if (tree)
           {
             if (const auto hit = tree->FirstHit(from, to); hit && hit->t < first)

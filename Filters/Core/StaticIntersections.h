@@ -75,6 +75,9 @@ struct StaticResolveResult
   std::vector<Points> points; ///< each mesh resolved
   std::vector<Points> shift;  ///< each mesh's move, per point
   std::vector<StaticResolveReport> reports;
+  /// Each mesh's new penetration at the points given, before the moves: what
+  /// MeasureNewPenetration of the meshes given finds.
+  std::vector<Penetration> found;
 };
 
 /// Moves the points of every mesh that lie inside an obstacle (and are not

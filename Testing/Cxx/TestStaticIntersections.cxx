@@ -74,6 +74,44 @@ TEST_F(CapInBox, TheMoveSpreadsToASmoothRimWithFewerSharpEdges)
     md::CountNewSharpEdges(sphere.points, sharp.points[0], sphere.triangles));
 }
 
+TEST_F(CapInBox, TheResolutionReportsThePenetrationItFoundAsTheMeasureDoes)
+{
+  // A sphere beside the cap one, partly inside it and the box, so that the muscle obstacles
+  // count too: what the resolution found at its input is what the measure finds there.
+  md::TriangleMesh other = Sphere(Eigen::Vector3d(-15, 0, 0), 8, 3);
+  const std::vector<md::TriangleMesh> meshes{ sphere, other };
+  const auto measured = md::MeasureNewPenetration(meshes, { Fixed(box) }, nullptr);
+  const auto r = md::ResolveStaticIntersections(meshes, { Fixed(box) }, nullptr, md::StaticResolveParameters{});
+  ASSERT_EQ(r.found.size(), 2u);
+  for (size_t m = 0; m < 2; ++m)
+  {
+    EXPECT_GT(measured[m].count, 0) << "mesh " << m;
+    EXPECT_EQ(r.found[m].count, measured[m].count) << "mesh " << m;
+    EXPECT_EQ(r.found[m].maxDepth, measured[m].maxDepth) << "mesh " << m;
+    EXPECT_EQ(r.found[m].fixedCount, measured[m].fixedCount) << "mesh " << m;
+    EXPECT_EQ(r.found[m].fixedMaxDepth, measured[m].fixedMaxDepth) << "mesh " << m;
+  }
+  EXPECT_GT(measured[0].fixedCount, 0);
+  EXPECT_LT(measured[0].fixedCount, measured[0].count); // in the box and in the other sphere
+}
+
+TEST_F(CapInBox, RestoreVolumesLeavesAMeshThatHoldsItsVolumeUntouched)
+{
+  // The settle holds the volume to 1e-9: nothing is given back, not a bit moves, and the share
+  // left is reported all the same.
+  std::vector<md::TriangleMesh> meshes{ sphere };
+  const double volume = md::EnclosedVolume(sphere.points, sphere.triangles);
+  const std::vector<double> left =
+    md::RestoreVolumes(meshes, { volume * (1 + 1e-9) }, { Fixed(box) }, { std::vector<char>(sphere.points.rows(), 0) });
+  EXPECT_TRUE(meshes[0].points == sphere.points);
+  EXPECT_NEAR(left[0], -1e-7, 1e-12);
+  // Short by more than that, it is given back.
+  const std::vector<double> given =
+    md::RestoreVolumes(meshes, { volume * 1.001 }, { Fixed(box) }, { std::vector<char>(sphere.points.rows(), 0) });
+  EXPECT_FALSE(meshes[0].points == sphere.points);
+  EXPECT_LT(std::abs(given[0]), 1e-5);
+}
+
 TEST_F(CapInBox, OverlapOfTheRestPoseIsLeftAlone)
 {
   const md::OverlapMasks rest = md::FindOverlaps({ sphere }, { Fixed(box) });
