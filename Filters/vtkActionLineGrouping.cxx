@@ -21,6 +21,33 @@
 
 vtkStandardNewMacro(vtkActionLineGrouping);
 
+struct vtkActionLineGrouping::Grouped
+{
+  std::vector<md::TriangleMesh> muscles;
+  std::vector<md::Points> paths;
+  std::vector<std::string> muscleNames, pathNames;
+  std::string assignments;
+  md::osim::PathGrouping grouping;
+  std::string decision;
+
+  bool DecidedOn(const std::vector<md::TriangleMesh>& otherMuscles, const std::vector<md::Points>& otherPaths,
+    const std::vector<std::string>& otherMuscleNames, const std::vector<std::string>& otherPathNames,
+    const std::string& otherAssignments) const
+  {
+    auto sameMesh = [](const md::TriangleMesh& a, const md::TriangleMesh& b) {
+      return a.points.rows() == b.points.rows() && a.triangles.rows() == b.triangles.rows() && a.points == b.points &&
+        a.triangles == b.triangles;
+    };
+    auto samePoints = [](const md::Points& a, const md::Points& b) {
+      return a.rows() == b.rows() && a == b;
+    };
+    return otherAssignments == this->assignments && otherMuscleNames == this->muscleNames &&
+      otherPathNames == this->pathNames &&
+      std::equal(otherMuscles.begin(), otherMuscles.end(), this->muscles.begin(), this->muscles.end(), sameMesh) &&
+      std::equal(otherPaths.begin(), otherPaths.end(), this->paths.begin(), this->paths.end(), samePoints);
+  }
+};
+
 vtkActionLineGrouping::vtkActionLineGrouping()
 {
   this->SetNumberOfInputPorts(3);
@@ -101,48 +128,59 @@ int vtkActionLineGrouping::RequestData(
     lines.push_back(polylines[0]);
     pathNames.push_back(paths[p].name.empty() ? "path " + std::to_string(p) : paths[p].name);
   }
-  md::osim::PathGrouping grouping;
-  int result = 1;
-  if (!mdvtk::CallCore(
-        this, "PathsOfMuscle: ",
-        [&] {
-          grouping = md::osim::GroupPaths(meshes, muscleNames, lines, pathNames,
-            md::osim::ParseAssignments(this->PathsOfMuscle ? this->PathsOfMuscle : ""));
-        },
-        result))
+  const std::string assignments = this->PathsOfMuscle ? this->PathsOfMuscle : "";
+  if (this->LastGrouping && this->LastGrouping->DecidedOn(meshes, lines, muscleNames, pathNames, assignments))
   {
-    return result;
+    this->Decision = this->LastGrouping->decision;
   }
-  std::ostringstream decision, unassigned;
-  for (size_t p = 0; p < paths.size(); ++p)
+  else
   {
-    if (grouping.muscleOfPath[p] < 0)
+    this->LastGrouping.reset();
+    md::osim::PathGrouping decided;
+    int result = 1;
+    if (!mdvtk::CallCore(
+          this, "PathsOfMuscle: ",
+          [&] {
+            decided =
+              md::osim::GroupPaths(meshes, muscleNames, lines, pathNames, md::osim::ParseAssignments(assignments));
+          },
+          result))
     {
-      unassigned << (unassigned.tellp() > 0 ? ", " : "") << pathNames[p];
-      continue;
+      return result;
     }
-    decision << pathNames[p] << " -> " << muscleNames[grouping.muscleOfPath[p]] << " ("
-             << (grouping.assignedByUser[p] ? "as given, " : "")
-             << static_cast<int>(100 * grouping.insideFraction[p] + 0.5) << " % of its length inside)\n";
-  }
-  for (size_t m = 0; m < muscles.size(); ++m)
-  {
-    if (std::find(grouping.muscleOfPath.begin(), grouping.muscleOfPath.end(), static_cast<int>(m)) ==
-      grouping.muscleOfPath.end())
+    std::ostringstream decision, unassigned;
+    for (size_t p = 0; p < paths.size(); ++p)
     {
-      vtkErrorMacro(<< muscles[m].label << ": no path runs inside this muscle; name its paths in PathsOfMuscle "
-                    << "(e.g. " << muscleNames[m] << "=" << pathNames.front() << ")");
-      return 0;
+      if (decided.muscleOfPath[p] < 0)
+      {
+        unassigned << (unassigned.tellp() > 0 ? ", " : "") << pathNames[p];
+        continue;
+      }
+      decision << pathNames[p] << " -> " << muscleNames[decided.muscleOfPath[p]] << " ("
+               << (decided.assignedByUser[p] ? "as given, " : "")
+               << static_cast<int>(100 * decided.insideFraction[p] + 0.5) << " % of its length inside)\n";
     }
+    for (size_t m = 0; m < muscles.size(); ++m)
+    {
+      if (std::find(decided.muscleOfPath.begin(), decided.muscleOfPath.end(), static_cast<int>(m)) ==
+        decided.muscleOfPath.end())
+      {
+        vtkErrorMacro(<< muscles[m].label << ": no path runs inside this muscle; name its paths in PathsOfMuscle "
+                      << "(e.g. " << muscleNames[m] << "=" << pathNames.front() << ")");
+        return 0;
+      }
+    }
+    this->Decision = decision.str();
+    vtkOutputWindow::GetInstance()->DisplayText(("ActionLineGrouping:\n" + this->Decision).c_str());
+    if (unassigned.tellp() > 0)
+    {
+      vtkWarningMacro(<< "paths that run inside no muscle (less than 5 % of their length) are left out: "
+                      << unassigned.str());
+    }
+    this->LastGrouping.reset(
+      new Grouped{ std::move(meshes), lines, muscleNames, pathNames, assignments, decided, this->Decision });
   }
-  this->Decision = decision.str();
-  vtkOutputWindow::GetInstance()->DisplayText(("ActionLineGrouping:\n" + this->Decision).c_str());
-  if (unassigned.tellp() > 0)
-  {
-    vtkWarningMacro(<< "paths that run inside no muscle (less than 5 % of their length) are left out: "
-                    << unassigned.str());
-  }
-
+  const md::osim::PathGrouping& grouping = this->LastGrouping->grouping;
   auto build = [&](const std::vector<mdvtk::Leaf>& source, bool isCurrent, vtkMultiBlockDataSet* output) {
     for (size_t m = 0; m < muscles.size(); ++m)
     {

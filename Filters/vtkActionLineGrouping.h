@@ -20,6 +20,7 @@
 
 #include <vtkMultiBlockDataSetAlgorithm.h>
 
+#include <memory>
 #include <string>
 
 class MUSCLEDEFORMATIONFILTERS_EXPORT vtkActionLineGrouping : public vtkMultiBlockDataSetAlgorithm
@@ -50,6 +51,11 @@ protected:
 
   char* PathsOfMuscle = nullptr;
   std::string Decision;
+
+  /// The last grouping and what it was decided on: a new time of PathsCurrent alone (every
+  /// frame of a motion) reuses it, and says nothing again.
+  struct Grouped;
+  std::unique_ptr<Grouped> LastGrouping;
 
 private:
   vtkActionLineGrouping(const vtkActionLineGrouping&) = delete;

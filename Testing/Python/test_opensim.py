@@ -209,6 +209,24 @@ class SmallModel(unittest.TestCase):
         # 0.4 of the path is inside; measured at the midpoints of 16 pieces.
         self.assertAlmostEqual(decided.GetFieldData().GetArray("PathInsideFraction").GetValue(0), 0.4, delta=1 / 16)
         self.assertEqual(decided.GetNumberOfPoints(), 2)
+        # Through a motion the grouping is decided once: another time moves the current paths but
+        # groups nothing again and says nothing again (it did at every frame, 4 of a frame's 10 ms
+        # on the LHDL hip); a new PathsOfMuscle decides again.
+        def current(t):
+            grouping.UpdatePipeline(t)
+            return points(block(grouping.GetClientSideObject().GetOutputDataObject(1), "deltoid_surface"))
+
+        start = current(0.0)
+        with mdtesting.CapturedMessages() as messages:
+            later = current(1.0)
+        self.assertNotIn("ActionLineGrouping", messages.text)
+        self.assertGreater(numpy.abs(later - start).max(), 0.1)
+        again = block(grouping.GetClientSideObject().GetOutputDataObject(0), "deltoid_surface")
+        self.assertEqual(again.GetFieldData().GetAbstractArray("ActionLinePaths").GetValue(0), "deltoid")
+        grouping.PathsOfMuscle = "deltoid_surface=deltoid"
+        with mdtesting.CapturedMessages() as messages:
+            current(0.5)
+        self.assertIn("deltoid -> deltoid_surface (as given", messages.text)
 
     def test_bad_input_is_named(self):
         for text, expected in (
