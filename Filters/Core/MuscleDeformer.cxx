@@ -960,7 +960,7 @@ std::vector<Eigen::Index> FlippedTriangles(
       continue; // degenerate: no orientation to compare
     }
     const Eigen::Matrix3d rotation =
-      BestRotation(covariance[triangles(t, 0)] + covariance[triangles(t, 1)] + covariance[triangles(t, 2)]);
+      BestRotationDirect(covariance[triangles(t, 0)] + covariance[triangles(t, 1)] + covariance[triangles(t, 2)]);
     flipped[t] = n1.dot(rotation * n0) < 0;
   }
   std::vector<Eigen::Index> list;

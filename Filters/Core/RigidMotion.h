@@ -36,6 +36,12 @@ struct RigidFit
 /// centred point pairs, i.e. the R minimising sum |to_i - R from_i|^2 (Kabsch).
 Eigen::Matrix3d BestRotation(const Eigen::Matrix3d& covariance);
 
+/// BestRotation by the eigenvectors of covariance^T covariance in closed form rather than an
+/// iterative SVD (about a tenth of its time; per triangle of a mesh, the SVD was most of
+/// counting its flipped triangles). The same rotation to rounding where the two largest
+/// singular values stand clear of zero; BestRotation itself where they do not.
+Eigen::Matrix3d BestRotationDirect(const Eigen::Matrix3d& covariance);
+
 /// Proper rotation and translation minimising sum |to_i - (R from_i + t)|^2
 /// (Kabsch / Horn). Both sets must have the same number of points (>= 1).
 RigidFit FitRigidTransform(const Points& from, const Points& to);

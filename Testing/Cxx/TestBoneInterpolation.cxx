@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "BoneInterpolation.h"
+#include "RigidMotion.h"
 
 #include <gtest/gtest.h>
 
@@ -52,6 +53,50 @@ TEST(RigidMotion, KabschRecoversAKnownTransform)
   EXPECT_TRUE(fit.transform.translation.isApprox(truth.translation, 1e-10));
   EXPECT_LT(fit.maxResidual, 1e-10);
   EXPECT_NEAR(fit.transform.rotation.determinant(), 1.0, 1e-12);
+}
+
+TEST(RigidMotion, TheDirectBestRotationIsTheSvdsToRounding)
+{
+  // Covariances as the flipped-triangle count builds them: general, flat (rank 2: a surface's
+  // edges), mirrored (det < 0), with two singular values nearly equal (a regular fan, where the
+  // closed form's eigenvectors lose digits), and with one clear of zero only (the SVD's own).
+  std::mt19937 generator(7);
+  std::uniform_real_distribution<double> entry(-1, 1);
+  auto rotation = [&] {
+    return Eigen::Quaterniond(Eigen::Vector4d::NullaryExpr([&](Eigen::Index) { return entry(generator); }).normalized())
+      .toRotationMatrix();
+  };
+  double worst = 0;
+  for (int k = 0; k < 2000; ++k)
+  {
+    Eigen::Vector3d singular(1 + entry(generator), 1 + entry(generator), 1 + entry(generator));
+    switch (k % 5)
+    {
+      case 1:
+        singular(2) = 0;
+        break;
+      case 2:
+        singular(2) = -singular(2);
+        break;
+      case 3:
+        singular(1) = singular(0) * (1 + 1e-9 * entry(generator));
+        break;
+      case 4:
+        singular(1) = singular(2) = 0;
+        break;
+      default:
+        break;
+    }
+    const Eigen::Matrix3d covariance = 30 * rotation() * singular.asDiagonal() * rotation();
+    const Eigen::Matrix3d direct = md::BestRotationDirect(covariance);
+    EXPECT_NEAR(direct.determinant(), 1.0, 1e-12) << "case " << k % 5 << " singular values " << singular.transpose();
+    EXPECT_TRUE((direct.transpose() * direct).isApprox(Eigen::Matrix3d::Identity(), 1e-12));
+    if (k % 5 != 4) // one singular value only: no rotation is the answer, the SVD picks one
+    {
+      worst = std::max(worst, (direct - md::BestRotation(covariance)).cwiseAbs().maxCoeff());
+    }
+  }
+  EXPECT_LT(worst, 1e-12);
 }
 
 TEST(RigidMotion, ScrewInterpolationKeepsTheJointCentreFixed)
