@@ -90,6 +90,25 @@ TriangleTree::TriangleTree(const TriangleMesh& mesh)
   {
     this->Order[t] = items[t].triangle;
   }
+  for (Node& node : this->Nodes)
+  {
+    if (node.left >= 0)
+    {
+      continue;
+    }
+    node.pointFirst = static_cast<int>(this->LeafPoints.size());
+    for (int i = node.first; i < node.first + node.count; ++i)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        this->LeafPoints.push_back(mesh.triangles(this->Order[i], k));
+      }
+    }
+    std::sort(this->LeafPoints.begin() + node.pointFirst, this->LeafPoints.end());
+    this->LeafPoints.erase(
+      std::unique(this->LeafPoints.begin() + node.pointFirst, this->LeafPoints.end()), this->LeafPoints.end());
+    node.pointCount = static_cast<int>(this->LeafPoints.size()) - node.pointFirst;
+  }
   this->UpdateBoxes();
 }
 
@@ -135,13 +154,11 @@ void TriangleTree::LeafBox(Node& node) const
 {
   node.low = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
   node.high = -node.low;
-  for (int i = node.first; i < node.first + node.count; ++i)
+  for (int i = node.pointFirst; i < node.pointFirst + node.pointCount; ++i)
   {
-    for (int k = 0; k < 3; ++k)
-    {
-      node.low = node.low.cwiseMin(this->Corner(this->Order[i], k));
-      node.high = node.high.cwiseMax(this->Corner(this->Order[i], k));
-    }
+    const Eigen::Vector3d p = this->Surface.points.row(this->LeafPoints[i]).transpose();
+    node.low = node.low.cwiseMin(p);
+    node.high = node.high.cwiseMax(p);
   }
 }
 

@@ -77,6 +77,7 @@ private:
     Eigen::Vector3d low, high;
     int first = 0, count = 0; // leaf: triangles Order[first .. first + count)
     int left = -1, right = -1;
+    int pointFirst = 0, pointCount = 0; // leaf: its triangles' points LeafPoints[pointFirst ..)
   };
   struct BuildItem
   {
@@ -104,6 +105,8 @@ private:
   TriangleMesh Surface;
   std::vector<Node> Nodes;
   std::vector<Eigen::Index> Order;
+  /// Each leaf's points, once each: a refit reads each point about twice rather than six times.
+  std::vector<Eigen::Index> LeafPoints;
   double Size = 0;
 };
 
