@@ -271,6 +271,14 @@ StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& 
     const Eigen::Index n = mesh.points.rows();
     const Deepest d = FindDeepest(mesh, m, set, fixed.size(), existing);
     result.found.push_back(PenetrationOf(d, fixed.size()));
+    if (result.found.back().count == 0)
+    {
+      // Nothing to move (after a converged settle, the rule): no groups, prints or smoothing.
+      result.points.push_back(mesh.points);
+      result.shift.push_back(Points::Zero(n, 3));
+      result.reports.emplace_back();
+      continue;
+    }
     const double backOff = 1e-5 * BoxDiagonal(mesh.points);
     Points shift = Points::Zero(n, 3);
     // Of each penetrating point: the obstacle's outward normal where it goes

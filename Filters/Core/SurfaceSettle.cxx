@@ -1308,21 +1308,41 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       next[m] = free[m] + multipliers(volumeStart + static_cast<Eigen::Index>(m)) * along[m];
     }
     std::vector<std::int64_t> inContact(count, 0);
-    for (Eigen::Index j = 0; j < volumeStart; ++j)
+    for (Eigen::Index j = 0; j < nc; ++j)
     {
-      if (!active[j])
+      if (active[j])
       {
-        continue;
-      }
-      const Contact& c = contacts[static_cast<size_t>(j)];
-      if (j < nc)
-      {
+        const Contact& c = contacts[static_cast<size_t>(j)];
         nowHeld[{ c.muscle, c.point, c.obstacle }].push_back(c.triangle);
         ++inContact[c.muscle];
       }
-      for (const Term& t : c.terms)
+    }
+    // Each muscle's points take every active row's push in the rows' order, the muscles in parallel.
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int k = 0; k < static_cast<int>(count); ++k)
+    {
+      const size_t m = static_cast<size_t>(k);
+      Points& x = next[m];
+      for (Eigen::Index j = 0; j < volumeStart; ++j)
       {
-        next[t.muscle] += (multipliers(j) * t.coefficient) * *t.column * c.normal.transpose();
+        if (!active[j])
+        {
+          continue;
+        }
+        const Contact& c = contacts[static_cast<size_t>(j)];
+        for (const Term& t : c.terms)
+        {
+          if (t.muscle != m)
+          {
+            continue;
+          }
+          const double push = multipliers(j) * t.coefficient;
+          const Eigen::VectorXd& column = *t.column;
+          for (Eigen::Index i = 0; i < x.rows(); ++i)
+          {
+            x.row(i) += (push * column(i)) * c.normal.transpose();
+          }
+        }
       }
     }
     for (size_t m = 0; m < count; ++m)

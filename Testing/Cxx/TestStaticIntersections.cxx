@@ -95,6 +95,21 @@ TEST_F(CapInBox, TheResolutionReportsThePenetrationItFoundAsTheMeasureDoes)
   EXPECT_LT(measured[0].fixedCount, measured[0].count); // in the box and in the other sphere
 }
 
+TEST_F(CapInBox, AMeshThatPenetratesNothingIsGivenBackAsItCame)
+{
+  // The sphere moved clear of the box: every point, shift and report as it was, bit for bit.
+  md::TriangleMesh clear = sphere;
+  clear.points.col(0).array() -= 5;
+  const auto r = md::ResolveStaticIntersections({ clear }, { Fixed(box) }, nullptr, md::StaticResolveParameters{});
+  EXPECT_TRUE(r.points[0] == clear.points);
+  EXPECT_EQ(r.shift[0].rows(), clear.points.rows());
+  EXPECT_EQ(r.shift[0].cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(r.reports[0].penetratingPoints, 0);
+  EXPECT_EQ(r.reports[0].groups, 0);
+  EXPECT_EQ(r.reports[0].maxShift, 0.0);
+  EXPECT_EQ(r.found[0].count, 0);
+}
+
 TEST_F(CapInBox, RestoreVolumesLeavesAMeshThatHoldsItsVolumeUntouched)
 {
   // The settle holds the volume to 1e-9: nothing is given back, not a bit moves, and the share
