@@ -188,10 +188,11 @@ std::vector<MuscleStepMeasures> ResolveAndMeasure(std::vector<TriangleMesh>& nex
   const std::vector<MuscleMotion>& muscles, const std::vector<FixedObstacle>& fixed, const OverlapMasks& restOverlap,
   const std::vector<double>& restVolumes, const InterpolationParameters& parameters,
   const std::vector<StepOutcome>& outcomes, const std::vector<MuscleStepMeasures>& previous,
-  std::vector<MuscleStepMeasures> measures)
+  std::vector<MuscleStepMeasures> measures, const std::vector<std::vector<char>>* outsideBones)
 {
   const size_t count = next.size();
-  StaticResolveResult resolved = ResolveStaticIntersections(next, fixed, &restOverlap, parameters.staticResolve);
+  StaticResolveResult resolved =
+    ResolveStaticIntersections(next, fixed, &restOverlap, parameters.staticResolve, outsideBones);
   // The volume is given back over the whole surface, except at the overlap
   // the rest pose has (which stays where it is); a point against an obstacle
   // cannot move outwards through it anyway.

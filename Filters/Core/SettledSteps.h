@@ -71,12 +71,14 @@ struct StepOutcome
 /// muscles' triangles): the static resolution (the rest pose's overlap `restOverlap` left
 /// alone), the volumes given back (`restVolumes`, with PreserveVolume) and the measures against
 /// the rest pose (`muscles`) and the last step's (`previous`). `measures` brings what the step
-/// measured already (its hull seconds) and is returned complete.
+/// measured already (its hull seconds) and is returned complete. `outsideBones`: the settle's
+/// proof of which points are outside which bone (SettleMotion::outsideBones), when `next` is
+/// where a settle left the muscles.
 std::vector<MuscleStepMeasures> ResolveAndMeasure(std::vector<TriangleMesh>& next,
   const std::vector<MuscleMotion>& muscles, const std::vector<FixedObstacle>& fixed, const OverlapMasks& restOverlap,
   const std::vector<double>& restVolumes, const InterpolationParameters& parameters,
   const std::vector<StepOutcome>& outcomes, const std::vector<MuscleStepMeasures>& previous,
-  std::vector<MuscleStepMeasures> measures);
+  std::vector<MuscleStepMeasures> measures, const std::vector<std::vector<char>>* outsideBones = nullptr);
 
 /// A step's measures computed in `frame`, their lengths in world units.
 void MeasuresToWorld(const LocalFrame& frame, MuscleStepMeasures& measures);

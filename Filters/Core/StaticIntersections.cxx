@@ -53,8 +53,8 @@ struct Deepest
   Points nearest;
 };
 
-Deepest FindDeepest(
-  const TriangleMesh& mesh, size_t m, const ObstacleSet& set, size_t fixedCount, const OverlapMasks* existing)
+Deepest FindDeepest(const TriangleMesh& mesh, size_t m, const ObstacleSet& set, size_t fixedCount,
+  const OverlapMasks* existing, const std::vector<char>* outsideFixed = nullptr)
 {
   const Eigen::Index n = mesh.points.rows();
   const std::vector<char> used = UsedMask(mesh);
@@ -71,7 +71,9 @@ Deepest FindDeepest(
     for (size_t o = 0; o < set.all.size(); ++o)
     {
       const TriangleTree* tree = set.For(m, o, fixedCount);
-      if (!tree || InOverlap(existing, m, o, i) || !tree->InBounds(p) || !tree->Inside(p))
+      const bool knownOutside =
+        outsideFixed && o < fixedCount && (*outsideFixed)[static_cast<size_t>(i) * fixedCount + o];
+      if (!tree || knownOutside || InOverlap(existing, m, o, i) || !tree->InBounds(p) || !tree->Inside(p))
       {
         continue;
       }
@@ -261,7 +263,8 @@ std::vector<Penetration> MeasureNewPenetration(
 }
 
 StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& meshes,
-  const std::vector<FixedObstacle>& fixed, const OverlapMasks* existing, const StaticResolveParameters& parameters)
+  const std::vector<FixedObstacle>& fixed, const OverlapMasks* existing, const StaticResolveParameters& parameters,
+  const std::vector<std::vector<char>>* outsideFixed)
 {
   const ObstacleSet set(meshes, fixed);
   StaticResolveResult result;
@@ -269,7 +272,11 @@ StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& 
   {
     const TriangleMesh& mesh = meshes[m];
     const Eigen::Index n = mesh.points.rows();
-    const Deepest d = FindDeepest(mesh, m, set, fixed.size(), existing);
+    const std::vector<char>* outside = outsideFixed && outsideFixed->size() == meshes.size() &&
+        (*outsideFixed)[m].size() == static_cast<size_t>(n) * fixed.size()
+      ? &(*outsideFixed)[m]
+      : nullptr;
+    const Deepest d = FindDeepest(mesh, m, set, fixed.size(), existing, outside);
     result.found.push_back(PenetrationOf(d, fixed.size()));
     if (result.found.back().count == 0)
     {

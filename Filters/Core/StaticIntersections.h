@@ -91,9 +91,13 @@ struct StaticResolveResult
 /// smoothed over the group and its rim (see StaticResolveParameters), each
 /// penetrating point still going at least its way out. No move enters a
 /// fixed obstacle. All meshes are resolved against the obstacles as they are
-/// on entry (the result does not depend on the meshes' order).
+/// on entry (the result does not depend on the meshes' order). `outsideFixed`
+/// (optional; per mesh, point * fixed.size() + obstacle): points known to be
+/// outside a fixed obstacle, which are not tested against it (a settle's proof,
+/// SettleMotion::outsideBones).
 StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& meshes,
-  const std::vector<FixedObstacle>& fixed, const OverlapMasks* existing, const StaticResolveParameters& parameters);
+  const std::vector<FixedObstacle>& fixed, const OverlapMasks* existing, const StaticResolveParameters& parameters,
+  const std::vector<std::vector<char>>* outsideFixed = nullptr);
 
 /// Gives the meshes back their target volumes after a static resolution
 /// (which dents them where it pushes): the surface moves out along its unit

@@ -1382,6 +1382,28 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       progress(static_cast<double>(iteration + 1) / std::max(1, parameters.maximumIterations));
     }
   }
+  // Which points the last contact search proves outside each bone at the points it ends at: its
+  // clearance there less the last move (what the next search would skip).
+  std::vector<std::vector<char>> outsideBones(diverging ? 0 : count);
+  for (size_t m = 0; m < outsideBones.size(); ++m)
+  {
+    const Eigen::Index n = meshes[m].points.rows();
+    const double margin = 1e-9 * energies[m]->Size();
+    outsideBones[m].assign(static_cast<size_t>(n) * bones.size(), 0);
+    for (Eigen::Index i = 0; i < n; ++i)
+    {
+      if (!energies[m]->Used()[i])
+      {
+        continue; // not searched: its own duplicates' positions
+      }
+      const double lastMove = (meshes[m].points.row(i) - previous[m].row(i)).norm();
+      for (size_t o = 0; o < bones.size(); ++o)
+      {
+        outsideBones[m][static_cast<size_t>(i) * bones.size() + o] =
+          clearance[m][static_cast<size_t>(i) * obstacles + o] - lastMove - margin > 0;
+      }
+    }
+  }
   // A settle that diverged leaves the muscles where they started rather than at an iterate that
   // means nothing; one that ran out of iterations keeps its last.
   for (size_t m = 0; m < count && !diverging; ++m)
@@ -1397,6 +1419,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       motion->points.push_back(muscles[m].points);
     }
     motion->free = std::move(free);
+    motion->outsideBones = std::move(outsideBones);
     motion->held.clear();
     if (motion->carryContacts && !diverging) // a diverged settle's contacts hold nothing
     {

@@ -277,6 +277,12 @@ struct SettleMotion
   /// The contacts that held the muscles where the last settle ended (with carryContacts), each
   /// as (muscle, point, obstacle, triangle), the obstacles the bones first and then the muscles.
   std::vector<std::array<Eigen::Index, 4>> held;
+  /// Per muscle, for each point and bone (point * bones + bone): 1 where the last settle's
+  /// contact search proves the point outside the bone, and farther than the contact offset, at
+  /// the points it ended at (its clearance less the last move). The static resolution after it
+  /// need not test those (ResolveStaticIntersections' `outsideFixed`). Empty after a settle that
+  /// diverged.
+  std::vector<std::vector<char>> outsideBones;
 };
 
 /// The start of a motion: `muscles` in the rest pose (their action lines `restLines`, the

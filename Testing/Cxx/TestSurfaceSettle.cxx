@@ -11,6 +11,7 @@
 #include "MotionCases.h"
 #include "NearestSegment.h"
 #include "RealData.h"
+#include "StaticIntersections.h"
 #include "SurfaceSettle.h"
 #include "TestMeshes.h"
 #include "TriangleTree.h"
@@ -430,6 +431,63 @@ TEST(SurfaceSettle, AMotionsContactsAreCarriedToItsNextStep)
   md::SettleMotion plain = md::StartMotion({ s.muscle }, { &energy }, { { s.line } }, bones);
   settle(plain, 25, first);
   EXPECT_TRUE(plain.held.empty());
+}
+
+TEST(SurfaceSettle, ASettleProvesWhichPointsAreOutsideEachBoneAndTheStaticResolutionSkipsThem)
+{
+  // The spindle pressed against the box bone (its line bent 25 degrees): the settle leaves, in
+  // SettleMotion::outsideBones, the points its last contact search proves outside the box and
+  // farther than the contact offset. Every one of them is outside, most points are (the far
+  // side), those in contact are not, and the static resolution given the proof finds and does
+  // exactly what it does testing every point.
+  const SpindleBesideABox setup;
+  const auto& [s, energy, bone, bones] = setup;
+  std::vector<md::TriangleMesh> meshes{ s.muscle };
+  md::SettleMotion motion = md::StartMotion({ s.muscle }, { &energy }, { { s.line } }, bones);
+  const md::SettleReport report = md::SettleMuscles(meshes, { &energy }, { { { s.line, Bent(s.line, 25) } } },
+    { md::EnclosedVolume(s.muscle.points, s.muscle.triangles) }, bones, nullptr, md::SettleParameters(), &motion)[0];
+  ASSERT_TRUE(report.converged);
+  ASSERT_GT(report.pointsInContact, 0);
+  ASSERT_EQ(motion.outsideBones.size(), 1u);
+  const std::vector<char>& outside = motion.outsideBones[0];
+  ASSERT_EQ(outside.size(), static_cast<size_t>(meshes[0].points.rows()));
+  const double offset = md::SettleParameters().contactOffset * energy.Size();
+  std::int64_t proven = 0, against = 0;
+  for (Eigen::Index i = 0; i < meshes[0].points.rows(); ++i)
+  {
+    const Eigen::Vector3d p = meshes[0].points.row(i).transpose();
+    const double distance = bone.ClosestPoint(p).distance;
+    against += distance < 1.01 * offset;
+    if (outside[i])
+    {
+      ++proven;
+      EXPECT_FALSE(bone.Inside(p)) << "point " << i;
+      EXPECT_GT(distance, offset) << "point " << i;
+    }
+  }
+  EXPECT_GT(against, 0);
+  EXPECT_GT(proven, meshes[0].points.rows() / 2);
+  EXPECT_LE(proven, meshes[0].points.rows() - against);
+  // The static resolution with the proof and without: the same, bit for bit.
+  md::TriangleMesh pressed = meshes[0];
+  pressed.points.col(1).array() += 0.5; // half a unit into the box where it touched
+  std::vector<std::vector<char>> proof{ outside };
+  for (Eigen::Index i = 0; i < pressed.points.rows(); ++i)
+  {
+    proof[0][i] = proof[0][i] && bone.ClosestPoint(meshes[0].points.row(i).transpose()).distance > 1.0;
+  }
+  const auto tested = md::ResolveStaticIntersections({ pressed }, bones, nullptr, md::StaticResolveParameters{});
+  const auto skipped =
+    md::ResolveStaticIntersections({ pressed }, bones, nullptr, md::StaticResolveParameters{}, &proof);
+  ASSERT_GT(tested.reports[0].penetratingPoints, 0);
+  EXPECT_EQ(skipped.reports[0].penetratingPoints, tested.reports[0].penetratingPoints);
+  EXPECT_TRUE(skipped.points[0] == tested.points[0]);
+  EXPECT_EQ(skipped.found[0].count, tested.found[0].count);
+  // A proof for another mesh's size is not used.
+  std::vector<std::vector<char>> wrong{ std::vector<char>(3, 1) };
+  EXPECT_TRUE(
+    md::ResolveStaticIntersections({ pressed }, bones, nullptr, md::StaticResolveParameters{}, &wrong).points[0] ==
+    tested.points[0]);
 }
 
 TEST(SurfaceSettle, ALineThroughABonePullsTheMuscleBesideItNotIntoIt)
