@@ -333,23 +333,35 @@ TriangleTree::Closest TriangleTree::ClosestPoint(const Eigen::Vector3d& p, doubl
 {
   Closest best;
   double bestSquared = within < std::numeric_limits<double>::max() ? within * within : within;
-  NodeStack stack;
-  stack.Push(0);
-  while (!stack.Empty())
+  // Each node with its box's distance, found when its parent ordered its children (not again).
+  std::array<std::pair<int, double>, maximumDepth + 2> stack;
+  int size = 0;
+  stack[size++] = { 0, BoxDistanceSquared(p, this->Nodes[0].low, this->Nodes[0].high) };
+  while (size > 0)
   {
-    const Node& node = this->Nodes[stack.Pop()];
-    if (BoxDistanceSquared(p, node.low, node.high) >= bestSquared)
+    const auto [index, boxSquared] = stack[--size];
+    if (boxSquared >= bestSquared)
     {
       continue;
     }
+    const Node& node = this->Nodes[index];
     if (node.left >= 0)
     {
       // Nearer child last, so it is visited first.
       const Node& left = this->Nodes[node.left];
       const Node& right = this->Nodes[node.right];
-      const bool leftNearer = BoxDistanceSquared(p, left.low, left.high) < BoxDistanceSquared(p, right.low, right.high);
-      stack.Push(leftNearer ? node.right : node.left);
-      stack.Push(leftNearer ? node.left : node.right);
+      const double toLeft = BoxDistanceSquared(p, left.low, left.high);
+      const double toRight = BoxDistanceSquared(p, right.low, right.high);
+      if (toLeft < toRight)
+      {
+        stack[size++] = { node.right, toRight };
+        stack[size++] = { node.left, toLeft };
+      }
+      else
+      {
+        stack[size++] = { node.left, toLeft };
+        stack[size++] = { node.right, toRight };
+      }
       continue;
     }
     for (int i = node.first; i < node.first + node.count; ++i)
