@@ -59,7 +59,9 @@ TEST(RigidMotion, TheDirectBestRotationIsTheSvdsToRounding)
 {
   // Covariances as the flipped-triangle count builds them: general, flat (rank 2: a surface's
   // edges), mirrored (det < 0), with two singular values nearly equal (a regular fan, where the
-  // closed form's eigenvectors lose digits), and with one clear of zero only (the SVD's own).
+  // closed form's eigenvectors lose digits), with one clear of zero only, and mirrored with the two
+  // smaller alike (no one rotation is the answer in these two: any of the best will do, as the
+  // SVD's pick does).
   std::mt19937 generator(7);
   std::uniform_real_distribution<double> entry(-1, 1);
   auto rotation = [&] {
@@ -70,7 +72,7 @@ TEST(RigidMotion, TheDirectBestRotationIsTheSvdsToRounding)
   for (int k = 0; k < 2000; ++k)
   {
     Eigen::Vector3d singular(1 + entry(generator), 1 + entry(generator), 1 + entry(generator));
-    switch (k % 5)
+    switch (k % 6)
     {
       case 1:
         singular(2) = 0;
@@ -84,16 +86,24 @@ TEST(RigidMotion, TheDirectBestRotationIsTheSvdsToRounding)
       case 4:
         singular(1) = singular(2) = 0;
         break;
+      case 5:
+        singular(2) = -singular(1);
+        break;
       default:
         break;
     }
     const Eigen::Matrix3d covariance = 30 * rotation() * singular.asDiagonal() * rotation();
     const Eigen::Matrix3d direct = md::BestRotationDirect(covariance);
-    EXPECT_NEAR(direct.determinant(), 1.0, 1e-12) << "case " << k % 5 << " singular values " << singular.transpose();
+    const Eigen::Matrix3d svd = md::BestRotation(covariance);
+    EXPECT_NEAR(direct.determinant(), 1.0, 1e-12) << "case " << k % 6 << " singular values " << singular.transpose();
     EXPECT_TRUE((direct.transpose() * direct).isApprox(Eigen::Matrix3d::Identity(), 1e-12));
-    if (k % 5 != 4) // one singular value only: no rotation is the answer, the SVD picks one
+    // As good a fit as the SVD's: the largest trace(R^T C) a rotation reaches.
+    EXPECT_NEAR(
+      (direct.transpose() * covariance).trace(), (svd.transpose() * covariance).trace(), 1e-12 * covariance.norm())
+      << "case " << k % 6;
+    if (k % 6 < 4)
     {
-      worst = std::max(worst, (direct - md::BestRotation(covariance)).cwiseAbs().maxCoeff());
+      worst = std::max(worst, (direct - svd).cwiseAbs().maxCoeff());
     }
   }
   EXPECT_LT(worst, 1e-12);
