@@ -972,6 +972,38 @@ std::vector<Contact> FindContacts(const std::vector<TriangleMesh>& meshes,
   }
   return contacts;
 }
+
+/// Per muscle, for each point and bone (point * bones + bone), whether the last contact search
+/// (its `clearance`, FindContacts' layout, found at the points `previous`) proves the point
+/// outside the bone and farther than the offset at the points `meshes` now hold: its clearance
+/// less its move since (what the next search would skip). Bones do not move within a settle.
+std::vector<std::vector<char>> ProvenOutsideBones(const std::vector<TriangleMesh>& meshes,
+  const std::vector<Points>& previous, const std::vector<const SurfaceEnergy*>& energies, size_t bones,
+  const std::vector<std::vector<double>>& clearance)
+{
+  const size_t count = meshes.size(), obstacles = bones + count;
+  std::vector<std::vector<char>> outside(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    const Eigen::Index n = meshes[m].points.rows();
+    const double margin = 1e-9 * energies[m]->Size(); // FindContacts'
+    outside[m].assign(static_cast<size_t>(n) * bones, 0);
+    for (Eigen::Index i = 0; i < n; ++i)
+    {
+      if (!energies[m]->Used()[i])
+      {
+        continue; // a duplicate the welded surface does not use: never searched
+      }
+      const double moved = (meshes[m].points.row(i) - previous[m].row(i)).norm();
+      for (size_t o = 0; o < bones; ++o)
+      {
+        outside[m][static_cast<size_t>(i) * bones + o] =
+          clearance[m][static_cast<size_t>(i) * obstacles + o] - moved - margin > 0;
+      }
+    }
+  }
+  return outside;
+}
 }
 
 bool KeptSurfaceEnergy::Holds(
@@ -1382,28 +1414,10 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       progress(static_cast<double>(iteration + 1) / std::max(1, parameters.maximumIterations));
     }
   }
-  // Which points the last contact search proves outside each bone at the points it ends at: its
-  // clearance there less the last move (what the next search would skip).
-  std::vector<std::vector<char>> outsideBones(diverging ? 0 : count);
-  for (size_t m = 0; m < outsideBones.size(); ++m)
-  {
-    const Eigen::Index n = meshes[m].points.rows();
-    const double margin = 1e-9 * energies[m]->Size();
-    outsideBones[m].assign(static_cast<size_t>(n) * bones.size(), 0);
-    for (Eigen::Index i = 0; i < n; ++i)
-    {
-      if (!energies[m]->Used()[i])
-      {
-        continue; // not searched: its own duplicates' positions
-      }
-      const double lastMove = (meshes[m].points.row(i) - previous[m].row(i)).norm();
-      for (size_t o = 0; o < bones.size(); ++o)
-      {
-        outsideBones[m][static_cast<size_t>(i) * bones.size() + o] =
-          clearance[m][static_cast<size_t>(i) * obstacles + o] - lastMove - margin > 0;
-      }
-    }
-  }
+  // Which points the static resolution after this settle need not test against the bones.
+  std::vector<std::vector<char>> outsideBones = diverging
+    ? std::vector<std::vector<char>>()
+    : ProvenOutsideBones(meshes, previous, energies, bones.size(), clearance);
   // A settle that diverged leaves the muscles where they started rather than at an iterate that
   // means nothing; one that ran out of iterations keeps its last.
   for (size_t m = 0; m < count && !diverging; ++m)
