@@ -6,13 +6,16 @@
 // frame-to-frame smoothness (the largest second difference of a muscle point over three frames,
 // and its ratio to the bones' own). At the frame nearest 60 degrees of flexion (hip_flexion frame
 // 35), the distance to InterpolatedMuscleDeformation's answer for that pose from the rest pose.
-// Prints figures; asserts nothing (see the tests).
+// Prints figures; asserts nothing (see the tests). Last, a checksum of every frame's points and
+// measures: a change meant to leave the answer alone (a speed-up, a restructuring) must leave it
+// the same on the same machine and build.
 //
 //   BenchmarkMotion [data folder] [hip_flexion|hip_adduction|phantom] [seed: -1 none, 0 float, s > 0 noise]
 #include "MotionFrames.h"
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -20,6 +23,26 @@
 
 namespace
 {
+/// FNV-1a over bytes, so that two runs can be compared to the bit.
+class Checksum
+{
+public:
+  void Add(const void* data, size_t bytes)
+  {
+    const auto* byte = static_cast<const unsigned char*>(data);
+    for (size_t k = 0; k < bytes; ++k)
+    {
+      this->Value = (this->Value ^ byte[k]) * 1099511628211ULL;
+    }
+  }
+  template<typename T>
+  void Add(const T& value)
+  {
+    this->Add(&value, sizeof(T));
+  }
+  unsigned long long Value = 14695981039346656037ULL;
+};
+
 double LargestDistance(const md::Points& a, const md::Points& b)
 {
   return a.rows() == b.rows() && a.rows() > 0 ? (a - b).rowwise().norm().maxCoeff() : -1.0;
@@ -51,6 +74,7 @@ int main(int argc, char** argv)
   std::printf("%5s %7s %5s %6s %8s %9s %7s %6s %6s %9s %7s %s\n", "frame", "flexion", "steps", "iter", "ms", "max|dV|%",
     "bonePen", "flips", "sharp", "2nd diff", "ratio", "muscle");
   std::vector<std::vector<md::Points>> points;
+  Checksum checksum; // of every frame's points and measures
   double framesSeconds = 0, worstRatio = 0, worstDepth = 0, worstVolume = 0;
   std::vector<double> frameSeconds; // after the first: their median (single frames here vary by 20 %)
   for (size_t k = 0; k < frames.poses.size(); ++k)
@@ -62,6 +86,23 @@ int main(int argc, char** argv)
       frameSeconds.push_back(r.seconds);
     }
     points.push_back(r.points);
+    for (const md::Points& p : r.points)
+    {
+      checksum.Add(p.data(), sizeof(double) * static_cast<size_t>(p.size()));
+    }
+    for (const md::MuscleStepMeasures& s : r.measures)
+    {
+      for (const double value : { s.volumeChangePercent, s.maxNewPenetrationDepth, s.maxNewBonePenetrationDepth,
+             s.stepStaticShift, s.maxStaticShift })
+      {
+        checksum.Add(value);
+      }
+      for (const std::int64_t count : { s.newPenetrationCount, s.newBonePenetrationCount, s.staticallyMovedPoints,
+             s.sharpEdgeCount, s.flippedTriangleCount, static_cast<std::int64_t>(s.stepIterations) })
+      {
+        checksum.Add(count);
+      }
+    }
     int iterations = 0;
     double volume = 0, depth = 0;
     std::int64_t flips = 0, sharp = 0;
@@ -155,5 +196,6 @@ int main(int argc, char** argv)
     }
     std::printf("\n");
   }
+  std::printf("checksum of every frame's points and measures: %016llx\n", checksum.Value);
   return 0;
 }
