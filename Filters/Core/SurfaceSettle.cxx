@@ -583,6 +583,9 @@ constexpr double kBlownUp = 2;
 /// point that is outside an obstacle, so that it need not test that point again until it, or the
 /// obstacle, has moved that far (FindContacts' `clearance`).
 constexpr double kClearanceReach = 0.03;
+/// The rounding of a distance to an obstacle, a fraction of the muscle's size: a clearance less
+/// this is still one (FindContacts, ProvenOutsideBones).
+constexpr double kClearanceRounding = 1e-9;
 
 /// A step whose every point moves less than this fraction of its muscle's size, in the direction
 /// of the last step, is a creep (SteadyStep).
@@ -898,7 +901,7 @@ std::vector<Contact> FindContacts(const std::vector<TriangleMesh>& meshes,
     const Points& x = meshes[m].points;
     const double offset = parameters.contactOffset * energies[m]->Size();
     const double reach = kClearanceReach * energies[m]->Size();
-    const double margin = 1e-9 * energies[m]->Size(); // rounding of the distances
+    const double margin = kClearanceRounding * energies[m]->Size();
     std::vector<double>& clear = clearance[m];
     std::vector<std::vector<Contact>> found(static_cast<size_t>(x.rows()));
     std::vector<char> inNow(static_cast<size_t>(x.rows()) * obstacles, 0);
@@ -986,7 +989,7 @@ std::vector<std::vector<char>> ProvenOutsideBones(const std::vector<TriangleMesh
   for (size_t m = 0; m < count; ++m)
   {
     const Eigen::Index n = meshes[m].points.rows();
-    const double margin = 1e-9 * energies[m]->Size(); // FindContacts'
+    const double margin = kClearanceRounding * energies[m]->Size();
     outside[m].assign(static_cast<size_t>(n) * bones, 0);
     for (Eigen::Index i = 0; i < n; ++i)
     {
@@ -1340,40 +1343,39 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       next[m] = free[m] + multipliers(volumeStart + static_cast<Eigen::Index>(m)) * along[m];
     }
     std::vector<std::int64_t> inContact(count, 0);
-    for (Eigen::Index j = 0; j < nc; ++j)
+    struct Push
     {
-      if (active[j])
+      double size;
+      const Eigen::VectorXd* column;
+      Eigen::Vector3d normal;
+    };
+    std::vector<std::vector<Push>> pushes(count); // each muscle's, in the rows' order
+    for (Eigen::Index j = 0; j < volumeStart; ++j)
+    {
+      if (!active[j])
       {
-        const Contact& c = contacts[static_cast<size_t>(j)];
+        continue;
+      }
+      const Contact& c = contacts[static_cast<size_t>(j)];
+      if (j < nc)
+      {
         nowHeld[{ c.muscle, c.point, c.obstacle }].push_back(c.triangle);
         ++inContact[c.muscle];
       }
+      for (const Term& t : c.terms)
+      {
+        pushes[t.muscle].push_back({ multipliers(j) * t.coefficient, t.column, c.normal });
+      }
     }
-    // Each muscle's points take every active row's push in the rows' order, the muscles in parallel.
 #pragma omp parallel for schedule(dynamic, 1)
     for (int k = 0; k < static_cast<int>(count); ++k)
     {
-      const size_t m = static_cast<size_t>(k);
-      Points& x = next[m];
-      for (Eigen::Index j = 0; j < volumeStart; ++j)
+      Points& x = next[static_cast<size_t>(k)];
+      for (const Push& push : pushes[static_cast<size_t>(k)])
       {
-        if (!active[j])
+        for (Eigen::Index i = 0; i < x.rows(); ++i)
         {
-          continue;
-        }
-        const Contact& c = contacts[static_cast<size_t>(j)];
-        for (const Term& t : c.terms)
-        {
-          if (t.muscle != m)
-          {
-            continue;
-          }
-          const double push = multipliers(j) * t.coefficient;
-          const Eigen::VectorXd& column = *t.column;
-          for (Eigen::Index i = 0; i < x.rows(); ++i)
-          {
-            x.row(i) += (push * column(i)) * c.normal.transpose();
-          }
+          x.row(i) += (push.size * (*push.column)(i)) * push.normal.transpose();
         }
       }
     }

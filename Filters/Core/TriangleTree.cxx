@@ -18,15 +18,17 @@ constexpr int maximumDepth = 60; // splits stop there, so a traversal stack neve
 
 /// The nodes still to visit in a depth-first traversal, on the call stack:
 /// queries run in hot parallel loops, where a heap allocation each would cost.
+/// An entry is a node's index, or the index with what the query knows of it.
+template<typename Entry = int>
 class NodeStack
 {
 public:
-  void Push(int node) { this->Nodes[this->Size++] = node; }
-  int Pop() { return this->Nodes[--this->Size]; }
+  void Push(const Entry& node) { this->Nodes[this->Size++] = node; }
+  Entry Pop() { return this->Nodes[--this->Size]; }
   bool Empty() const { return this->Size == 0; }
 
 private:
-  std::array<int, maximumDepth + 2> Nodes;
+  std::array<Entry, maximumDepth + 2> Nodes;
   int Size = 0;
 };
 
@@ -196,7 +198,7 @@ void TriangleTree::ForTrianglesNearSegment(
 {
   // `limit` is read at every box: a caller may shorten the segment as it goes.
   const Eigen::Vector3d inverse = direction.cwiseInverse();
-  NodeStack stack;
+  NodeStack<> stack;
   stack.Push(0);
   while (!stack.Empty())
   {
@@ -334,12 +336,11 @@ TriangleTree::Closest TriangleTree::ClosestPoint(const Eigen::Vector3d& p, doubl
   Closest best;
   double bestSquared = within < std::numeric_limits<double>::max() ? within * within : within;
   // Each node with its box's distance, found when its parent ordered its children (not again).
-  std::array<std::pair<int, double>, maximumDepth + 2> stack;
-  int size = 0;
-  stack[size++] = { 0, BoxDistanceSquared(p, this->Nodes[0].low, this->Nodes[0].high) };
-  while (size > 0)
+  NodeStack<std::pair<int, double>> stack;
+  stack.Push({ 0, BoxDistanceSquared(p, this->Nodes[0].low, this->Nodes[0].high) });
+  while (!stack.Empty())
   {
-    const auto [index, boxSquared] = stack[--size];
+    const auto [index, boxSquared] = stack.Pop();
     if (boxSquared >= bestSquared)
     {
       continue;
@@ -354,13 +355,13 @@ TriangleTree::Closest TriangleTree::ClosestPoint(const Eigen::Vector3d& p, doubl
       const double toRight = BoxDistanceSquared(p, right.low, right.high);
       if (toLeft < toRight)
       {
-        stack[size++] = { node.right, toRight };
-        stack[size++] = { node.left, toLeft };
+        stack.Push({ node.right, toRight });
+        stack.Push({ node.left, toLeft });
       }
       else
       {
-        stack[size++] = { node.left, toLeft };
-        stack[size++] = { node.right, toRight };
+        stack.Push({ node.left, toLeft });
+        stack.Push({ node.right, toRight });
       }
       continue;
     }
