@@ -306,6 +306,11 @@ size_t MotionDeformation::StateBytes(const State& state)
     add(p);
   }
   bytes += state.settle.held.size() * sizeof(state.settle.held[0]);
+  for (const std::vector<double>& clearance : state.settle.boneClearance)
+  {
+    bytes += clearance.size() * sizeof(double);
+  }
+  bytes += state.settle.bonePlacements.size() * sizeof(RigidFit); // boneReference is shared by every state
   for (const MuscleStepMeasures& s : state.previous)
   {
     add(s.staticShift);

@@ -976,21 +976,22 @@ std::vector<Contact> FindContacts(const std::vector<TriangleMesh>& meshes,
   return contacts;
 }
 
-/// Per muscle, for each point and bone (point * bones + bone), whether the last contact search
-/// (its `clearance`, FindContacts' layout, found at the points `previous`) proves the point
-/// outside the bone and farther than the offset at the points `meshes` now hold: its clearance
-/// less its move since (what the next search would skip). Bones do not move within a settle.
-std::vector<std::vector<char>> ProvenOutsideBones(const std::vector<TriangleMesh>& meshes,
+/// Per muscle, for each point and bone (point * bones + bone), how much farther than the offset
+/// the last contact search (its `clearance`, FindContacts' layout, found at the points
+/// `previous`) proves the point from the bone at the points `meshes` now hold: its clearance less
+/// its move since and the rounding (positive: what the next search would skip). Bones do not
+/// move within a settle.
+std::vector<std::vector<double>> BoneClearancesAtEnd(const std::vector<TriangleMesh>& meshes,
   const std::vector<Points>& previous, const std::vector<const SurfaceEnergy*>& energies, size_t bones,
   const std::vector<std::vector<double>>& clearance)
 {
   const size_t count = meshes.size(), obstacles = bones + count;
-  std::vector<std::vector<char>> outside(count);
+  std::vector<std::vector<double>> left(count);
   for (size_t m = 0; m < count; ++m)
   {
     const Eigen::Index n = meshes[m].points.rows();
     const double margin = kClearanceRounding * energies[m]->Size();
-    outside[m].assign(static_cast<size_t>(n) * bones, 0);
+    left[m].assign(static_cast<size_t>(n) * bones, 0.0);
     for (Eigen::Index i = 0; i < n; ++i)
     {
       if (!energies[m]->Used()[i])
@@ -1000,12 +1001,12 @@ std::vector<std::vector<char>> ProvenOutsideBones(const std::vector<TriangleMesh
       const double moved = (meshes[m].points.row(i) - previous[m].row(i)).norm();
       for (size_t o = 0; o < bones; ++o)
       {
-        outside[m][static_cast<size_t>(i) * bones + o] =
-          clearance[m][static_cast<size_t>(i) * obstacles + o] - moved - margin > 0;
+        left[m][static_cast<size_t>(i) * bones + o] =
+          std::max(0.0, clearance[m][static_cast<size_t>(i) * obstacles + o] - moved - margin);
       }
     }
   }
-  return outside;
+  return left;
 }
 }
 
@@ -1098,7 +1099,80 @@ SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::ve
     motion.restDepths.push_back(energies[m]->SampleDepthsInBones(still.back(), restBones));
   }
   motion.free = FreeMinima(energies, still, restBones);
+  auto reference = std::make_shared<std::vector<Points>>();
+  for (const FixedObstacle& bone : restBones)
+  {
+    reference->push_back(bone.tree->Mesh().points);
+  }
+  motion.boneReference = std::move(reference);
   return motion;
+}
+
+std::vector<RigidFit> PlaceBones(
+  const std::shared_ptr<const std::vector<Points>>& reference, const std::vector<FixedObstacle>& bones)
+{
+  if (!reference || reference->size() != bones.size())
+  {
+    return {};
+  }
+  for (size_t b = 0; b < bones.size(); ++b)
+  {
+    if ((*reference)[b].rows() != bones[b].tree->Mesh().points.rows() || (*reference)[b].rows() == 0)
+    {
+      return {};
+    }
+  }
+  std::vector<RigidFit> placements(bones.size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int b = 0; b < static_cast<int>(bones.size()); ++b)
+  {
+    placements[b] = FitRigidTransform((*reference)[b], bones[b].tree->Mesh().points);
+  }
+  return placements;
+}
+
+std::vector<std::vector<double>> BoneClearancesNow(
+  const SettleMotion& motion, const std::vector<TriangleMesh>& muscles, const std::vector<RigidFit>& placements)
+{
+  const size_t count = muscles.size(), bones = placements.size(), obstacles = bones + count;
+  if (bones == 0 || motion.bonePlacements.size() != bones || motion.boneClearance.size() != count ||
+    motion.points.size() != count)
+  {
+    return {};
+  }
+  for (size_t m = 0; m < count; ++m)
+  {
+    if (motion.points[m].rows() != muscles[m].points.rows() ||
+      motion.boneClearance[m].size() != static_cast<size_t>(muscles[m].points.rows()) * bones)
+    {
+      return {};
+    }
+  }
+  std::vector<std::vector<double>> now(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    const Points& then = motion.points[m];
+    const Points& points = muscles[m].points;
+    now[m].assign(static_cast<size_t>(points.rows()) * obstacles, 0.0);
+    for (size_t b = 0; b < bones; ++b)
+    {
+      const RigidTransform fromThen = Inverse(motion.bonePlacements[b].transform);
+      const RigidTransform fromNow = Inverse(placements[b].transform);
+      const double residuals = motion.bonePlacements[b].maxResidual + placements[b].maxResidual;
+      for (Eigen::Index i = 0; i < points.rows(); ++i)
+      {
+        const double clearance = motion.boneClearance[m][static_cast<size_t>(i) * bones + b];
+        if (!(clearance > 0))
+        {
+          continue;
+        }
+        const Eigen::Vector3d here = points.row(i).transpose(), there = then.row(i).transpose();
+        const double moved = (fromNow.Apply(here) - fromThen.Apply(there)).norm();
+        now[m][static_cast<size_t>(i) * obstacles + b] = std::max(0.0, clearance - moved - residuals);
+      }
+    }
+  }
+  return now;
 }
 
 std::vector<Points> FreeMinima(const std::vector<const SurfaceEnergy*>& energies,
@@ -1210,11 +1284,23 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   std::vector<std::vector<char>> wasInside(count);
   std::vector<std::vector<double>> clearance(count); // FindContacts'
 
+  // The bones where they are now, and what the last settle proved of the points' distances from
+  // them, carried here.
+  const std::vector<RigidFit> placements = motion ? PlaceBones(motion->boneReference, bones) : std::vector<RigidFit>();
+  std::vector<std::vector<double>> carried =
+    motion ? BoneClearancesNow(*motion, meshes, placements) : std::vector<std::vector<double>>();
   std::vector<Points> previous(count);
   for (size_t m = 0; m < count; ++m)
   {
     wasInside[m].assign(static_cast<size_t>(meshes[m].points.rows()) * obstacles, 1);
-    clearance[m].assign(static_cast<size_t>(meshes[m].points.rows()) * obstacles, 0.0);
+    if (carried.size() == count)
+    {
+      clearance[m] = std::move(carried[m]);
+    }
+    else
+    {
+      clearance[m].assign(static_cast<size_t>(meshes[m].points.rows()) * obstacles, 0.0);
+    }
     previous[m] = meshes[m].points;
   }
   std::vector<Points> lastSteps; // each muscle's last move, for SteadyStep
@@ -1416,10 +1502,18 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       progress(static_cast<double>(iteration + 1) / std::max(1, parameters.maximumIterations));
     }
   }
-  // Which points the static resolution after this settle need not test against the bones.
-  std::vector<std::vector<char>> outsideBones = diverging
-    ? std::vector<std::vector<char>>()
-    : ProvenOutsideBones(meshes, previous, energies, bones.size(), clearance);
+  // How far each point is proven outside each bone where the settle ends (for the next settle),
+  // and so which points the static resolution after it need not test against the bones.
+  std::vector<std::vector<double>> boneClearance = diverging
+    ? std::vector<std::vector<double>>()
+    : BoneClearancesAtEnd(meshes, previous, energies, bones.size(), clearance);
+  std::vector<std::vector<char>> outsideBones(boneClearance.size());
+  for (size_t m = 0; m < boneClearance.size(); ++m)
+  {
+    outsideBones[m].resize(boneClearance[m].size());
+    std::transform(boneClearance[m].begin(), boneClearance[m].end(), outsideBones[m].begin(),
+      [](double c) { return static_cast<char>(c > 0); });
+  }
   // A settle that diverged leaves the muscles where they started rather than at an iterate that
   // means nothing; one that ran out of iterations keeps its last.
   for (size_t m = 0; m < count && !diverging; ++m)
@@ -1436,6 +1530,8 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     }
     motion->free = std::move(free);
     motion->outsideBones = std::move(outsideBones);
+    motion->boneClearance = std::move(boneClearance);
+    motion->bonePlacements = diverging ? std::vector<RigidFit>() : placements;
     motion->held.clear();
     if (motion->carryContacts && !diverging) // a diverged settle's contacts hold nothing
     {

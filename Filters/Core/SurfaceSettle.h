@@ -14,6 +14,7 @@
 #pragma once
 
 #include "MuscleDeformer.h"
+#include "RigidMotion.h"
 #include "StaticIntersections.h"
 #include "VolumeConstrainedSolver.h"
 
@@ -283,7 +284,37 @@ struct SettleMotion
   /// need not test those (ResolveStaticIntersections' `outsideFixed`). Empty after a settle that
   /// diverged.
   std::vector<std::vector<char>> outsideBones;
+  /// The bones' points in the rest pose (StartMotion's `restBones`), shared by every step's
+  /// SettleMotion: what `bonePlacements` place.
+  std::shared_ptr<const std::vector<Points>> boneReference;
+  /// Per bone, the rigid placement of its rest points that fits it where the last settle ended
+  /// (with the largest distance of its points from the placed rest points).
+  std::vector<RigidFit> bonePlacements;
+  /// Per muscle, for each point and bone (the layout of `outsideBones`): how much farther than
+  /// the contact offset the last settle's contact search proves the point from the bone where it
+  /// ended (0 where it proves nothing). The next settle's first contact search starts from it,
+  /// less how far the point has moved since relative to the bone's placement (BoneClearancesNow):
+  /// a point near a bone mostly moves with it, so most points need not be searched again at the
+  /// first iteration. Empty after a settle that diverged.
+  std::vector<std::vector<double>> boneClearance;
 };
+
+/// Each bone's rest points (`reference`, SettleMotion::boneReference) placed rigidly where
+/// `bones`' trees are now (FitRigidTransform); empty without a reference.
+std::vector<RigidFit> PlaceBones(
+  const std::shared_ptr<const std::vector<Points>>& reference, const std::vector<FixedObstacle>& bones);
+
+/// The clearances `motion` carries (SettleMotion::boneClearance) made good for the points
+/// `muscles` hold and the bones where `placements` (PlaceBones') put them now: each less how far its
+/// point has moved relative to the bone, in the bone's rest frame as the two placements put
+/// it, and less both placements' largest residuals (a bone not quite rigid). The distance from
+/// a point to a surface changes by at most the point's move relative to it, so a point that
+/// was outside a bone, and farther than the offset, by a clearance is still outside by what is
+/// left. Laid out as FindContacts' clearance, point * (bones + muscles) + obstacle (the
+/// muscles' entries 0). Empty where `motion` carries none (no settle before,
+/// one that diverged, no bones).
+std::vector<std::vector<double>> BoneClearancesNow(
+  const SettleMotion& motion, const std::vector<TriangleMesh>& muscles, const std::vector<RigidFit>& placements);
 
 /// The start of a motion: `muscles` in the rest pose (their action lines `restLines`, the
 /// bones `restBones` in the rest pose).

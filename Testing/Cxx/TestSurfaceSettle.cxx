@@ -490,6 +490,71 @@ TEST(SurfaceSettle, ASettleProvesWhichPointsAreOutsideEachBoneAndTheStaticResolu
     tested.points[0]);
 }
 
+TEST(SurfaceSettle, AMotionCarriesWhatItProvedOfTheBonesToItsNextSettle)
+{
+  // The spindle pressed against the box bone (its line bent 25 degrees), then the box and the
+  // line turned together by 3 degrees about an axis off both and the muscle carried along: the
+  // clearances the first settle proved, made good for the second's start (BoneClearancesNow),
+  // bound every point's true distance from the moved box (less the offset) from below, and most
+  // points keep one, which the second settle's first contact search need not test. With them
+  // and without, that settle ends at the same points to the bit.
+  SpindleBesideABox setup;
+  const auto& [s, energy, bone, bones] = setup;
+  const double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
+  md::SettleMotion motion = md::StartMotion({ s.muscle }, { &energy }, { { s.line } }, bones);
+  std::vector<md::TriangleMesh> meshes{ s.muscle };
+  ASSERT_TRUE(md::SettleMuscles(meshes, { &energy }, { { { s.line, Bent(s.line, 25) } } }, { volume }, bones, nullptr,
+    md::SettleParameters(), &motion)[0]
+                .converged);
+  ASSERT_EQ(motion.boneClearance.size(), 1u);
+  ASSERT_EQ(motion.bonePlacements.size(), 1u);
+  EXPECT_LT(motion.bonePlacements[0].maxResidual, 1e-12 * s.Size()); // the box has not moved
+
+  const md::RigidTransform turn =
+    md::RigidTransform::AboutPoint(Eigen::Vector3d(0.3, 0.2, 1.0), 3 * EIGEN_PI / 180, Eigen::Vector3d(-30, -10, 5));
+  setup.bone.Refit(turn.Apply(motion.boneReference->at(0)));
+  const std::vector<md::RigidFit> placements = md::PlaceBones(motion.boneReference, bones);
+  ASSERT_EQ(placements.size(), 1u);
+  EXPECT_LT((placements[0].transform.rotation - turn.rotation).norm(), 1e-12);
+  EXPECT_LT(placements[0].maxResidual, 1e-9 * s.Size());
+  std::vector<md::TriangleMesh> start{ { turn.Apply(motion.points[0]), meshes[0].triangles } };
+  start[0].points.col(1).array() += 0.05; // and a little nearer the box than it takes it
+  const std::vector<std::vector<double>> now = md::BoneClearancesNow(motion, start, placements);
+  ASSERT_EQ(now.size(), 1u);
+  const size_t obstacles = 2; // the box, then the spindle itself
+  ASSERT_EQ(now[0].size(), static_cast<size_t>(start[0].points.rows()) * obstacles);
+  const double offset = md::SettleParameters().contactOffset * energy.Size();
+  std::int64_t kept = 0;
+  for (Eigen::Index i = 0; i < start[0].points.rows(); ++i)
+  {
+    EXPECT_EQ(now[0][static_cast<size_t>(i) * obstacles + 1], 0.0); // nothing of the muscles
+    const double clearance = now[0][static_cast<size_t>(i) * obstacles];
+    if (clearance > 0)
+    {
+      ++kept;
+      const Eigen::Vector3d p = start[0].points.row(i).transpose();
+      EXPECT_FALSE(bone.Inside(p)) << "point " << i;
+      EXPECT_GE(bone.ClosestPoint(p).distance - offset, clearance) << "point " << i;
+    }
+  }
+  EXPECT_GT(kept, start[0].points.rows() / 2);
+
+  // The next settle with what was proved and without it.
+  md::SettleMotion forgetful = motion;
+  forgetful.boneClearance.clear();
+  EXPECT_TRUE(md::BoneClearancesNow(forgetful, start, placements).empty());
+  md::Points turnedLine = turn.Apply(Bent(s.line, 25));
+  std::vector<md::TriangleMesh> a{ s.muscle }, b{ s.muscle };
+  const md::SettleReport withProof = md::SettleMuscles(
+    a, { &energy }, { { { s.line, turnedLine } } }, { volume }, bones, nullptr, md::SettleParameters(), &motion)[0];
+  const md::SettleReport without = md::SettleMuscles(
+    b, { &energy }, { { { s.line, turnedLine } } }, { volume }, bones, nullptr, md::SettleParameters(), &forgetful)[0];
+  ASSERT_TRUE(withProof.converged);
+  EXPECT_GT(withProof.pointsInContact, 0);
+  EXPECT_EQ(withProof.iterations, without.iterations);
+  EXPECT_TRUE(a[0].points == b[0].points);
+}
+
 TEST(SurfaceSettle, ALineThroughABonePullsTheMuscleBesideItNotIntoIt)
 {
   // The bent line's far half runs into the box bone (y > 14). Its samples pull the muscle to
