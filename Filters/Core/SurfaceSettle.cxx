@@ -905,6 +905,12 @@ std::vector<Contact> FindContacts(const std::vector<TriangleMesh>& meshes,
     std::vector<double>& clear = clearance[m];
     std::vector<std::vector<Contact>> found(static_cast<size_t>(x.rows()));
     std::vector<char> inNow(static_cast<size_t>(x.rows()) * obstacles, 0);
+    // Which of this muscle's pairs were held, looked up once rather than in the map at every pair.
+    std::vector<char> wasHeld(static_cast<size_t>(x.rows()) * obstacles, 0);
+    for (auto entry = held.lower_bound({ m, 0, 0 }); entry != held.end() && std::get<0>(entry->first) == m; ++entry)
+    {
+      wasHeld[static_cast<size_t>(std::get<1>(entry->first)) * obstacles + std::get<2>(entry->first)] = 1;
+    }
 #pragma omp parallel for schedule(dynamic, 256)
     for (Eigen::Index i = 0; i < x.rows(); ++i)
     {
@@ -920,12 +926,12 @@ std::vector<Contact> FindContacts(const std::vector<TriangleMesh>& meshes,
           continue;
         }
         const size_t flag = static_cast<size_t>(i) * obstacles + o;
-        const auto before = held.find({ m, i, o });
         clear[flag] -= moved[m](i) + (o < bones.size() ? 0.0 : largestMove[o - bones.size()]) + margin;
-        if (clear[flag] > 0 && before == held.end())
+        if (clear[flag] > 0 && !wasHeld[flag])
         {
           continue; // still outside and not near (inNow stays 0)
         }
+        const auto before = wasHeld[flag] ? held.find({ m, i, o }) : held.end();
         const TriangleTree& tree = obstacle(o);
         const bool inside = tree.InBounds(p) && tree.Inside(p);
         // Outside, a point closer than the offset breaks its constraint too. One search as far
