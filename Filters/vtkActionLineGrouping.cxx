@@ -14,9 +14,12 @@
 #include <vtkMultiBlockDataSet.h>
 #include <vtkObjectFactory.h>
 #include <vtkOutputWindow.h>
+#include <vtkPointData.h>
 #include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
 #include <vtkStringArray.h>
 
+#include <cstdint>
 #include <sstream>
 
 vtkStandardNewMacro(vtkActionLineGrouping);
@@ -29,6 +32,10 @@ struct vtkActionLineGrouping::Grouped
   std::string assignments;
   md::osim::PathGrouping grouping;
   std::string decision;
+  /// Output 0 (the rest pose's paths grouped) as built from paths with `pathsDigest`: the same
+  /// while the grouping and the paths are, so it is not built again at every frame.
+  vtkSmartPointer<vtkMultiBlockDataSet> pathsOutput;
+  std::uint64_t pathsDigest = 0;
 
   bool DecidedOn(const std::vector<md::TriangleMesh>& otherMuscles, const std::vector<md::Points>& otherPaths,
     const std::vector<std::string>& otherMuscleNames, const std::vector<std::string>& otherPathNames,
@@ -47,6 +54,67 @@ struct vtkActionLineGrouping::Grouped
       std::equal(otherPaths.begin(), otherPaths.end(), this->paths.begin(), this->paths.end(), samePoints);
   }
 };
+
+namespace
+{
+/// A hash (FNV-1a) of everything of the paths that output 0 copies: their point and cell counts
+/// and every point and cell array's name, type and values.
+std::uint64_t PathsDigest(const std::vector<mdvtk::Leaf>& paths)
+{
+  std::uint64_t hash = 1469598103934665603ull;
+  auto add = [&](const void* data, size_t bytes) {
+    const auto* byte = static_cast<const unsigned char*>(data);
+    for (size_t k = 0; k < bytes; ++k)
+    {
+      hash = (hash ^ byte[k]) * 1099511628211ull;
+    }
+  };
+  auto addNumber = [&](long long value) {
+    add(&value, sizeof(value));
+  };
+  for (const mdvtk::Leaf& path : paths)
+  {
+    vtkPolyData* data = path.data;
+    addNumber(data ? data->GetNumberOfPoints() : -1);
+    addNumber(data ? data->GetNumberOfCells() : -1);
+    if (!data)
+    {
+      continue;
+    }
+    for (vtkFieldData* arrays :
+      { static_cast<vtkFieldData*>(data->GetPointData()), static_cast<vtkFieldData*>(data->GetCellData()) })
+    {
+      addNumber(arrays->GetNumberOfArrays());
+      for (int a = 0; a < arrays->GetNumberOfArrays(); ++a)
+      {
+        vtkAbstractArray* array = arrays->GetAbstractArray(a);
+        const std::string name = array->GetName() ? array->GetName() : "";
+        add(name.data(), name.size() + 1);
+        addNumber(array->GetDataType());
+        addNumber(array->GetNumberOfValues());
+        if (auto* strings = vtkStringArray::SafeDownCast(array))
+        {
+          for (vtkIdType v = 0; v < strings->GetNumberOfValues(); ++v)
+          {
+            const std::string& value = strings->GetValue(v);
+            add(value.data(), value.size() + 1);
+          }
+        }
+        else if (auto* numbers = vtkDataArray::SafeDownCast(array))
+        {
+          add(numbers->GetVoidPointer(0),
+            static_cast<size_t>(numbers->GetNumberOfValues()) * static_cast<size_t>(numbers->GetDataTypeSize()));
+        }
+        else
+        {
+          addNumber(reinterpret_cast<std::uintptr_t>(array)); // another kind: never taken as the same
+        }
+      }
+    }
+  }
+  return hash;
+}
+}
 
 vtkActionLineGrouping::vtkActionLineGrouping()
 {
@@ -218,8 +286,20 @@ int vtkActionLineGrouping::RequestData(
       mdvtk::AddBlock(output, muscleNames[m], block);
     }
   };
-  build(paths, false, vtkMultiBlockDataSet::GetData(outputVector, 0));
-  mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, 0), mdvtk::Role::ActionLine);
+  vtkMultiBlockDataSet* grouped = vtkMultiBlockDataSet::GetData(outputVector, 0);
+  const std::uint64_t digest = PathsDigest(paths);
+  if (this->LastGrouping->pathsOutput && this->LastGrouping->pathsDigest == digest)
+  {
+    grouped->ShallowCopy(this->LastGrouping->pathsOutput);
+  }
+  else
+  {
+    build(paths, false, grouped);
+    mdvtk::MarkRoles(grouped, mdvtk::Role::ActionLine);
+    this->LastGrouping->pathsOutput = vtkSmartPointer<vtkMultiBlockDataSet>::New();
+    this->LastGrouping->pathsOutput->ShallowCopy(grouped);
+    this->LastGrouping->pathsDigest = digest;
+  }
   if (haveCurrent)
   {
     build(current, true, vtkMultiBlockDataSet::GetData(outputVector, 1));

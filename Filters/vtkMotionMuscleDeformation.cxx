@@ -590,6 +590,10 @@ int vtkMotionMuscleDeformation::RequestData(
     measures.steps = advanced.steps;
     measures.seconds = advanced.seconds;
     const auto older = in.frames.find(k - 2);
+    const bool threeFrames = k >= 2 && before != in.frames.end() && older != in.frames.end();
+    // What drives the muscles (the bones' points and the lines), once for all muscles.
+    const double driven =
+      threeFrames ? md::LargestSecondDifference(older->second.pose, before->second.pose, pose) : 0.0;
     for (size_t m = 0; m < in.blockOf.size(); ++m)
     {
       kept.points[m] = advanced.points[m];
@@ -597,10 +601,9 @@ int vtkMotionMuscleDeformation::RequestData(
       s.staticShift = md::Points(0, 3);
       measures.measures.push_back(s);
       double second = std::nan(""), ratio = std::nan("");
-      if (k >= 2 && before != in.frames.end() && older != in.frames.end() && kept.points[m].rows() > 0)
+      if (threeFrames && kept.points[m].rows() > 0)
       {
         second = md::LargestSecondDifference(older->second.points[m], before->second.points[m], kept.points[m]);
-        const double driven = md::LargestSecondDifference(older->second.pose, before->second.pose, pose);
         ratio = driven > 0 ? second / driven : std::nan("");
       }
       measures.secondDifference.push_back(second);

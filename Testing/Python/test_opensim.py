@@ -11,7 +11,9 @@ import numpy
 import mdtesting
 import mdexamples
 from paraview import servermanager, simple
-from vtkmodules.vtkFiltersSources import vtkCubeSource
+from vtkmodules.vtkCommonCore import vtkDoubleArray
+from vtkmodules.vtkCommonDataModel import vtkPolyData
+from vtkmodules.vtkFiltersSources import vtkCubeSource, vtkLineSource
 from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter
 
 mdtesting.load_plugin()
@@ -216,17 +218,65 @@ class SmallModel(unittest.TestCase):
             grouping.UpdatePipeline(t)
             return points(block(grouping.GetClientSideObject().GetOutputDataObject(1), "deltoid_surface"))
 
+        def rest_output():
+            grouped = block(grouping.GetClientSideObject().GetOutputDataObject(0), "deltoid_surface")
+            arrays = sorted(grouped.GetPointData().GetArrayName(a) for a in range(grouped.GetPointData().GetNumberOfArrays()))
+            return points(grouped), arrays, grouped.GetFieldData().GetAbstractArray("ActionLinePaths").GetValue(0)
+
         start = current(0.0)
+        rest_start = rest_output()
         with mdtesting.CapturedMessages() as messages:
             later = current(1.0)
         self.assertNotIn("ActionLineGrouping", messages.text)
         self.assertGreater(numpy.abs(later - start).max(), 0.1)
-        again = block(grouping.GetClientSideObject().GetOutputDataObject(0), "deltoid_surface")
-        self.assertEqual(again.GetFieldData().GetAbstractArray("ActionLinePaths").GetValue(0), "deltoid")
+        # The rest pose's paths (output 0, kept from the first time rather than built again) are the same.
+        rest_later = rest_output()
+        self.assertEqual(rest_later[2], "deltoid")
+        self.assertEqual(rest_later[1], rest_start[1])
+        self.assertTrue(numpy.array_equal(rest_later[0], rest_start[0]))
         grouping.PathsOfMuscle = "deltoid_surface=deltoid"
         with mdtesting.CapturedMessages() as messages:
             current(0.5)
         self.assertIn("deltoid -> deltoid_surface (as given", messages.text)
+
+    def test_grouping_follows_a_change_of_the_paths_arrays(self):
+        # Output 0 (the rest pose's paths, grouped) is kept between updates while the grouping and
+        # the paths are the same; a change of a path's array alone, its points unchanged, is seen.
+        box = vtkCubeSource()
+        box.SetXLength(2.0)
+        box.Update()
+        muscle = simple.PVTrivialProducer(registrationName="belly")
+        muscle.GetClientSideObject().SetOutput(box.GetOutput())
+        line = vtkLineSource()
+        line.SetPoint1(-0.5, 0, 0)
+        line.SetPoint2(0.5, 0, 0)
+        line.Update()
+        path = vtkPolyData()
+        path.DeepCopy(line.GetOutput())
+        tension = vtkDoubleArray()
+        tension.SetName("Tension")
+        tension.SetNumberOfTuples(path.GetNumberOfPoints())
+        tension.Fill(1.0)
+        path.GetPointData().AddArray(tension)
+        paths = simple.PVTrivialProducer(registrationName="belly_path")
+        paths.GetClientSideObject().SetOutput(path)
+        grouping = simple.ActionLineGrouping(Input=simple.GroupDatasets(Input=[muscle]), Paths=paths)
+
+        def grouped_tension():
+            grouping.GetClientSideObject().Update()  # the proxy does not see a change made to the data
+            grouped = block(grouping.GetClientSideObject().GetOutputDataObject(0), "belly")
+            return grouped.GetPointData().GetArray("Tension").GetValue(0)
+
+        self.assertEqual(grouped_tension(), 1.0)
+        doubled = vtkDoubleArray()  # a new array: one changed in place may be shared with the output
+        doubled.DeepCopy(tension)
+        doubled.Fill(2.0)
+        path.GetPointData().RemoveArray("Tension")
+        path.GetPointData().AddArray(doubled)
+        path.Modified()
+        paths.GetClientSideObject().Modified()
+        self.assertEqual(grouped_tension(), 2.0)
+        simple.Delete(grouping)
 
     def test_bad_input_is_named(self):
         for text, expected in (
