@@ -8,13 +8,15 @@
 // 35), the distance to InterpolatedMuscleDeformation's answer for that pose from the rest pose.
 // Prints figures; asserts nothing (see the tests). Last, a checksum of every frame's points and
 // measures: a change meant to leave the answer alone (a speed-up, a restructuring) must leave it
-// the same on the same machine and build.
+// the same on the same machine and build. With a seed (LHDL), the same motion on the exact input
+// too, and the largest distance between the two runs' surfaces at any frame.
 //
 //   BenchmarkMotion [data folder] [hip_flexion|hip_adduction|phantom] [seed: -1 none, 0 float, s > 0 noise]
 #include "MotionFrames.h"
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -151,6 +153,44 @@ int main(int argc, char** argv)
               "penetration %.3f, smoothness ratio %.2f\n",
     total, frames.poses.size() > 1 ? 1000 * framesSeconds / (frames.poses.size() - 1) : 0.0, 1000 * median, worstVolume,
     worstDepth, worstRatio);
+
+  // Perturbed input against the exact input: how far every frame's surfaces moved (issue 13's
+  // measure, through the whole motion).
+  MotionFrames exactFrames;
+  if (seed >= 0 && motion != "phantom" && LhdlFrames(folder, motion, -1, exactFrames) &&
+    exactFrames.poses.size() == frames.poses.size())
+  {
+    md::MotionDeformation exact(exactFrames.muscles, exactFrames.bones, parameters);
+    double largest = 0, worstRms = 0;
+    size_t largestFrame = 0;
+    std::string largestMuscle, beyond;
+    constexpr double kNoiseBound = 0.01; // mm: issue 13's bound for 1e-7 of input noise
+    for (size_t k = 0; k < exactFrames.poses.size(); ++k)
+    {
+      const md::MotionFrameResult r = exact.Advance(exactFrames.poses[k]);
+      for (size_t m = 0; m < r.points.size(); ++m)
+      {
+        const double distance = LargestDistance(points[k][m], r.points[m]);
+        if (distance > kNoiseBound)
+        {
+          beyond += " " + std::to_string(k) + " (" + frames.muscles[m].name + " " + std::to_string(distance) + " mm)";
+        }
+        if (distance > largest)
+        {
+          largest = distance;
+          largestFrame = k;
+          largestMuscle = frames.muscles[m].name;
+        }
+        if (distance >= 0)
+        {
+          worstRms = std::max(worstRms, std::sqrt((points[k][m] - r.points[m]).rowwise().squaredNorm().mean()));
+        }
+      }
+    }
+    std::printf("against the exact input, every frame: largest distance %.6f mm (frame %zu, %s), RMS up to %.6f mm\n",
+      largest, largestFrame, largestMuscle.c_str(), worstRms);
+    std::printf("  frames beyond %.2f mm:%s\n", kNoiseBound, beyond.empty() ? " none" : beyond.c_str());
+  }
 
   // The frame nearest 60 degrees of flexion against the interpolation method from the rest pose.
   if (motion != "hip_adduction")
