@@ -620,8 +620,9 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
         ? StepOutcome{ settled[m].iterations, settled[m].converged, 0, settled[m].seconds }
         : StepOutcome{ deformed[m].iterations, deformed[m].converged, deformed[m].verticesFrozen, deformed[m].seconds };
     }
+    const std::vector<std::vector<char>> outsideBones = ProvenOutsideBones(settleMotion.boneClearance);
     measures = ResolveAndMeasure(next, muscles, fixed, restOverlap, restVolumes, parameters, outcomes, previous,
-      measures, settle ? &settleMotion.outsideBones : nullptr);
+      measures, settle ? &outsideBones : nullptr);
     if (!settle)
     {
       RefitHulls(hullPass, next, deformed, muscles, parameters, measures);

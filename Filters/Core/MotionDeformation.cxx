@@ -459,10 +459,7 @@ MotionFrameResult MotionDeformation::Advance(const MotionPose& worldPose, const 
       {
         outcomes[k] = { settled[k].iterations, settled[k].converged, 0, settled[k].seconds };
       }
-      // The settle's proof of which points are outside the bones serves this step's end only (not
-      // kept with the frame).
-      const std::vector<std::vector<char>> outsideBones = std::move(next->settle.outsideBones);
-      next->settle.outsideBones.clear();
+      const std::vector<std::vector<char>> outsideBones = ProvenOutsideBones(next->settle.boneClearance);
       std::vector<MuscleStepMeasures> measures = ResolveAndMeasure(muscles, in.muscles, in.fixed, in.restOverlap,
         in.restVolumes, in.parameters, outcomes, next->previous, std::vector<MuscleStepMeasures>(count), &outsideBones);
       for (size_t k = 0; k < count; ++k)

@@ -72,7 +72,7 @@ struct StepOutcome
 /// alone), the volumes given back (`restVolumes`, with PreserveVolume) and the measures against
 /// the rest pose (`muscles`) and the last step's (`previous`). `measures` brings what the step
 /// measured already (its hull seconds) and is returned complete. `outsideBones`: the settle's
-/// proof of which points are outside which bone (SettleMotion::outsideBones), when `next` is
+/// proof of which points are outside which bone (ProvenOutsideBones), when `next` is
 /// where a settle left the muscles.
 std::vector<MuscleStepMeasures> ResolveAndMeasure(std::vector<TriangleMesh>& next,
   const std::vector<MuscleMotion>& muscles, const std::vector<FixedObstacle>& fixed, const OverlapMasks& restOverlap,

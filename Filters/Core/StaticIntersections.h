@@ -94,7 +94,7 @@ struct StaticResolveResult
 /// on entry (the result does not depend on the meshes' order). `outsideFixed`
 /// (optional; per mesh, point * fixed.size() + obstacle): points known to be
 /// outside a fixed obstacle, which are not tested against it (a settle's proof,
-/// SettleMotion::outsideBones).
+/// ProvenOutsideBones).
 StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& meshes,
   const std::vector<FixedObstacle>& fixed, const OverlapMasks* existing, const StaticResolveParameters& parameters,
   const std::vector<std::vector<char>>* outsideFixed = nullptr);

@@ -1114,6 +1114,18 @@ SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::ve
   return motion;
 }
 
+std::vector<std::vector<char>> ProvenOutsideBones(const std::vector<std::vector<double>>& boneClearance)
+{
+  std::vector<std::vector<char>> outside(boneClearance.size());
+  for (size_t m = 0; m < boneClearance.size(); ++m)
+  {
+    outside[m].resize(boneClearance[m].size());
+    std::transform(boneClearance[m].begin(), boneClearance[m].end(), outside[m].begin(),
+      [](double c) { return static_cast<char>(c > 0); });
+  }
+  return outside;
+}
+
 std::vector<RigidFit> PlaceBones(
   const std::shared_ptr<const std::vector<Points>>& reference, const std::vector<FixedObstacle>& bones)
 {
@@ -1508,18 +1520,11 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       progress(static_cast<double>(iteration + 1) / std::max(1, parameters.maximumIterations));
     }
   }
-  // How far each point is proven outside each bone where the settle ends (for the next settle),
-  // and so which points the static resolution after it need not test against the bones.
+  // How far each point is proven outside each bone where the settle ends (for the static
+  // resolution after it and for the next settle).
   std::vector<std::vector<double>> boneClearance = diverging
     ? std::vector<std::vector<double>>()
     : BoneClearancesAtEnd(meshes, previous, energies, bones.size(), clearance);
-  std::vector<std::vector<char>> outsideBones(boneClearance.size());
-  for (size_t m = 0; m < boneClearance.size(); ++m)
-  {
-    outsideBones[m].resize(boneClearance[m].size());
-    std::transform(boneClearance[m].begin(), boneClearance[m].end(), outsideBones[m].begin(),
-      [](double c) { return static_cast<char>(c > 0); });
-  }
   // A settle that diverged leaves the muscles where they started rather than at an iterate that
   // means nothing; one that ran out of iterations keeps its last.
   for (size_t m = 0; m < count && !diverging; ++m)
@@ -1535,7 +1540,6 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       motion->points.push_back(muscles[m].points);
     }
     motion->free = std::move(free);
-    motion->outsideBones = std::move(outsideBones);
     motion->boneClearance = std::move(boneClearance);
     motion->bonePlacements = diverging ? std::vector<RigidFit>() : placements;
     motion->held.clear();

@@ -278,26 +278,28 @@ struct SettleMotion
   /// The contacts that held the muscles where the last settle ended (with carryContacts), each
   /// as (muscle, point, obstacle, triangle), the obstacles the bones first and then the muscles.
   std::vector<std::array<Eigen::Index, 4>> held;
-  /// Per muscle, for each point and bone (point * bones + bone): 1 where the last settle's
-  /// contact search proves the point outside the bone, and farther than the contact offset, at
-  /// the points it ended at (its clearance less the last move). The static resolution after it
-  /// need not test those (ResolveStaticIntersections' `outsideFixed`). Empty after a settle that
-  /// diverged.
-  std::vector<std::vector<char>> outsideBones;
   /// The bones' points in the rest pose (StartMotion's `restBones`), shared by every step's
   /// SettleMotion: what `bonePlacements` place.
   std::shared_ptr<const std::vector<Points>> boneReference;
   /// Per bone, the rigid placement of its rest points that fits it where the last settle ended
   /// (with the largest distance of its points from the placed rest points).
   std::vector<RigidFit> bonePlacements;
-  /// Per muscle, for each point and bone (the layout of `outsideBones`): how much farther than
-  /// the contact offset the last settle's contact search proves the point from the bone where it
-  /// ended (0 where it proves nothing). The next settle's first contact search starts from it,
+  /// Per muscle, for each point and bone (point * bones + bone): how much farther than the
+  /// contact offset the last settle's contact search proves the point from the bone where it
+  /// ended (its clearance less the last move; 0 where it proves nothing). The static resolution
+  /// after it need not test the points it proves (ProvenOutsideBones), and the next settle's first
+  /// contact search starts from it,
   /// less how far the point has moved since relative to the bone's placement (BoneClearancesNow):
   /// a point near a bone mostly moves with it, so most points need not be searched again at the
   /// first iteration. Empty after a settle that diverged.
   std::vector<std::vector<double>> boneClearance;
 };
+
+/// Per muscle, for each point and bone (point * bones + bone): 1 where `boneClearance`
+/// (SettleMotion's) proves the point outside the bone and farther than the contact offset, what
+/// the static resolution after that settle need not test (ResolveStaticIntersections'
+/// `outsideFixed`).
+std::vector<std::vector<char>> ProvenOutsideBones(const std::vector<std::vector<double>>& boneClearance);
 
 /// Each bone's rest points (`reference`, SettleMotion::boneReference) placed rigidly where
 /// `bones`' trees are now (FitRigidTransform); empty without a reference.

@@ -436,7 +436,7 @@ TEST(SurfaceSettle, AMotionsContactsAreCarriedToItsNextStep)
 TEST(SurfaceSettle, ASettleProvesWhichPointsAreOutsideEachBoneAndTheStaticResolutionSkipsThem)
 {
   // The spindle pressed against the box bone (its line bent 25 degrees): the settle leaves, in
-  // SettleMotion::outsideBones, the points its last contact search proves outside the box and
+  // SettleMotion::boneClearance, the points its last contact search proves outside the box and
   // farther than the contact offset. Every one of them is outside, most points are (the far
   // side), those in contact are not, and the static resolution given the proof finds and does
   // exactly what it does testing every point.
@@ -448,8 +448,9 @@ TEST(SurfaceSettle, ASettleProvesWhichPointsAreOutsideEachBoneAndTheStaticResolu
     { md::EnclosedVolume(s.muscle.points, s.muscle.triangles) }, bones, nullptr, md::SettleParameters(), &motion)[0];
   ASSERT_TRUE(report.converged);
   ASSERT_GT(report.pointsInContact, 0);
-  ASSERT_EQ(motion.outsideBones.size(), 1u);
-  const std::vector<char>& outside = motion.outsideBones[0];
+  const std::vector<std::vector<char>> outsideBones = md::ProvenOutsideBones(motion.boneClearance);
+  ASSERT_EQ(outsideBones.size(), 1u);
+  const std::vector<char>& outside = outsideBones[0];
   ASSERT_EQ(outside.size(), static_cast<size_t>(meshes[0].points.rows()));
   const double offset = md::SettleParameters().contactOffset * energy.Size();
   std::int64_t proven = 0, against = 0;
