@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkActionLineGrouping.h"
 
+#include "Fnv1a.h"
 #include "MDBlocks.h"
 #include "OpenSimAttachment.h"
 
@@ -61,16 +62,9 @@ namespace
 /// and every point and cell array's name, type and values.
 std::uint64_t PathsDigest(const std::vector<mdvtk::Leaf>& paths)
 {
-  std::uint64_t hash = 1469598103934665603ull;
-  auto add = [&](const void* data, size_t bytes) {
-    const auto* byte = static_cast<const unsigned char*>(data);
-    for (size_t k = 0; k < bytes; ++k)
-    {
-      hash = (hash ^ byte[k]) * 1099511628211ull;
-    }
-  };
+  md::Fnv1a hash;
   auto addNumber = [&](long long value) {
-    add(&value, sizeof(value));
+    hash.Add(value);
   };
   for (const mdvtk::Leaf& path : paths)
   {
@@ -89,7 +83,7 @@ std::uint64_t PathsDigest(const std::vector<mdvtk::Leaf>& paths)
       {
         vtkAbstractArray* array = arrays->GetAbstractArray(a);
         const std::string name = array->GetName() ? array->GetName() : "";
-        add(name.data(), name.size() + 1);
+        hash.Add(name.data(), name.size() + 1);
         addNumber(array->GetDataType());
         addNumber(array->GetNumberOfValues());
         if (auto* strings = vtkStringArray::SafeDownCast(array))
@@ -97,12 +91,12 @@ std::uint64_t PathsDigest(const std::vector<mdvtk::Leaf>& paths)
           for (vtkIdType v = 0; v < strings->GetNumberOfValues(); ++v)
           {
             const std::string& value = strings->GetValue(v);
-            add(value.data(), value.size() + 1);
+            hash.Add(value.data(), value.size() + 1);
           }
         }
         else if (auto* numbers = vtkDataArray::SafeDownCast(array))
         {
-          add(numbers->GetVoidPointer(0),
+          hash.Add(numbers->GetVoidPointer(0),
             static_cast<size_t>(numbers->GetNumberOfValues()) * static_cast<size_t>(numbers->GetDataTypeSize()));
         }
         else
@@ -112,7 +106,7 @@ std::uint64_t PathsDigest(const std::vector<mdvtk::Leaf>& paths)
       }
     }
   }
-  return hash;
+  return hash.Value();
 }
 }
 

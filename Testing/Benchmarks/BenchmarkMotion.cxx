@@ -12,6 +12,7 @@
 // too, and the largest distance between the two runs' surfaces at any frame.
 //
 //   BenchmarkMotion [data folder] [hip_flexion|hip_adduction|phantom] [seed: -1 none, 0 float, s > 0 noise]
+#include "Fnv1a.h"
 #include "MotionFrames.h"
 
 #include <algorithm>
@@ -25,26 +26,6 @@
 
 namespace
 {
-/// FNV-1a over bytes, so that two runs can be compared to the bit.
-class Checksum
-{
-public:
-  void Add(const void* data, size_t bytes)
-  {
-    const auto* byte = static_cast<const unsigned char*>(data);
-    for (size_t k = 0; k < bytes; ++k)
-    {
-      this->Value = (this->Value ^ byte[k]) * 1099511628211ULL;
-    }
-  }
-  template<typename T>
-  void Add(const T& value)
-  {
-    this->Add(&value, sizeof(T));
-  }
-  unsigned long long Value = 14695981039346656037ULL;
-};
-
 double LargestDistance(const md::Points& a, const md::Points& b)
 {
   return a.rows() == b.rows() && a.rows() > 0 ? (a - b).rowwise().norm().maxCoeff() : -1.0;
@@ -76,7 +57,7 @@ int main(int argc, char** argv)
   std::printf("%5s %7s %5s %6s %8s %9s %7s %6s %6s %9s %7s %s\n", "frame", "flexion", "steps", "iter", "ms", "max|dV|%",
     "bonePen", "flips", "sharp", "2nd diff", "ratio", "muscle");
   std::vector<std::vector<md::Points>> points;
-  Checksum checksum; // of every frame's points and measures
+  md::Fnv1a checksum; // of every frame's points and measures, so that two runs can be compared to the bit
   double framesSeconds = 0, worstRatio = 0, worstDepth = 0, worstVolume = 0;
   std::vector<double> frameSeconds; // after the first: their median (single frames here vary by 20 %)
   for (size_t k = 0; k < frames.poses.size(); ++k)
@@ -236,6 +217,7 @@ int main(int argc, char** argv)
     }
     std::printf("\n");
   }
-  std::printf("checksum of every frame's points and measures: %016llx\n", checksum.Value);
+  std::printf(
+    "checksum of every frame's points and measures: %016llx\n", static_cast<unsigned long long>(checksum.Value()));
   return 0;
 }
