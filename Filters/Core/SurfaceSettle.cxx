@@ -297,24 +297,28 @@ namespace
 /// Overwrites the rows of `y` (the factor's order) by (L D L^T)^-1 y, every column at once: the
 /// columns share one pass over L, which is what the solve's time goes on (the order of the
 /// arithmetic is that of Eigen's own solve, column by column). The forward pass skips the rows
-/// still zero: for a unit vector it touches only the points the elimination reaches.
+/// still zero: for a unit vector it touches only the points the elimination reaches. The row
+/// each column of L reads (forward) or writes (backward) is held in a local copy: through `y`
+/// the compiler must store and load it again at every entry, as a row below could alias it.
 template<class Rows>
 void SolveFactored(
   const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& lower, const Eigen::VectorXd& diagonal, Rows& y)
 {
+  using Row = Eigen::Matrix<double, 1, Rows::ColsAtCompileTime, Eigen::RowMajor>;
   const Eigen::Index n = lower.cols();
   const auto* start = lower.outerIndexPtr();
   const auto* row = lower.innerIndexPtr();
   const double* value = lower.valuePtr();
   for (Eigen::Index j = 0; j < n; ++j)
   {
-    if ((y.row(j).array() == 0.0).all())
+    const Row yj = y.row(j);
+    if ((yj.array() == 0.0).all())
     {
       continue;
     }
     for (auto k = start[j]; k < start[j + 1]; ++k)
     {
-      y.row(row[k]) -= value[k] * y.row(j);
+      y.row(row[k]) -= value[k] * yj;
     }
   }
   for (Eigen::Index j = 0; j < n; ++j)
@@ -323,10 +327,12 @@ void SolveFactored(
   }
   for (Eigen::Index j = n - 1; j >= 0; --j)
   {
+    Row yj = y.row(j);
     for (auto k = start[j]; k < start[j + 1]; ++k)
     {
-      y.row(j) -= value[k] * y.row(row[k]);
+      yj -= value[k] * y.row(row[k]);
     }
+    y.row(j) = yj;
   }
 }
 }
