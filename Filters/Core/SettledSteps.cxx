@@ -133,6 +133,9 @@ std::vector<SettleReport> SettleStep(const SettleInput& in, double from, double 
   RefitBones(in, to);
   std::vector<Points> freeMinima = FreeMinima(in.energies, LinesAt(in, to), in.fixed);
   const int parts = SettleParts(motion, in.energies, freeMinima, in.parameters);
+  // A step whose minimum moves farther than largestCarriedMove starts every part with no
+  // contacts: with largestCarriedMove at most half largestStartMove, each part moves farther too.
+  const bool carry = LargestStartMove(motion, in.energies, freeMinima) <= in.parameters.largestCarriedMove;
   std::vector<SettleReport> reports;
   auto settlePart = [&](int k, std::vector<Points> minima) {
     const double start = k == 1 ? from : from + (to - from) * (k - 1) / parts;
@@ -140,6 +143,10 @@ std::vector<SettleReport> SettleStep(const SettleInput& in, double from, double 
     if (parts > 1) // one part: the bones are at `to` already
     {
       RefitBones(in, end);
+    }
+    if (!carry)
+    {
+      motion.held.clear();
     }
     const std::vector<SettleReport> part = SettleToPose(
       in, start, end, kSettleHalvings, muscles, motion, [&](double fraction) { progress((k - 1 + fraction) / parts); },

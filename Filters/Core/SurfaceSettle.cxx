@@ -15,6 +15,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <set>
 #include <tuple>
@@ -294,6 +295,19 @@ void SurfaceEnergy::CarryToUnwelded(Points& settled) const
 
 namespace
 {
+/// The muscles' indices, the one whose factor costs most to solve with first: a parallel loop
+/// over the muscles that hands them out in this order (schedule dynamic) starts the longest
+/// solve at once instead of leaving it to the end while the other core idles (the LHDL gluteus
+/// maximus's factor has as many entries as the other three muscles' together).
+std::vector<int> CostliestFirst(const std::vector<const SurfaceEnergy*>& energies)
+{
+  std::vector<int> order(energies.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+    [&](int a, int b) { return energies[a]->FactorEntries() > energies[b]->FactorEntries(); });
+  return order;
+}
+
 /// Overwrites the rows of `y` (the factor's order) by (L D L^T)^-1 y, every column at once: the
 /// columns share one pass over L, which is what the solve's time goes on (the order of the
 /// arithmetic is that of Eigen's own solve, column by column). The forward pass skips the rows
@@ -327,12 +341,18 @@ void SolveFactored(
   }
   for (Eigen::Index j = n - 1; j >= 0; --j)
   {
-    Row yj = y.row(j);
-    for (auto k = start[j]; k < start[j + 1]; ++k)
+    Row even = y.row(j), odd = Row::Zero();
+    auto k = start[j];
+    for (; k + 1 < start[j + 1]; k += 2)
     {
-      yj -= value[k] * y.row(row[k]);
+      even -= value[k] * y.row(row[k]);
+      odd -= value[k + 1] * y.row(row[k + 1]);
     }
-    y.row(j) = yj;
+    if (k < start[j + 1])
+    {
+      even -= value[k] * y.row(row[k]);
+    }
+    y.row(j) = even + odd;
   }
 }
 }
@@ -416,8 +436,9 @@ void SurfaceEnergy::PrepareAll(
   std::vector<std::vector<Eigen::Index>> missing(energies.size());
   std::vector<std::vector<Eigen::VectorXd>> solved(energies.size());
   std::vector<std::pair<size_t, size_t>> blocks; // (muscle, first column)
-  for (size_t m = 0; m < energies.size(); ++m)
+  for (const int muscle : CostliestFirst(energies))
   {
+    const auto m = static_cast<size_t>(muscle);
     missing[m] = energies[m]->Missing(keys[m]);
     solved[m].resize(missing[m].size());
     for (size_t first = 0; first < missing[m].size(); first += kBlock)
@@ -1203,28 +1224,41 @@ std::vector<Points> FreeMinima(const std::vector<const SurfaceEnergy*>& energies
   const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones)
 {
   std::vector<Points> free(energies.size());
+  const std::vector<int> order = CostliestFirst(energies);
 #pragma omp parallel for schedule(dynamic, 1)
-  for (int m = 0; m < static_cast<int>(energies.size()); ++m)
+  for (int k = 0; k < static_cast<int>(energies.size()); ++k)
   {
+    const int m = order[static_cast<size_t>(k)];
     free[m] = energies[m]->Solve(energies[m]->RightHandSide(lines[m], bones));
   }
   return free;
+}
+
+double LargestStartMove(
+  const SettleMotion& motion, const std::vector<const SurfaceEnergy*>& energies, const std::vector<Points>& freeMinima)
+{
+  const size_t count = energies.size();
+  if (motion.free.size() != count || freeMinima.size() != count)
+  {
+    return 0;
+  }
+  double largest = 0;
+  for (size_t m = 0; m < count; ++m)
+  {
+    largest = std::max(largest, (freeMinima[m] - motion.free[m]).rowwise().norm().maxCoeff() / energies[m]->Size());
+  }
+  return largest;
 }
 
 int SettleParts(const SettleMotion& motion, const std::vector<const SurfaceEnergy*>& energies,
   const std::vector<Points>& freeMinima, const SettleParameters& parameters)
 {
   constexpr int kMostParts = 64;
-  const size_t count = energies.size();
-  if (motion.free.size() != count || freeMinima.size() != count || !(parameters.largestStartMove > 0))
+  if (!(parameters.largestStartMove > 0))
   {
     return 1;
   }
-  double largest = 0; // relative to each muscle's size
-  for (size_t m = 0; m < count; ++m)
-  {
-    largest = std::max(largest, (freeMinima[m] - motion.free[m]).rowwise().norm().maxCoeff() / energies[m]->Size());
-  }
+  const double largest = LargestStartMove(motion, energies, freeMinima);
   return static_cast<int>(std::clamp(std::ceil(largest / parameters.largestStartMove), 1.0, double(kMostParts)));
 }
 
@@ -1333,6 +1367,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   {
     sizes[m] = energies[m]->Size();
   }
+  const std::vector<int> costliestFirst = CostliestFirst(energies);
   bool settled = false, diverging = false;
   int farMoves = 0;
   int iteration = 0;
@@ -1374,7 +1409,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
 #pragma omp parallel for schedule(dynamic, 1)
     for (int k = 0; k < static_cast<int>(count); ++k)
     {
-      const size_t m = static_cast<size_t>(k);
+      const size_t m = static_cast<size_t>(costliestFirst[static_cast<size_t>(k)]);
       volumeNow[m] = EnclosedVolume(meshes[m].points, meshes[m].triangles, &gradients[m]);
       along[m] = energies[m]->Solve(gradients[m]);
       // g . x_new = V - V(x) + g . x, the volume's linearisation at x.
@@ -1480,8 +1515,9 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
 #pragma omp parallel for schedule(dynamic, 1)
     for (int k = 0; k < static_cast<int>(count); ++k)
     {
-      Points& x = next[static_cast<size_t>(k)];
-      for (const Push& push : pushes[static_cast<size_t>(k)])
+      const size_t m = static_cast<size_t>(costliestFirst[static_cast<size_t>(k)]);
+      Points& x = next[m];
+      for (const Push& push : pushes[m])
       {
         for (Eigen::Index i = 0; i < x.rows(); ++i)
         {

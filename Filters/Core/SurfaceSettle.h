@@ -70,6 +70,18 @@ struct SettleParameters
   /// the minimum, not on whether a settle converged, so that the count changes with the input
   /// only where the move crosses a multiple of this, not under rounding noise.
   double largestStartMove = 0.125;
+  /// A step of a motion whose unconstrained minimum moves by more than this
+  /// fraction of a muscle's size starts with no contacts, even where the motion carries them
+  /// (SettleMotion::carryContacts): the muscle jumps (an OpenSim path point comes or goes, and its
+  /// line with it), and the contacts that held it before no longer fit. Carried there, the
+  /// settle swung between contacts for 30 iterations or more and was done again from none
+  /// whenever it had not converged by then: whether it had, rounding decided, and the two
+  /// answers lay 1.1 mm apart (LHDL hip_flexion frame 33, minimum moved by 0.10). Decided on the
+  /// minimum's move, like SettleParts, not on whether a settle converged: the LHDL motions' frames
+  /// move 0.017 (0.039 and 0.10 where a path point comes or goes), the phantom's sweep 0.03-0.05
+  /// (0.08 and 0.16 at two frames). At most half largestStartMove, so that every part of a step
+  /// split in parts moves farther than this too.
+  double largestCarriedMove = 0.0625;
   /// Linearisations of the volume and of the obstacles' surfaces. The LHDL hip's slowest step
   /// (flexion 60 degrees, N = 8, step 5) takes about 75 on the exact input and fewer on
   /// perturbed ones: at 50 the exact one was halved (InterpolatedDeformation) and the others
@@ -176,6 +188,8 @@ public:
   /// touches: a piece a scan left apart from the rest, with nothing but the follow rows to
   /// place it (it moves with its nearest action-line segment).
   std::int64_t PointsNoLineDrives() const { return this->Undriven; }
+  /// The entries of the energy's factor: what a solve with it costs.
+  Eigen::Index FactorEntries() const { return this->Factor.matrixL().nestedExpression().nonZeros(); }
   /// The points the welded surface uses.
   std::int64_t PointsUsed() const { return std::count(this->PointUsed.begin(), this->PointUsed.end(), 1); }
 
@@ -333,6 +347,12 @@ std::vector<Points> FreeMinima(const std::vector<const SurfaceEnergy*>& energies
 /// moves by more than SettleParameters::largestStartMove of its size (at most 64).
 int SettleParts(const SettleMotion& motion, const std::vector<const SurfaceEnergy*>& energies,
   const std::vector<Points>& freeMinima, const SettleParameters& parameters);
+
+/// How far the muscles' unconstrained minimum moves from where `motion` is to the pose whose
+/// minima are `freeMinima`: the largest point move, relative to its muscle's size (0 without
+/// a motion to start from).
+double LargestStartMove(
+  const SettleMotion& motion, const std::vector<const SurfaceEnergy*>& energies, const std::vector<Points>& freeMinima);
 
 /// Settles every muscle of `muscles` (their points in, the settled points out) to the minimum
 /// of its full-mesh energy for the pose `lines[m]` describes, holding `volumes[m]`, none of its

@@ -27,14 +27,36 @@ struct MotionCase
 /// (a scan's duplicate points stay duplicates); with `splitDuplicates` it is a
 /// function of the coordinate's place, so that they part by about 1e-7: how
 /// much the results depend on such perturbations.
-inline MotionCase Perturbed(MotionCase c, int seed, bool splitDuplicates = false)
+///
+/// `kept` (with splitDuplicates false): arrays perturbed before with the same seed, each with its
+/// perturbation, which an array equal to one of them takes instead of drawing it again (the same
+/// bits: the move is a function of the value and the seed). The frames of a motion share most of
+/// their arrays (the muscles, the bones that do not move), and a draw costs microseconds.
+struct PerturbedArrays
+{
+  std::vector<std::pair<md::Points, md::Points>> arrays; // (exact, perturbed)
+};
+inline MotionCase Perturbed(MotionCase c, int seed, bool splitDuplicates = false, PerturbedArrays* kept = nullptr)
 {
   int array = 0;
   auto perturb = [&](md::Points& points) {
     ++array;
-    for (Eigen::Index i = 0; i < points.size(); ++i)
+    if (kept && !splitDuplicates)
     {
-      double& x = points.data()[i];
+      for (const auto& [exact, perturbed] : kept->arrays)
+      {
+        if (exact.rows() == points.rows() && exact == points)
+        {
+          points = perturbed;
+          return;
+        }
+      }
+      kept->arrays.emplace_back(points, points);
+    }
+    md::Points& drawn = kept && !splitDuplicates ? kept->arrays.back().second : points;
+    for (Eigen::Index i = 0; i < drawn.size(); ++i)
+    {
+      double& x = drawn.data()[i];
       if (seed > 0)
       {
         const int key = splitDuplicates ? static_cast<int>(i) * 131 + array : static_cast<int>(std::hash<double>{}(x));
@@ -44,6 +66,7 @@ inline MotionCase Perturbed(MotionCase c, int seed, bool splitDuplicates = false
       }
       x = static_cast<double>(static_cast<float>(x));
     }
+    points = drawn;
   };
   for (md::MuscleMotion& m : c.muscles)
   {

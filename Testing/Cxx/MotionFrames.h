@@ -43,6 +43,7 @@ inline md::MotionPose PoseOf(const MotionCase& c, const std::vector<std::vector<
 inline bool LhdlFrames(const std::string& folder, const std::string& motion, int seed, MotionFrames& out)
 {
   out.name = "LHDL " + motion;
+  PerturbedArrays kept; // the frames share most of their arrays
   for (int k = 0;; ++k)
   {
     LhdlCase lhdl;
@@ -64,7 +65,7 @@ inline bool LhdlFrames(const std::string& folder, const std::string& motion, int
     }
     if (seed >= 0)
     {
-      c = Perturbed(c, seed); // the bones and the surfaces; the raw lines as they are
+      c = Perturbed(c, seed, false, &kept); // the bones and the surfaces; the raw lines as they are
     }
     if (k == 0)
     {

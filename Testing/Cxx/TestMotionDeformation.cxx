@@ -238,3 +238,53 @@ TEST(MotionDeformation, OnTheHipEveryFrameOfBothMotionsIsSound)
     }
   }
 }
+
+TEST(MotionDeformation, OnTheHipAMotionDependsOnNoRoundingNoise)
+{
+  // hip_flexion on the exact input and with every coordinate of the bones and muscles moved by at
+  // most 1e-7 of itself (seeds 1 and 2; BenchmarkMotion for more): the surfaces at every frame.
+  // Measured (Release): seeds 1 and 3 within 0.0006 mm at every frame, seed 2 too but at frames 33 and 34, where the
+  // iliacus's path point goes and its line jumps by 19 mm: there its settle from no contacts
+  // swings between contacts with the iliac bone for 25 iterations or so, and where it comes to
+  // rest moves by 0.14 and 0.17 mm (the psoas 0.015 mm); frame 35 is within 0.001 mm again.
+  // Before such a step started with no contacts (SettleParameters::largestCarriedMove), whether
+  // its carried contacts settled within 30 iterations decided which of two answers it took,
+  // 1.1 mm apart, and rounding decided that (the exact input against seeds 1, 2 and 3).
+  auto run = [](int seed, std::vector<std::vector<md::Points>>& points) {
+    MotionFrames frames;
+    if (!LhdlFrames("", "hip_flexion", seed, frames))
+    {
+      return false;
+    }
+    md::InterpolationParameters parameters;
+    parameters.numberOfSteps = 0; // the first frame in automatic steps, as the filter and BenchmarkMotion
+    md::MotionDeformation deformation(frames.muscles, frames.bones, parameters);
+    for (const md::MotionPose& pose : frames.poses)
+    {
+      points.push_back(deformation.Advance(pose).points);
+    }
+    return true;
+  };
+  std::vector<std::vector<md::Points>> exact;
+  if (!run(-1, exact))
+  {
+    GTEST_SKIP() << "the LHDL data (lhdl_hip_r) was not found";
+  }
+  for (const int seed : { 1, 2 })
+  {
+    std::vector<std::vector<md::Points>> perturbed;
+    ASSERT_TRUE(run(seed, perturbed));
+    ASSERT_EQ(perturbed.size(), exact.size());
+    double largest = 0;
+    for (size_t k = 0; k < exact.size(); ++k)
+    {
+      for (size_t m = 0; m < exact[k].size(); ++m)
+      {
+        const double distance = (perturbed[k][m] - exact[k][m]).rowwise().norm().maxCoeff();
+        largest = std::max(largest, distance);
+        EXPECT_LT(distance, k == 33 || k == 34 ? 0.25 : 0.01) << "seed " << seed << " frame " << k << " muscle " << m;
+      }
+    }
+    std::printf("[ measured ] seed %d: largest distance from the exact input's surfaces %.6f mm\n", seed, largest);
+  }
+}

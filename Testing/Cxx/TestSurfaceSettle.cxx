@@ -11,6 +11,7 @@
 #include "MotionCases.h"
 #include "NearestSegment.h"
 #include "RealData.h"
+#include "SettledSteps.h"
 #include "StaticIntersections.h"
 #include "SurfaceSettle.h"
 #include "TestMeshes.h"
@@ -431,6 +432,69 @@ TEST(SurfaceSettle, AMotionsContactsAreCarriedToItsNextStep)
   md::SettleMotion plain = md::StartMotion({ s.muscle }, { &energy }, { { s.line } }, bones);
   settle(plain, 25, first);
   EXPECT_TRUE(plain.held.empty());
+}
+
+TEST(SurfaceSettle, AMotionsStepThatJumpsStartsWithNoContacts)
+{
+  // SettleStep: a step whose unconstrained minimum moves farther than largestCarriedMove (the
+  // line jumps, as where an OpenSim path point comes or goes) starts with no contacts though the
+  // motion carries them, and ends where the same step with none carried ends, to the bit. The
+  // spindle against the box bone, its line bent 25 degrees, then 28 (an ordinary step) or 45 (a
+  // jump). (Which of the two starts the LHDL iliacus's jump had decided its answer to 1.1 mm:
+  // MotionDeformation.OnTheHipAMotionDependsOnNoRoundingNoise.)
+  const SpindleBesideABox setup;
+  const auto& [s, energy, bone, bones] = setup;
+  const md::TriangleMesh box = Box({ 5, 14, -20 }, { 45, 40, 20 });
+  const std::vector<md::Obstacle> obstacles{ { "box", std::make_shared<md::TriangleTree>(box) } };
+  const std::vector<md::FixedObstacle> fixed{ { "box", obstacles[0].tree.get() } };
+  const std::vector<md::PoseInterpolator> boneMotions{ md::PoseInterpolator(
+    box.points, box.points, md::InterpolationMode::Rigid) };
+  const std::vector<std::vector<md::Points>> restLines{ { s.line } };
+  const std::vector<double> volumes{ md::EnclosedVolume(s.muscle.points, s.muscle.triangles) };
+  const md::OverlapMasks noOverlap;
+  const std::vector<const md::SurfaceEnergy*> energies{ &energy };
+  md::SettleMotion at25 = md::StartMotion({ s.muscle }, energies, restLines, fixed);
+  at25.carryContacts = true;
+  std::vector<md::TriangleMesh> start{ s.muscle };
+  ASSERT_TRUE(md::SettleMuscles(
+    start, energies, { { { s.line, Bent(s.line, 25) } } }, volumes, fixed, nullptr, md::SettleParameters(), &at25)[0]
+                .converged);
+  ASSERT_FALSE(at25.held.empty());
+  struct Stepped
+  {
+    md::Points points;
+    int iterations = 0;
+  };
+  const md::SettleParameters parameters;
+  auto step = [&](double degrees, bool carried) {
+    const std::vector<std::vector<md::PoseInterpolator>> lineMotions{ { md::PoseInterpolator(
+      Bent(s.line, 25), Bent(s.line, degrees), md::InterpolationMode::Rigid) } };
+    const md::SettleInput in{ obstacles, boneMotions, lineMotions, restLines, energies, volumes, fixed, noOverlap,
+      parameters };
+    md::SettleMotion motion = at25;
+    if (!carried)
+    {
+      motion.held.clear();
+    }
+    std::vector<md::TriangleMesh> muscles = start;
+    const md::SettleReport report = md::SettleStep(in, 0, 1, muscles, motion, [](double) {})[0];
+    EXPECT_TRUE(report.converged) << degrees;
+    return Stepped{ muscles[0].points, report.iterations };
+  };
+  auto move = [&](double degrees) {
+    return md::LargestStartMove(
+      at25, energies, md::FreeMinima(energies, { { { s.line, Bent(s.line, degrees) } } }, fixed));
+  };
+  const double bound = md::SettleParameters().largestCarriedMove;
+  EXPECT_LT(move(28), bound); // measured 0.013
+  EXPECT_GT(move(45), bound); // 0.098
+  const Stepped jump = step(45, true), cold = step(45, false);
+  EXPECT_EQ(jump.iterations, cold.iterations);
+  EXPECT_TRUE(jump.points == cold.points);
+  // The ordinary step, carried, ends where the step from none ends, in no more iterations.
+  const Stepped warm = step(28, true), fresh = step(28, false);
+  EXPECT_LE(warm.iterations, fresh.iterations);
+  EXPECT_LT((warm.points - fresh.points).rowwise().norm().maxCoeff(), 1e-5 * s.Size());
 }
 
 TEST(SurfaceSettle, ASettleProvesWhichPointsAreOutsideEachBoneAndTheStaticResolutionSkipsThem)
