@@ -44,8 +44,9 @@ void AddFailedAttempt(std::vector<SettleReport>& reports, const std::vector<Sett
 
 /// A settle that starts with the last one's contacts (SettleMotion::carryContacts) converges in
 /// 5 to 23 iterations through the LHDL hip's motions; one that has not in this many started from
-/// contacts that no longer hold (where an OpenSim path point comes or goes, a muscle's line
-/// jumps) and is done again from none, as every settle that carries none is.
+/// contacts that no longer hold and is done again from none, as every settle that carries none
+/// is. (A step whose muscles jump, where an OpenSim path point comes or goes, carries none in the
+/// first place: SettleParameters::largestCarriedMove.)
 constexpr int kCarriedContactIterations = 30;
 
 /// Settles the muscles (`muscles`' points out) from where `motion` is, the pose at fraction
