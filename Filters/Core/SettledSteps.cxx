@@ -133,10 +133,11 @@ std::vector<SettleReport> SettleStep(const SettleInput& in, double from, double 
 {
   RefitBones(in, to);
   std::vector<Points> freeMinima = FreeMinima(in.energies, LinesAt(in, to), in.fixed);
-  const int parts = SettleParts(motion, in.energies, freeMinima, in.parameters);
+  const double move = LargestStartMove(motion, in.energies, freeMinima);
+  const int parts = SettleParts(move, in.parameters);
   // A step whose minimum moves farther than largestCarriedMove starts every part with no
   // contacts: with largestCarriedMove at most half largestStartMove, each part moves farther too.
-  const bool carry = LargestStartMove(motion, in.energies, freeMinima) <= in.parameters.largestCarriedMove;
+  const bool carry = move <= in.parameters.largestCarriedMove;
   std::vector<SettleReport> reports;
   auto settlePart = [&](int k, std::vector<Points> minima) {
     const double start = k == 1 ? from : from + (to - from) * (k - 1) / parts;

@@ -1252,16 +1252,14 @@ double LargestStartMove(
   return largest;
 }
 
-int SettleParts(const SettleMotion& motion, const std::vector<const SurfaceEnergy*>& energies,
-  const std::vector<Points>& freeMinima, const SettleParameters& parameters)
+int SettleParts(double startMove, const SettleParameters& parameters)
 {
   constexpr int kMostParts = 64;
   if (!(parameters.largestStartMove > 0))
   {
     return 1;
   }
-  const double largest = LargestStartMove(motion, energies, freeMinima);
-  return static_cast<int>(std::clamp(std::ceil(largest / parameters.largestStartMove), 1.0, double(kMostParts)));
+  return static_cast<int>(std::clamp(std::ceil(startMove / parameters.largestStartMove), 1.0, double(kMostParts)));
 }
 
 std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,

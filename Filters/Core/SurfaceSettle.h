@@ -342,17 +342,16 @@ SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::ve
 std::vector<Points> FreeMinima(const std::vector<const SurfaceEnergy*>& energies,
   const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones);
 
-/// How many equal parts a motion's step from where `motion` is to a pose whose unconstrained
-/// minima are `freeMinima` (FreeMinima's) is settled in: the fewest in which no muscle's minimum
-/// moves by more than SettleParameters::largestStartMove of its size (at most 64).
-int SettleParts(const SettleMotion& motion, const std::vector<const SurfaceEnergy*>& energies,
-  const std::vector<Points>& freeMinima, const SettleParameters& parameters);
-
 /// How far the muscles' unconstrained minimum moves from where `motion` is to the pose whose
-/// minima are `freeMinima`: the largest point move, relative to its muscle's size (0 without
-/// a motion to start from).
+/// minima are `freeMinima` (FreeMinima's): the largest point move, relative to its muscle's size
+/// (0 without a motion to start from).
 double LargestStartMove(
   const SettleMotion& motion, const std::vector<const SurfaceEnergy*>& energies, const std::vector<Points>& freeMinima);
+
+/// How many equal parts a motion's step whose minimum moves by `startMove` (LargestStartMove's)
+/// is settled in: the fewest in which no muscle's minimum moves by more than
+/// SettleParameters::largestStartMove of its size (at most 64).
+int SettleParts(double startMove, const SettleParameters& parameters);
 
 /// Settles every muscle of `muscles` (their points in, the settled points out) to the minimum
 /// of its full-mesh energy for the pose `lines[m]` describes, holding `volumes[m]`, none of its

@@ -41,7 +41,8 @@ inline MotionCase Perturbed(MotionCase c, int seed, bool splitDuplicates = false
   int array = 0;
   auto perturb = [&](md::Points& points) {
     ++array;
-    if (kept && !splitDuplicates)
+    const bool keep = kept && !splitDuplicates;
+    if (keep)
     {
       for (const auto& [exact, perturbed] : kept->arrays)
       {
@@ -51,12 +52,11 @@ inline MotionCase Perturbed(MotionCase c, int seed, bool splitDuplicates = false
           return;
         }
       }
-      kept->arrays.emplace_back(points, points);
     }
-    md::Points& drawn = kept && !splitDuplicates ? kept->arrays.back().second : points;
-    for (Eigen::Index i = 0; i < drawn.size(); ++i)
+    const md::Points exact = keep ? points : md::Points();
+    for (Eigen::Index i = 0; i < points.size(); ++i)
     {
-      double& x = drawn.data()[i];
+      double& x = points.data()[i];
       if (seed > 0)
       {
         const int key = splitDuplicates ? static_cast<int>(i) * 131 + array : static_cast<int>(std::hash<double>{}(x));
@@ -66,7 +66,10 @@ inline MotionCase Perturbed(MotionCase c, int seed, bool splitDuplicates = false
       }
       x = static_cast<double>(static_cast<float>(x));
     }
-    points = drawn;
+    if (keep)
+    {
+      kept->arrays.emplace_back(exact, points);
+    }
   };
   for (md::MuscleMotion& m : c.muscles)
   {
