@@ -173,7 +173,8 @@ bool CheckLeaf(vtkPolyData* data, const std::string& label, std::string& error)
 }
 }
 
-bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves, std::string& error)
+bool CollectLeaves(
+  vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves, std::string& error, bool checkData)
 {
   leaves.clear();
   if (!input)
@@ -184,7 +185,7 @@ bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vect
   if (auto* polyData = vtkPolyData::SafeDownCast(input))
   {
     leaves.push_back(Leaf{ "", polyData, inputName });
-    return CheckLeaf(polyData, inputName, error);
+    return !checkData || CheckLeaf(polyData, inputName, error);
   }
   auto* tree = vtkMultiBlockDataSet::SafeDownCast(input);
   if (!tree)
@@ -209,7 +210,7 @@ bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vect
       error = label + " is a " + leaf->GetClassName() + ", not a vtkPolyData";
       ok = false;
     }
-    if (polyData && ok)
+    if (polyData && ok && checkData)
     {
       ok = CheckLeaf(polyData, label, error);
     }
@@ -221,6 +222,21 @@ bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vect
     ok = false;
   }
   return ok;
+}
+
+vtkMTimeType DataMTime(vtkDataObject* input)
+{
+  vtkMTimeType latest = input ? input->GetMTime() : 0;
+  if (auto* tree = vtkMultiBlockDataSet::SafeDownCast(input))
+  {
+    ForEachLeaf(tree, [&](vtkDataObjectTreeIterator* it) {
+      if (vtkDataObject* leaf = it->GetCurrentDataObject())
+      {
+        latest = std::max(latest, leaf->GetMTime());
+      }
+    });
+  }
+  return latest;
 }
 
 bool PairLeaves(vtkObject* reporter, const std::vector<Leaf>& a, const std::string& nameA, const std::vector<Leaf>& b,

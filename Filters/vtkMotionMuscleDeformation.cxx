@@ -327,12 +327,15 @@ struct Leaves
   std::vector<size_t> restLinesOf, motionLinesOf;
 };
 
-bool CollectInputs(vtkMotionMuscleDeformation* self, vtkDataObject* const inputs[5], Leaves& leaves, std::string& error)
+/// `checkRest` false: the rest-pose inputs were checked before and not modified since, and are
+/// not checked again (the bones' 130 000 points at every frame of the LHDL hip).
+bool CollectInputs(
+  vtkMotionMuscleDeformation* self, vtkDataObject* const inputs[5], bool checkRest, Leaves& leaves, std::string& error)
 {
-  return mdvtk::CollectLeaves(inputs[0], PortNames[0], leaves.muscles, error) &&
-    mdvtk::CollectLeaves(inputs[3], PortNames[3], leaves.restLines, error) &&
+  return mdvtk::CollectLeaves(inputs[0], PortNames[0], leaves.muscles, error, checkRest) &&
+    mdvtk::CollectLeaves(inputs[3], PortNames[3], leaves.restLines, error, checkRest) &&
     mdvtk::CollectLeaves(inputs[4], PortNames[4], leaves.motionLines, error) &&
-    mdvtk::CollectLeaves(inputs[1], PortNames[1], leaves.restBones, error) &&
+    mdvtk::CollectLeaves(inputs[1], PortNames[1], leaves.restBones, error, checkRest) &&
     mdvtk::PairLeaves(self, leaves.muscles, PortNames[0], leaves.restLines, PortNames[3], leaves.restLinesOf, error) &&
     mdvtk::PairLeaves(
       self, leaves.restLines, PortNames[3], leaves.motionLines, PortNames[4], leaves.motionLinesOf, error);
@@ -356,7 +359,7 @@ int vtkMotionMuscleDeformation::RequestData(
     inputs[port] = vtkDataObject::GetData(inputVector[port], 0);
     if (port != kMotionPorts[0] && port != kMotionPorts[1])
     {
-      signature.restInputs = std::max(signature.restInputs, inputs[port] ? inputs[port]->GetMTime() : 0);
+      signature.restInputs = std::max(signature.restInputs, mdvtk::DataMTime(inputs[port]));
     }
     else if (auto* executive = vtkDemandDrivenPipeline::SafeDownCast(this->GetInputExecutive(port, 0)))
     {
@@ -376,7 +379,10 @@ int vtkMotionMuscleDeformation::RequestData(
   }
   Leaves leaves;
   std::string error;
-  if (!CollectInputs(this, inputs, leaves, error))
+  // The deformation was built from rest-pose inputs that passed the checks: while they are not
+  // modified, a frame checks only the time-varying inputs.
+  const bool restChecked = in.deformation && signature == in.signature;
+  if (!CollectInputs(this, inputs, !restChecked, leaves, error))
   {
     vtkErrorMacro(<< error);
     return stop(0);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 
 namespace md
@@ -91,5 +92,39 @@ Points PoseInterpolator::AtFraction(double s) const
     return (1.0 - s) * this->Rest + s * this->Current;
   }
   return this->Screw->At(s).Apply(this->Rest) + s * this->Residual;
+}
+
+std::vector<PoseInterpolator> PoseInterpolators(
+  const std::vector<Points>& rest, const std::vector<Points>& current, InterpolationMode mode)
+{
+  if (rest.size() != current.size())
+  {
+    throw InputError("the rest pose has " + std::to_string(rest.size()) + " parts but the current pose has " +
+      std::to_string(current.size()));
+  }
+  std::vector<std::optional<PoseInterpolator>> built(rest.size());
+  std::vector<std::exception_ptr> failed(rest.size()); // no exception may leave a parallel region
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int k = 0; k < static_cast<int>(rest.size()); ++k)
+  {
+    try
+    {
+      built[k].emplace(rest[k], current[k], mode);
+    }
+    catch (...)
+    {
+      failed[k] = std::current_exception();
+    }
+  }
+  std::vector<PoseInterpolator> interpolators;
+  for (size_t k = 0; k < built.size(); ++k)
+  {
+    if (failed[k])
+    {
+      std::rethrow_exception(failed[k]);
+    }
+    interpolators.push_back(std::move(*built[k]));
+  }
+  return interpolators;
 }
 }

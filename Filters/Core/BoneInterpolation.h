@@ -7,6 +7,7 @@
 #include "RigidMotion.h"
 
 #include <optional>
+#include <vector>
 
 namespace md
 {
@@ -48,4 +49,9 @@ private:
   std::optional<ScrewInterpolation> Screw;
   Points Residual; // CP minus the fitted rigid motion of the RP, blended in linearly
 };
+
+/// One PoseInterpolator per pair rest[k] -> current[k], built in parallel (each fits a rigid
+/// motion to all the points of a bone). Throws the first pair's InputError.
+std::vector<PoseInterpolator> PoseInterpolators(
+  const std::vector<Points>& rest, const std::vector<Points>& current, InterpolationMode mode);
 }

@@ -508,6 +508,7 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
     current[m] = muscles[m].muscle;
   }
   const OverlapMasks restOverlap = FindOverlaps(current, fixed);
+  const std::vector<NewSharpEdges> sharpEdges = MuscleSharpEdges(muscles);
 
   // The full-mesh energies (rest pose only), kept for every step; each step's settle goes on
   // from the last one's answer (from the rest pose at the first), so the answer depends
@@ -622,7 +623,7 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
     }
     const std::vector<std::vector<char>> outsideBones = ProvenOutsideBones(settleMotion.boneClearance);
     measures = ResolveAndMeasure(next, muscles, fixed, restOverlap, restVolumes, parameters, outcomes, previous,
-      measures, settle ? &outsideBones : nullptr);
+      measures, settle ? &outsideBones : nullptr, &sharpEdges);
     if (!settle)
     {
       RefitHulls(hullPass, next, deformed, muscles, parameters, measures);

@@ -79,6 +79,22 @@ std::vector<std::vector<std::int64_t>> PointNeighbours(const Triangles& triangle
 std::int64_t CountNewSharpEdges(
   const Points& rest, const Points& current, const Triangles& triangles, double angleDegrees = 60.0);
 
+/// CountNewSharpEdges for many poses of one rest surface: the edges not sharp at rest are
+/// found once (pairing the triangles by edge is most of the count's time).
+class NewSharpEdges
+{
+public:
+  NewSharpEdges() = default;
+  NewSharpEdges(const Points& rest, const Triangles& triangles, double angleDegrees = 60.0);
+  /// The edges not sharp at rest that are sharp in `current` (the rest surface's triangles).
+  std::int64_t Count(const Points& current) const;
+
+private:
+  Triangles TrianglesAtRest;
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> NotSharpAtRest; ///< the two triangles of each edge
+  double Limit = 0.5;                                                ///< cosine of the angle
+};
+
 /// Number of pairs of triangles that intersect other than at what they share.
 std::int64_t CountSelfIntersections(const TriangleMesh& surface);
 }

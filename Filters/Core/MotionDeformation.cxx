@@ -119,6 +119,7 @@ struct MotionDeformation::Internals
   std::vector<FixedObstacle> fixed;
   std::vector<std::string> boneNames;
   OverlapMasks restOverlap;
+  std::vector<NewSharpEdges> sharpEdges; ///< [active]
   LineSamplesInside linesInBonesAtRest;
   size_t muscleCount = 0;
   double preparationSeconds = 0;
@@ -240,6 +241,7 @@ MotionDeformation::MotionDeformation(const std::vector<Muscle>& muscles, const s
     state->current.push_back(m.muscle);
   }
   in.restOverlap = FindOverlaps(state->current, in.fixed);
+  in.sharpEdges = MuscleSharpEdges(in.muscles);
   state->settle = StartMotion(state->current, in.energyPointers, in.restLines, in.fixed);
   state->settle.carryContacts = true; // a frame's contacts are the last frame's, moved on
   std::vector<std::vector<MatchedLine>> still;
@@ -423,11 +425,8 @@ MotionFrameResult MotionDeformation::Advance(const MotionPose& worldPose, const 
   }
   if (steps > 0)
   {
-    std::vector<PoseInterpolator> boneMotions;
-    for (size_t b = 0; b < pose.bones.size(); ++b)
-    {
-      boneMotions.emplace_back(from.pose.bones[b], pose.bones[b], in.parameters.interpolationMode);
-    }
+    const std::vector<PoseInterpolator> boneMotions =
+      PoseInterpolators(from.pose.bones, pose.bones, in.parameters.interpolationMode);
     std::vector<std::vector<PoseInterpolator>> lineMotions(count);
     for (size_t k = 0; k < count; ++k)
     {
@@ -460,8 +459,9 @@ MotionFrameResult MotionDeformation::Advance(const MotionPose& worldPose, const 
         outcomes[k] = { settled[k].iterations, settled[k].converged, 0, settled[k].seconds };
       }
       const std::vector<std::vector<char>> outsideBones = ProvenOutsideBones(next->settle.boneClearance);
-      std::vector<MuscleStepMeasures> measures = ResolveAndMeasure(muscles, in.muscles, in.fixed, in.restOverlap,
-        in.restVolumes, in.parameters, outcomes, next->previous, std::vector<MuscleStepMeasures>(count), &outsideBones);
+      std::vector<MuscleStepMeasures> measures =
+        ResolveAndMeasure(muscles, in.muscles, in.fixed, in.restOverlap, in.restVolumes, in.parameters, outcomes,
+          next->previous, std::vector<MuscleStepMeasures>(count), &outsideBones, &in.sharpEdges);
       for (size_t k = 0; k < count; ++k)
       {
         const int iterations = frameMeasures[k].stepIterations + measures[k].stepIterations;

@@ -959,9 +959,10 @@ std::vector<Eigen::Index> FlippedTriangles(
     {
       continue; // degenerate: no orientation to compare
     }
-    const Eigen::Matrix3d rotation =
-      BestRotationDirect(covariance[triangles(t, 0)] + covariance[triangles(t, 1)] + covariance[triangles(t, 2)]);
-    flipped[t] = n1.dot(rotation * n0) < 0;
+    const Eigen::Matrix3d local =
+      covariance[triangles(t, 0)] + covariance[triangles(t, 1)] + covariance[triangles(t, 2)];
+    const int sign = SignUnderBestRotation(local, n0, n1);
+    flipped[t] = sign != 0 ? sign < 0 : n1.dot(BestRotationDirect(local) * n0) < 0;
   }
   std::vector<Eigen::Index> list;
   for (Eigen::Index t = 0; t < m; ++t)

@@ -92,6 +92,79 @@ Eigen::Matrix3d BestRotationDirect(const Eigen::Matrix3d& covariance)
 
 namespace
 {
+/// The cofactor matrix: det(X) X^-T where X is invertible.
+Eigen::Matrix3d Cofactor(const Eigen::Matrix3d& x)
+{
+  Eigen::Matrix3d cofactor;
+  for (int i = 0; i < 3; ++i)
+  {
+    for (int j = 0; j < 3; ++j)
+    {
+      const int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+      cofactor(i, j) = x(i1, j1) * x(i2, j2) - x(i1, j2) * x(i2, j1);
+    }
+  }
+  return cofactor;
+}
+}
+
+int SignUnderBestRotation(const Eigen::Matrix3d& covariance, const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+{
+  // With C = U diag(s1, s2, s3) V^T, U and V proper rotations and s3 of det C's sign, R = U V^T,
+  // and C's cofactor matrix is U diag(s2 s3, s1 s3, s1 s2) V^T. So M = C + cof(C) / |C|_F has the
+  // same U and V and singular values (s1 + s2 s3 / |C|, s2 + s1 s3 / |C|, s3 + s1 s2 / |C|), the
+  // first two >= 0 (|C| >= s1 >= s2 >= |s3|): where det M > 0 all are, and R is M's polar factor.
+  // A muscle's local covariances are near rank 2 (the edges lie near the surface: s3 near 0),
+  // where M is far better conditioned than C; scaled Newton steps X <- (z X + X^-T / z) / 2 keep
+  // the polar factor and bring the singular values together.
+  // With X = R S and S's eigenvalues within [L, U], |X / k - R| = |S / k - I| <= e = (U - L) / (U + L)
+  // for k = (U + L) / 2: so b . (R a) has the sign of b . (X a) where that exceeds e k |a| |b|.
+  // The bounds: the eigenvalues of X^T X lie within sqrt(2/3) d of their mean, d being the
+  // Frobenius distance of X^T X from that mean times I (the deviations sum to zero).
+  const double size = covariance.norm();
+  if (!(size > 0) || !std::isfinite(size))
+  {
+    return 0;
+  }
+  Eigen::Matrix3d x = covariance + Cofactor(covariance) / size;
+  // Far from singular (a condition number of at most about 1e4): rounding stays far below the
+  // margin, and the best rotation is unique (C's two largest singular values clear of zero and
+  // of each other's negatives).
+  constexpr double kLeastDeterminant = 1e-4; // of |M|_F^3
+  if (!(x.determinant() > kLeastDeterminant * std::pow(x.norm(), 3)))
+  {
+    return 0;
+  }
+  const double scale = a.norm() * b.norm();
+  constexpr int kNewtonSteps = 3;
+  for (int step = 0;; ++step)
+  {
+    const Eigen::Matrix3d product = x.transpose() * x;
+    const double mean = product.trace() / 3;
+    const double spread =
+      std::sqrt((product - mean * Eigen::Matrix3d::Identity()).squaredNorm() * (2.0 / 3.0)) + 1e-12 * mean;
+    if (mean - spread > 0)
+    {
+      const double upper = std::sqrt(mean + spread), lower = std::sqrt(mean - spread);
+      const double reach = (upper - lower) / (upper + lower) + 1e-7; // + rounding, with a wide margin
+      const double value = b.dot(x * a) / (0.5 * (upper + lower));
+      if (std::abs(value) > reach * scale)
+      {
+        return value > 0 ? 1 : -1;
+      }
+    }
+    if (step == kNewtonSteps)
+    {
+      return 0;
+    }
+    const Eigen::Matrix3d inverseTransposed = Cofactor(x) / x.determinant();
+    const double z = std::sqrt(std::sqrt(inverseTransposed.squaredNorm() / x.squaredNorm()));
+    x = 0.5 * (z * x + inverseTransposed / z);
+  }
+}
+
+namespace
+{
 /// Points spread across their own axis by less than this fraction of their spread along it
 /// (the smaller two singular values of the covariance against the largest) are nearly
 /// collinear: the rotation about that axis is fixed by the pull to the identity below.

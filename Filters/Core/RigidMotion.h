@@ -42,6 +42,11 @@ Eigen::Matrix3d BestRotation(const Eigen::Matrix3d& covariance);
 /// singular values stand clear of zero; BestRotation itself where they do not.
 Eigen::Matrix3d BestRotationDirect(const Eigen::Matrix3d& covariance);
 
+/// The sign of b . (R a), R = BestRotationDirect(covariance), where bounds on the covariance's
+/// singular values tell it without R (at a small part of its cost): +1 or -1; 0 where they do not
+/// (the covariance far from a scaled rotation, or the product near zero), and R must be computed.
+int SignUnderBestRotation(const Eigen::Matrix3d& covariance, const Eigen::Vector3d& a, const Eigen::Vector3d& b);
+
 /// Proper rotation and translation minimising sum |to_i - (R from_i + t)|^2
 /// (Kabsch / Horn). Both sets must have the same number of points (>= 1).
 RigidFit FitRigidTransform(const Points& from, const Points& to);

@@ -197,7 +197,8 @@ std::vector<MuscleStepMeasures> ResolveAndMeasure(std::vector<TriangleMesh>& nex
   const std::vector<MuscleMotion>& muscles, const std::vector<FixedObstacle>& fixed, const OverlapMasks& restOverlap,
   const std::vector<double>& restVolumes, const InterpolationParameters& parameters,
   const std::vector<StepOutcome>& outcomes, const std::vector<MuscleStepMeasures>& previous,
-  std::vector<MuscleStepMeasures> measures, const std::vector<std::vector<char>>* outsideBones)
+  std::vector<MuscleStepMeasures> measures, const std::vector<std::vector<char>>* outsideBones,
+  const std::vector<NewSharpEdges>* sharpEdges)
 {
   const size_t count = next.size();
   StaticResolveResult resolved =
@@ -248,7 +249,8 @@ std::vector<MuscleStepMeasures> ResolveAndMeasure(std::vector<TriangleMesh>& nex
     s.stepStaticShift = resolved.reports[m].maxShift;
     s.maxStaticShift = std::max(previous[m].maxStaticShift, s.stepStaticShift);
     s.staticallyMovedPoints = resolved.reports[m].penetratingPoints;
-    s.sharpEdgeCount = CountNewSharpEdges(rest.points, next[m].points, rest.triangles);
+    s.sharpEdgeCount = sharpEdges ? (*sharpEdges)[m].Count(next[m].points)
+                                  : NewSharpEdges(rest.points, rest.triangles).Count(next[m].points);
     s.flippedTriangleCount = CountFlippedTriangles(rest.points, next[m].points, rest.triangles);
     s.stepIterations = outcomes[m].iterations;
     s.iterations = previous[m].iterations + s.stepIterations;
@@ -258,6 +260,17 @@ std::vector<MuscleStepMeasures> ResolveAndMeasure(std::vector<TriangleMesh>& nex
     s.staticShift = std::move(resolved.shift[m]);
   }
   return measures;
+}
+
+std::vector<NewSharpEdges> MuscleSharpEdges(const std::vector<MuscleMotion>& muscles)
+{
+  std::vector<NewSharpEdges> edges(muscles.size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int m = 0; m < static_cast<int>(muscles.size()); ++m)
+  {
+    edges[m] = NewSharpEdges(muscles[m].muscle.points, muscles[m].muscle.triangles);
+  }
+  return edges;
 }
 
 std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vector<MuscleMotion>& muscles,

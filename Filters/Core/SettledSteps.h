@@ -8,6 +8,7 @@
 #include "BoneInterpolation.h"
 #include "InterpolatedDeformation.h"
 #include "LocalFrame.h"
+#include "MeshChecks.h"
 #include "StaticIntersections.h"
 #include "SurfaceSettle.h"
 
@@ -73,12 +74,17 @@ struct StepOutcome
 /// the rest pose (`muscles`) and the last step's (`previous`). `measures` brings what the step
 /// measured already (its hull seconds) and is returned complete. `outsideBones`: the settle's
 /// proof of which points are outside which bone (ProvenOutsideBones), when `next` is
-/// where a settle left the muscles.
+/// where a settle left the muscles. `sharpEdges`: the muscles' rest edges (MuscleSharpEdges),
+/// found once for many steps; found here when null.
 std::vector<MuscleStepMeasures> ResolveAndMeasure(std::vector<TriangleMesh>& next,
   const std::vector<MuscleMotion>& muscles, const std::vector<FixedObstacle>& fixed, const OverlapMasks& restOverlap,
   const std::vector<double>& restVolumes, const InterpolationParameters& parameters,
   const std::vector<StepOutcome>& outcomes, const std::vector<MuscleStepMeasures>& previous,
-  std::vector<MuscleStepMeasures> measures, const std::vector<std::vector<char>>* outsideBones = nullptr);
+  std::vector<MuscleStepMeasures> measures, const std::vector<std::vector<char>>* outsideBones = nullptr,
+  const std::vector<NewSharpEdges>* sharpEdges = nullptr);
+
+/// Each muscle's NewSharpEdges at rest, found in parallel.
+std::vector<NewSharpEdges> MuscleSharpEdges(const std::vector<MuscleMotion>& muscles);
 
 /// A step's measures computed in `frame`, their lengths in world units.
 void MeasuresToWorld(const LocalFrame& frame, MuscleStepMeasures& measures);

@@ -109,6 +109,91 @@ TEST(RigidMotion, TheDirectBestRotationIsTheSvdsToRounding)
   EXPECT_LT(worst, 1e-12);
 }
 
+TEST(RigidMotion, SignUnderBestRotationAgreesWithTheRotationAndDecidesForSurfaces)
+{
+  // The same kinds of covariance as above, and the triangles' normals as FlippedTriangles asks
+  // about them: where the sign is told without the rotation it is the rotation's, and a surface
+  // moved near rigidly (a flat covariance, singular values within a factor 3) is told at once
+  // for all but a few pairs whose product is near zero.
+  std::mt19937 generator(11);
+  std::uniform_real_distribution<double> entry(-1, 1);
+  auto rotation = [&] {
+    return Eigen::Quaterniond(Eigen::Vector4d::NullaryExpr([&](Eigen::Index) { return entry(generator); }).normalized())
+      .toRotationMatrix();
+  };
+  auto vector = [&] {
+    return Eigen::Vector3d(entry(generator), entry(generator), entry(generator));
+  };
+  int told = 0, disagreed = 0, flat = 0, flatTold = 0;
+  for (int k = 0; k < 12000; ++k)
+  {
+    Eigen::Vector3d singular(1 + 0.5 * entry(generator), 1 + 0.5 * entry(generator), 0.05 * entry(generator));
+    switch (k % 6)
+    {
+      case 1:
+        singular(2) = 1 + entry(generator); // general
+        break;
+      case 2:
+        singular(2) = -singular(1); // mirrored, the smaller two alike
+        break;
+      case 3:
+        singular(1) = singular(2) = 0; // one clear of zero
+        break;
+      case 4:
+        singular(2) = -std::abs(singular(2)) - 0.5; // mirrored
+        break;
+      default:
+        break; // flat, as a surface's edges give
+    }
+    const Eigen::Matrix3d u = rotation(), v = rotation();
+    const Eigen::Matrix3d covariance = 30 * u * singular.asDiagonal() * v.transpose();
+    // The rest normal near the flat covariance's normal direction, the deformed one near where
+    // the motion takes it or against it (a flip), or anywhere.
+    const Eigen::Vector3d n0 = v.col(2) + 0.3 * vector(), n1 = (k % 12 < 6 ? 1.0 : -1.0) * u.col(2) + 0.3 * vector();
+    const int sign = md::SignUnderBestRotation(covariance, n0, n1);
+    const double exact = n1.dot(md::BestRotationDirect(covariance) * n0);
+    told += sign != 0 ? 1 : 0;
+    disagreed += sign != 0 && (sign > 0) != (exact > 0) ? 1 : 0;
+    if (k % 6 == 0 || k % 6 == 5)
+    {
+      ++flat;
+      flatTold += sign != 0 ? 1 : 0;
+    }
+    const Eigen::Vector3d a = vector(), b = vector(); // any directions
+    const int anySign = md::SignUnderBestRotation(covariance, a, b);
+    disagreed += anySign != 0 && (anySign > 0) != (b.dot(md::BestRotationDirect(covariance) * a) > 0) ? 1 : 0;
+  }
+  EXPECT_EQ(disagreed, 0);
+  EXPECT_GT(flatTold, 0.97 * flat) << "of " << flat << " flat covariances";
+  EXPECT_LT(told, 12000); // the mirrored and singular ones are left to the rotation
+  EXPECT_EQ(md::SignUnderBestRotation(Eigen::Matrix3d::Zero(), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitX()), 0);
+  Eigen::Matrix3d broken = Eigen::Matrix3d::Identity();
+  broken(0, 1) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(md::SignUnderBestRotation(broken, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitX()), 0);
+}
+
+TEST(BoneInterpolation, PoseInterpolatorsAreTheOnesBuiltOneByOneAndPassOnTheirErrors)
+{
+  std::vector<Points> rest, current;
+  for (unsigned k = 0; k < 3; ++k)
+  {
+    rest.push_back(RandomCloud(40 + 10 * static_cast<int>(k), 20 + k, 30));
+    const md::RigidTransform motion = md::RigidTransform::AboutPoint(axis, 0.3 * (k + 1), joint);
+    current.push_back(motion.Apply(rest.back()) + 1e-3 * RandomCloud(rest.back().rows(), 30 + k, 1));
+  }
+  const std::vector<md::PoseInterpolator> built = md::PoseInterpolators(rest, current, md::InterpolationMode::Rigid);
+  ASSERT_EQ(built.size(), 3u);
+  for (size_t k = 0; k < 3; ++k)
+  {
+    const md::PoseInterpolator alone(rest[k], current[k], md::InterpolationMode::Rigid);
+    EXPECT_EQ(built[k].AtFraction(0.37), alone.AtFraction(0.37)) << "bone " << k;
+  }
+  current[1] = current[1].topRows(5); // a bone that lost points
+  EXPECT_THROW(md::PoseInterpolators(rest, current, md::InterpolationMode::Rigid), md::InputError);
+  current.pop_back();
+  EXPECT_THROW(md::PoseInterpolators(rest, current, md::InterpolationMode::Linear), md::InputError);
+}
+
 TEST(RigidMotion, ScrewInterpolationKeepsTheJointCentreFixed)
 {
   const Points rest = RandomCloud(50, 2, 40);

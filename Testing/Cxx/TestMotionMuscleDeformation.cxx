@@ -269,6 +269,35 @@ TEST(MotionMuscleDeformation, BadMotionsGiveClearErrorsAndNoCrash)
   }
 }
 
+TEST(MotionMuscleDeformation, ARestInputModifiedInPlaceIsReadAndCheckedAgain)
+{
+  // A frame checks the rest-pose inputs only when they were modified since they were checked:
+  // a leaf modified in place (the multiblock holding it is not) counts, and starts the motion again.
+  PhantomMotionPipeline p(30, 6);
+  p.phantom->Update();
+  vtkNew<vtkMultiBlockDataSet> muscles;
+  muscles->DeepCopy(p.phantom->GetOutputDataObject(0));
+  p.motion->SetInputData(0, muscles);
+  ASSERT_EQ(p.At(2), 1);
+  ASSERT_EQ(p.At(3), 1);
+  EXPECT_EQ(p.motion->GetFramesComputed(), 4);
+  auto* leaf = vtkPolyData::SafeDownCast(muscles->GetBlock(1));
+  ASSERT_NE(leaf, nullptr);
+  double kept[3];
+  leaf->GetPoint(7, kept);
+  leaf->GetPoints()->SetPoint(7, std::nan(""), 0.0, 0.0);
+  leaf->GetPoints()->Modified();
+  {
+    CapturedMessages messages;
+    EXPECT_EQ(p.At(4), 0);
+    EXPECT_TRUE(messages.Contains("NaN or infinite coordinates (point 7)")) << messages.Text();
+  }
+  leaf->GetPoints()->SetPoint(7, kept);
+  leaf->GetPoints()->Modified();
+  ASSERT_EQ(p.At(5), 1);                           // another time: the pipeline does not see into the multiblock either
+  EXPECT_EQ(p.motion->GetFramesComputed(), 4 + 6); // frames 0 ... 5 again, from the rest pose
+}
+
 TEST(MotionMuscleDeformation, AStoppedRunKeepsTheFramesDoneAndTheNextGoesOnFromThem)
 {
   PhantomMotionPipeline p(30, 6);
