@@ -173,6 +173,8 @@ bool CheckLeaf(vtkPolyData* data, const std::string& label, std::string& error)
 }
 }
 
+namespace
+{
 bool CollectLeaves(
   vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves, std::string& error, bool checkData)
 {
@@ -222,6 +224,23 @@ bool CollectLeaves(
     ok = false;
   }
   return ok;
+}
+}
+
+bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves, std::string& error)
+{
+  return CollectLeaves(input, inputName, leaves, error, true);
+}
+
+bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves, std::string& error,
+  InputCheck& checked)
+{
+  if (!CollectLeaves(input, inputName, leaves, error, !checked.Unchanged(input)))
+  {
+    return false;
+  }
+  checked.Passed(input);
+  return true;
 }
 
 vtkMTimeType DataMTime(vtkDataObject* input)

@@ -23,6 +23,11 @@
 #include <memory>
 #include <string>
 
+namespace mdvtk
+{
+class InputCheck;
+}
+
 class MUSCLEDEFORMATIONFILTERS_EXPORT vtkActionLineGrouping : public vtkMultiBlockDataSetAlgorithm
 {
 public:
@@ -56,6 +61,9 @@ protected:
   /// frame of a motion) reuses it, and says nothing again.
   struct Grouped;
   std::unique_ptr<Grouped> LastGrouping;
+  /// The muscles and the rest pose's paths as they last passed the input checks: the same at
+  /// every frame of a motion, not checked again.
+  std::unique_ptr<mdvtk::InputCheck[]> Checked;
 
 private:
   vtkActionLineGrouping(const vtkActionLineGrouping&) = delete;

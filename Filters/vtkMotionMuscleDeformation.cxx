@@ -116,6 +116,7 @@ struct vtkMotionMuscleDeformation::Internals
   double upstreamTime = 0;
   bool upstreamAsked = false;
   int framesComputed = 0;
+  mdvtk::InputCheck checked[5]; ///< per input port, the rest pose's
 
   void Restart()
   {
@@ -327,15 +328,15 @@ struct Leaves
   std::vector<size_t> restLinesOf, motionLinesOf;
 };
 
-/// `checkRest` false: the rest-pose inputs were checked before and not modified since, and are
-/// not checked again (the bones' 130 000 points at every frame of the LHDL hip).
-bool CollectInputs(
-  vtkMotionMuscleDeformation* self, vtkDataObject* const inputs[5], bool checkRest, Leaves& leaves, std::string& error)
+/// The rest-pose inputs are checked only where they were modified since they last passed
+/// (`checked`, per port): a frame checks the time-varying inputs.
+bool CollectInputs(vtkMotionMuscleDeformation* self, vtkDataObject* const inputs[5], mdvtk::InputCheck checked[5],
+  Leaves& leaves, std::string& error)
 {
-  return mdvtk::CollectLeaves(inputs[0], PortNames[0], leaves.muscles, error, checkRest) &&
-    mdvtk::CollectLeaves(inputs[3], PortNames[3], leaves.restLines, error, checkRest) &&
+  return mdvtk::CollectLeaves(inputs[0], PortNames[0], leaves.muscles, error, checked[0]) &&
+    mdvtk::CollectLeaves(inputs[3], PortNames[3], leaves.restLines, error, checked[3]) &&
     mdvtk::CollectLeaves(inputs[4], PortNames[4], leaves.motionLines, error) &&
-    mdvtk::CollectLeaves(inputs[1], PortNames[1], leaves.restBones, error, checkRest) &&
+    mdvtk::CollectLeaves(inputs[1], PortNames[1], leaves.restBones, error, checked[1]) &&
     mdvtk::PairLeaves(self, leaves.muscles, PortNames[0], leaves.restLines, PortNames[3], leaves.restLinesOf, error) &&
     mdvtk::PairLeaves(
       self, leaves.restLines, PortNames[3], leaves.motionLines, PortNames[4], leaves.motionLinesOf, error);
@@ -379,10 +380,7 @@ int vtkMotionMuscleDeformation::RequestData(
   }
   Leaves leaves;
   std::string error;
-  // The deformation was built from rest-pose inputs that passed the checks: while they are not
-  // modified, a frame checks only the time-varying inputs.
-  const bool restChecked = in.deformation && signature == in.signature;
-  if (!CollectInputs(this, inputs, !restChecked, leaves, error))
+  if (!CollectInputs(this, inputs, in.checked, leaves, error))
   {
     vtkErrorMacro(<< error);
     return stop(0);

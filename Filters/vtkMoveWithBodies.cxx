@@ -20,6 +20,7 @@
 vtkStandardNewMacro(vtkMoveWithBodies);
 
 vtkMoveWithBodies::vtkMoveWithBodies()
+  : InputChecked(std::make_unique<mdvtk::InputCheck>())
 {
   this->SetNumberOfInputPorts(2);
 }
@@ -63,7 +64,7 @@ int vtkMoveWithBodies::RequestData(
   vtkDataObject* output = vtkDataObject::GetData(outputVector, 0);
   std::vector<mdvtk::Leaf> leaves;
   std::string error;
-  if (!mdvtk::CollectLeaves(input, "Input", leaves, error))
+  if (!mdvtk::CollectLeaves(input, "Input", leaves, error, *this->InputChecked))
   {
     vtkErrorMacro(<< error);
     return 0;

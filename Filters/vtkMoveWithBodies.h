@@ -16,6 +16,13 @@
 
 #include <vtkPassInputTypeAlgorithm.h>
 
+#include <memory>
+
+namespace mdvtk
+{
+class InputCheck;
+}
+
 class MUSCLEDEFORMATIONFILTERS_EXPORT vtkMoveWithBodies : public vtkPassInputTypeAlgorithm
 {
 public:
@@ -39,6 +46,9 @@ protected:
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   char* BodyOfSurface = nullptr;
+  /// The surfaces as they last passed the input checks: at every frame of a motion they are the
+  /// same rest pose, not checked again.
+  std::unique_ptr<mdvtk::InputCheck> InputChecked;
 
 private:
   vtkMoveWithBodies(const vtkMoveWithBodies&) = delete;

@@ -21,7 +21,9 @@
 #include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
 #include <vtkPointData.h>
+#include <vtkStringArray.h>
 #include <vtkTable.h>
+#include <vtkVariant.h>
 
 #include <gtest/gtest.h>
 
@@ -423,4 +425,43 @@ TEST(MalformedInput, EveryFailureOfTheCoreBecomesAnErrorMessageNotACrash)
   EXPECT_TRUE(mdvtk::CallCore(
     filter, "", [] {}, result));
   EXPECT_EQ(result, 1);
+}
+
+TEST(MalformedInput, AnInputCheckedOnceIsCheckedAgainWhenALeafOfItIsModified)
+{
+  // MoveWithBodies and MotionMuscleDeformation run at every frame of a motion with the same rest
+  // pose: they check it once, and again only where it (or a leaf of it) was modified since.
+  Phantom phantom;
+  auto bones = vtkSmartPointer<vtkMultiBlockDataSet>::New();
+  bones->DeepCopy(phantom.Output(vtkMusculoskeletalPhantom::BONES_REST));
+  vtkNew<vtkTable> transforms; // every body still
+  vtkNew<vtkStringArray> body;
+  body->SetName("Body");
+  transforms->AddColumn(body);
+  for (const char* name : { "R00", "R01", "R02", "R10", "R11", "R12", "R20", "R21", "R22", "Tx", "Ty", "Tz" })
+  {
+    vtkNew<vtkDoubleArray> column;
+    column->SetName(name);
+    transforms->AddColumn(column);
+  }
+  for (unsigned int b = 0; b < bones->GetNumberOfBlocks(); ++b)
+  {
+    const char* blockName = bones->GetMetaData(b)->Get(vtkCompositeDataSet::NAME());
+    transforms->InsertNextBlankRow();
+    transforms->SetValue(b, 0, vtkVariant(blockName));
+    for (int i = 0; i < 3; ++i)
+    {
+      transforms->SetValue(b, 1 + 4 * i, vtkVariant(1.0));
+    }
+  }
+  vtkNew<vtkMoveWithBodies> f;
+  f->SetInputDataObject(0, bones);
+  f->SetInputDataObject(1, transforms);
+  EXPECT_EQ(Refusal(f), "");
+  auto* leaf = FirstBlock(bones);
+  leaf->GetPoints()->SetPoint(3, std::nan(""), 0.0, 0.0);
+  leaf->GetPoints()->Modified();
+  f->SetBodyOfSurface("unused=nothing"); // runs again; the multiblock itself is not modified
+  const std::string text = Refusal(f);
+  EXPECT_NE(text.find("has NaN or infinite coordinates (point 3)"), std::string::npos) << text;
 }
