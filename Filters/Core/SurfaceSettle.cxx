@@ -906,114 +906,182 @@ void ExcludeOpposedContacts(const std::vector<Contact>& contacts, size_t bones, 
 /// settle, a muscle by its largest point's move): while that stays positive the point is still
 /// outside and not near, which the full test would find too, so it is not tested again. The
 /// contacts found are exactly those of testing every point.
-std::vector<Contact> FindContacts(const std::vector<TriangleMesh>& meshes,
-  const std::vector<const SurfaceEnergy*>& energies, const std::vector<FixedObstacle>& bones,
-  const std::vector<std::unique_ptr<TriangleTree>>& trees, const OverlapMasks* restOverlap, const HeldContacts& held,
-  const std::vector<Points>& previous, const SettleParameters& parameters, std::vector<std::vector<char>>& wasInside,
-  std::vector<std::vector<double>>& clearance)
+/// The search runs in blocks of points (Run, any order, in parallel), so that a parallel loop can
+/// hand them out beside other work; Finish gathers the contacts in the points' order.
+class ContactSearch
 {
-  const size_t count = meshes.size(), obstacles = bones.size() + count;
-  auto obstacle = [&](size_t o) -> const TriangleTree& {
-    return o < bones.size() ? *bones[o].tree : *trees[o - bones.size()];
-  };
-  // How far each muscle's points moved since the last iteration, and the largest.
-  std::vector<Eigen::VectorXd> moved(count);
-  std::vector<double> largestMove(count, 0.0);
-  for (size_t m = 0; m < count; ++m)
+public:
+  ContactSearch(const std::vector<TriangleMesh>& meshes, const std::vector<const SurfaceEnergy*>& energies,
+    const std::vector<FixedObstacle>& bones, const std::vector<std::unique_ptr<TriangleTree>>& trees,
+    const OverlapMasks* restOverlap, const HeldContacts& held, const std::vector<Points>& previous,
+    const SettleParameters& parameters, std::vector<std::vector<char>>& wasInside,
+    std::vector<std::vector<double>>& clearance)
+    : Meshes(meshes)
+    , Energies(energies)
+    , Bones(bones)
+    , Trees(trees)
+    , RestOverlap(restOverlap)
+    , Held(held)
+    , Previous(previous)
+    , Parameters(parameters)
+    , WasInside(wasInside)
+    , Clearance(clearance)
   {
-    moved[m] = (meshes[m].points - previous[m]).rowwise().norm();
-    for (Eigen::Index i = 0; i < moved[m].size(); ++i)
+    const size_t count = meshes.size(), obstacles = this->Obstacles();
+    // How far each muscle's points moved since the last iteration, and the largest.
+    this->Moved.resize(count);
+    this->LargestMove.assign(count, 0.0);
+    this->Found.resize(count);
+    this->InNow.resize(count);
+    this->WasHeld.resize(count);
+    for (size_t m = 0; m < count; ++m)
     {
-      largestMove[m] = energies[m]->Used()[i] ? std::max(largestMove[m], moved[m](i)) : largestMove[m];
+      this->Moved[m] = (meshes[m].points - previous[m]).rowwise().norm();
+      for (Eigen::Index i = 0; i < this->Moved[m].size(); ++i)
+      {
+        this->LargestMove[m] =
+          energies[m]->Used()[i] ? std::max(this->LargestMove[m], this->Moved[m](i)) : this->LargestMove[m];
+      }
+      const auto points = static_cast<size_t>(meshes[m].points.rows());
+      this->Found[m].resize(points);
+      this->InNow[m].assign(points * obstacles, 0);
+      // Which of this muscle's pairs were held, looked up once rather than in the map at every pair.
+      this->WasHeld[m].assign(points * obstacles, 0);
+      for (auto entry = held.lower_bound({ m, 0, 0 }); entry != held.end() && std::get<0>(entry->first) == m; ++entry)
+      {
+        this->WasHeld[m][static_cast<size_t>(std::get<1>(entry->first)) * obstacles + std::get<2>(entry->first)] = 1;
+      }
+      for (Eigen::Index first = 0; first < meshes[m].points.rows(); first += kSearchBlock)
+      {
+        this->Blocks.emplace_back(m, first);
+      }
     }
   }
-  std::vector<Contact> contacts;
-  for (size_t m = 0; m < count; ++m)
+
+  int NumberOfBlocks() const { return static_cast<int>(this->Blocks.size()); }
+
+  /// Tests the points of block `block` against every obstacle.
+  void Run(int block)
   {
-    const Points& x = meshes[m].points;
-    const double offset = parameters.contactOffset * energies[m]->Size();
-    const double reach = kClearanceReach * energies[m]->Size();
-    const double margin = kClearanceRounding * energies[m]->Size();
-    std::vector<double>& clear = clearance[m];
-    std::vector<std::vector<Contact>> found(static_cast<size_t>(x.rows()));
-    std::vector<char> inNow(static_cast<size_t>(x.rows()) * obstacles, 0);
-    // Which of this muscle's pairs were held, looked up once rather than in the map at every pair.
-    std::vector<char> wasHeld(static_cast<size_t>(x.rows()) * obstacles, 0);
-    for (auto entry = held.lower_bound({ m, 0, 0 }); entry != held.end() && std::get<0>(entry->first) == m; ++entry)
+    const auto [m, first] = this->Blocks[static_cast<size_t>(block)];
+    const Eigen::Index end = std::min(first + kSearchBlock, this->Meshes[m].points.rows());
+    for (Eigen::Index i = first; i < end; ++i)
     {
-      wasHeld[static_cast<size_t>(std::get<1>(entry->first)) * obstacles + std::get<2>(entry->first)] = 1;
+      this->TestPoint(m, i);
     }
-#pragma omp parallel for schedule(dynamic, 256)
-    for (Eigen::Index i = 0; i < x.rows(); ++i)
+  }
+
+  /// The contacts found, muscle by muscle and point by point; `wasInside` updated.
+  std::vector<Contact> Finish()
+  {
+    std::vector<Contact> contacts;
+    for (size_t m = 0; m < this->Meshes.size(); ++m)
     {
-      if (!energies[m]->Used()[i])
+      this->WasInside[m] = std::move(this->InNow[m]);
+      for (auto& list : this->Found[m])
+      {
+        for (Contact& c : list)
+        {
+          contacts.push_back(std::move(c));
+        }
+      }
+    }
+    return contacts;
+  }
+
+private:
+  /// Points a block of the search holds.
+  static constexpr Eigen::Index kSearchBlock = 256;
+
+  size_t Obstacles() const { return this->Bones.size() + this->Meshes.size(); }
+
+  const TriangleTree& Obstacle(size_t o) const
+  {
+    return o < this->Bones.size() ? *this->Bones[o].tree : *this->Trees[o - this->Bones.size()];
+  }
+
+  void TestPoint(size_t m, Eigen::Index i)
+  {
+    const SurfaceEnergy& energy = *this->Energies[m];
+    if (!energy.Used()[i])
+    {
+      return;
+    }
+    const size_t bones = this->Bones.size(), obstacles = this->Obstacles();
+    const double offset = this->Parameters.contactOffset * energy.Size();
+    const double reach = kClearanceReach * energy.Size();
+    const double margin = kClearanceRounding * energy.Size();
+    std::vector<double>& clear = this->Clearance[m];
+    const Eigen::Vector3d p = this->Meshes[m].points.row(i).transpose();
+    for (size_t o = 0; o < obstacles; ++o)
+    {
+      if ((o >= bones && o - bones == m) || InOverlap(this->RestOverlap, m, o, i))
       {
         continue;
       }
-      const Eigen::Vector3d p = x.row(i).transpose();
-      for (size_t o = 0; o < obstacles; ++o)
+      const size_t flag = static_cast<size_t>(i) * obstacles + o;
+      clear[flag] -= this->Moved[m](i) + (o < bones ? 0.0 : this->LargestMove[o - bones]) + margin;
+      const bool wasHeld = this->WasHeld[m][flag];
+      if (clear[flag] > 0 && !wasHeld)
       {
-        if ((o >= bones.size() && o - bones.size() == m) || InOverlap(restOverlap, m, o, i))
-        {
-          continue;
-        }
-        const size_t flag = static_cast<size_t>(i) * obstacles + o;
-        clear[flag] -= moved[m](i) + (o < bones.size() ? 0.0 : largestMove[o - bones.size()]) + margin;
-        if (clear[flag] > 0 && !wasHeld[flag])
-        {
-          continue; // still outside and not near (inNow stays 0)
-        }
-        const auto before = wasHeld[flag] ? held.find({ m, i, o }) : held.end();
-        const TriangleTree& tree = obstacle(o);
-        const bool inside = tree.InBounds(p) && tree.Inside(p);
-        // Outside, a point closer than the offset breaks its constraint too. One search as far
-        // as the clearance looks finds the nearest triangle within the offset as well (the same
-        // one: the search visits the nearer triangles in the same order).
-        const TriangleTree::Closest within = inside ? TriangleTree::Closest() : tree.ClosestPoint(p, reach);
-        const bool nearer = within.triangle >= 0 && within.distance * within.distance < offset * offset;
-        const TriangleTree::Closest near = nearer ? within : TriangleTree::Closest();
-        if (!inside && !nearer && before == held.end())
-        {
-          clear[flag] = (within.triangle < 0 ? reach : within.distance) - offset - margin;
-          continue;
-        }
-        clear[flag] = 0;
-        // A point that went in during the last iteration is held by the triangle it went in
-        // through: the nearest may be on the far side of a thin bone.
-        std::optional<TriangleTree::Hit> wayIn;
-        if (inside && !wasInside[m][flag])
-        {
-          wayIn = tree.FirstHit(previous[m].row(i).transpose(), p);
-        }
-        inNow[flag] = inside;
-        std::vector<Eigen::Index> triangles{ wayIn ? wayIn->triangle
-            : near.triangle >= 0                   ? near.triangle
-                                                   : tree.ClosestPoint(p).triangle };
-        if (before != held.end())
-        {
-          triangles.insert(triangles.end(), before->second.begin(), before->second.end());
-        }
-        std::sort(triangles.begin(), triangles.end());
-        triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
-        for (const Eigen::Index t : triangles)
-        {
-          found[i].push_back(
-            Linearise(m, i, o, t, p, inside, inside || near.triangle >= 0, tree, bones.size(), offset));
-        }
+        continue; // still outside and not near (inNow stays 0)
       }
-    }
-    wasInside[m] = std::move(inNow);
-    for (auto& list : found)
-    {
-      for (Contact& c : list)
+      const auto before = wasHeld ? this->Held.find({ m, i, o }) : this->Held.end();
+      const TriangleTree& tree = this->Obstacle(o);
+      const bool inside = tree.InBounds(p) && tree.Inside(p);
+      // Outside, a point closer than the offset breaks its constraint too. One search as far
+      // as the clearance looks finds the nearest triangle within the offset as well (the same
+      // one: the search visits the nearer triangles in the same order).
+      const TriangleTree::Closest within = inside ? TriangleTree::Closest() : tree.ClosestPoint(p, reach);
+      const bool nearer = within.triangle >= 0 && within.distance * within.distance < offset * offset;
+      const TriangleTree::Closest near = nearer ? within : TriangleTree::Closest();
+      if (!inside && !nearer && before == this->Held.end())
       {
-        contacts.push_back(std::move(c));
+        clear[flag] = (within.triangle < 0 ? reach : within.distance) - offset - margin;
+        continue;
+      }
+      clear[flag] = 0;
+      // A point that went in during the last iteration is held by the triangle it went in
+      // through: the nearest may be on the far side of a thin bone.
+      std::optional<TriangleTree::Hit> wayIn;
+      if (inside && !this->WasInside[m][flag])
+      {
+        wayIn = tree.FirstHit(this->Previous[m].row(i).transpose(), p);
+      }
+      this->InNow[m][flag] = inside;
+      std::vector<Eigen::Index> triangles{ wayIn ? wayIn->triangle
+          : near.triangle >= 0                   ? near.triangle
+                                                 : tree.ClosestPoint(p).triangle };
+      if (before != this->Held.end())
+      {
+        triangles.insert(triangles.end(), before->second.begin(), before->second.end());
+      }
+      std::sort(triangles.begin(), triangles.end());
+      triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
+      for (const Eigen::Index t : triangles)
+      {
+        this->Found[m][static_cast<size_t>(i)].push_back(
+          Linearise(m, i, o, t, p, inside, inside || near.triangle >= 0, tree, bones, offset));
       }
     }
   }
-  return contacts;
-}
 
+  const std::vector<TriangleMesh>& Meshes;
+  const std::vector<const SurfaceEnergy*>& Energies;
+  const std::vector<FixedObstacle>& Bones;
+  const std::vector<std::unique_ptr<TriangleTree>>& Trees;
+  const OverlapMasks* RestOverlap;
+  const HeldContacts& Held;
+  const std::vector<Points>& Previous;
+  const SettleParameters& Parameters;
+  std::vector<std::vector<char>>& WasInside;
+  std::vector<std::vector<double>>& Clearance;
+  std::vector<Eigen::VectorXd> Moved;
+  std::vector<double> LargestMove;
+  std::vector<std::vector<std::vector<Contact>>> Found; ///< [muscle][point]
+  std::vector<std::vector<char>> InNow, WasHeld;        ///< [muscle][point * obstacles + obstacle]
+  std::vector<std::pair<size_t, Eigen::Index>> Blocks;  ///< (muscle, first point)
+};
 /// Per muscle, for each point and bone (point * bones + bone), how much farther than the offset
 /// the last contact search (its `clearance`, FindContacts' layout, found at the points
 /// `previous`) proves the point from the bone at the points `meshes` now hold: its clearance less
@@ -1388,14 +1456,35 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
         trees[m] = std::make_unique<TriangleTree>(meshes[m]);
       }
     }
-    // The contacts: every point inside an obstacle or nearer than the offset, and those held before.
-    std::vector<Contact> contacts =
-      FindContacts(meshes, energies, bones, trees, restOverlap, held, previous, parameters, wasInside, clearance);
+    // The contacts (every point inside an obstacle or nearer than the offset, and those held
+    // before) and the volume's direction K^-1 g, independent of each other, in one parallel loop:
+    // the gluteus maximus's solve takes one core while the other does the other muscles' and the
+    // contact search (each in the same arithmetic as alone).
+    ContactSearch search(meshes, energies, bones, trees, restOverlap, held, previous, parameters, wasInside, clearance);
+    std::vector<Points> gradients(count), along(count);
+    std::vector<double> volumeNow(count), volumeRight(count);
+    const int tasks = static_cast<int>(count) + search.NumberOfBlocks();
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int task = 0; task < tasks; ++task)
+    {
+      if (task >= static_cast<int>(count))
+      {
+        search.Run(task - static_cast<int>(count));
+        continue;
+      }
+      const size_t m = static_cast<size_t>(costliestFirst[static_cast<size_t>(task)]);
+      volumeNow[m] = EnclosedVolume(meshes[m].points, meshes[m].triangles, &gradients[m]);
+      along[m] = energies[m]->Solve(gradients[m]);
+      // g . x_new = V - V(x) + g . x, the volume's linearisation at x.
+      volumeRight[m] = targets[m] - volumeNow[m] + (gradients[m].array() * meshes[m].points.array()).sum() -
+        (gradients[m].array() * free[m].array()).sum();
+    }
+    std::vector<Contact> contacts = search.Finish();
     const Eigen::Index nc = static_cast<Eigen::Index>(contacts.size());
     const Eigen::Index volumeStart = nc + static_cast<Eigen::Index>(letGo.size());
     contacts.insert(contacts.end(), letGo.begin(), letGo.end());
 
-    // The inverse's columns at every point a contact names, and the volume's direction.
+    // The inverse's columns at every point a contact names.
     std::vector<std::vector<Eigen::Index>> needed(count);
     for (const Contact& c : contacts)
     {
@@ -1405,20 +1494,12 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       }
     }
     const Eigen::Index size = volumeStart + static_cast<Eigen::Index>(count);
-    std::vector<Points> gradients(count), along(count);
     Eigen::VectorXd rhs(size);
-    std::vector<double> volumeNow(count);
-    SurfaceEnergy::PrepareAll(energies, needed);
-#pragma omp parallel for schedule(dynamic, 1)
-    for (int k = 0; k < static_cast<int>(count); ++k)
+    for (size_t m = 0; m < count; ++m)
     {
-      const size_t m = static_cast<size_t>(costliestFirst[static_cast<size_t>(k)]);
-      volumeNow[m] = EnclosedVolume(meshes[m].points, meshes[m].triangles, &gradients[m]);
-      along[m] = energies[m]->Solve(gradients[m]);
-      // g . x_new = V - V(x) + g . x, the volume's linearisation at x.
-      rhs(volumeStart + static_cast<Eigen::Index>(m)) = targets[m] - volumeNow[m] +
-        (gradients[m].array() * meshes[m].points.array()).sum() - (gradients[m].array() * free[m].array()).sum();
+      rhs(volumeStart + static_cast<Eigen::Index>(m)) = volumeRight[m];
     }
+    SurfaceEnergy::PrepareAll(energies, needed);
     for (Contact& c : contacts)
     {
       for (Term& t : c.terms)
