@@ -613,10 +613,10 @@ constexpr Eigen::Index kPushBlock = 512;
 
 /// How far (a fraction of the muscle's size) the contact search looks beyond the offset for a
 /// point that is outside an obstacle, so that it need not test that point again until it, or the
-/// obstacle, has moved that far (FindContacts' `clearance`).
+/// obstacle, has moved that far (ContactSearch's `clearance`).
 constexpr double kClearanceReach = 0.03;
 /// The rounding of a distance to an obstacle, a fraction of the muscle's size: a clearance less
-/// this is still one (FindContacts, ProvenOutsideBones).
+/// this is still one (ContactSearch, ProvenOutsideBones).
 constexpr double kClearanceRounding = 1e-9;
 
 /// A step whose every point moves less than this fraction of its muscle's size, in the direction
@@ -1083,7 +1083,7 @@ private:
   std::vector<std::pair<size_t, Eigen::Index>> Blocks;  ///< (muscle, first point)
 };
 /// Per muscle, for each point and bone (point * bones + bone), how much farther than the offset
-/// the last contact search (its `clearance`, FindContacts' layout, found at the points
+/// the last contact search (its `clearance`, ContactSearch's layout, found at the points
 /// `previous`) proves the point from the bone at the points `meshes` now hold: its clearance less
 /// its move since and the rounding (positive: what the next search would skip). Bones do not
 /// move within a settle.
@@ -1411,7 +1411,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   // Which obstacles each point was inside at the last iteration (at the start: as if it were
   // inside them all, so that a point inside at the start goes out the nearest way) and where it was.
   std::vector<std::vector<char>> wasInside(count);
-  std::vector<std::vector<double>> clearance(count); // FindContacts'
+  std::vector<std::vector<double>> clearance(count); // ContactSearch's
 
   // The bones where they are now, and what the last settle proved of the points' distances from
   // them, carried here.

@@ -326,7 +326,7 @@ std::vector<RigidFit> PlaceBones(
 /// it, and less both placements' largest residuals (a bone not quite rigid). The distance from
 /// a point to a surface changes by at most the point's move relative to it, so a point that
 /// was outside a bone, and farther than the offset, by a clearance is still outside by what is
-/// left. Laid out as FindContacts' clearance, point * (bones + muscles) + obstacle (the
+/// left. Laid out as ContactSearch's clearance, point * (bones + muscles) + obstacle (the
 /// muscles' entries 0). Empty where `motion` carries none (no settle before,
 /// one that diverged, no bones).
 std::vector<std::vector<double>> BoneClearancesNow(
