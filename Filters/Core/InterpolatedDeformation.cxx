@@ -622,8 +622,8 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
         : StepOutcome{ deformed[m].iterations, deformed[m].converged, deformed[m].verticesFrozen, deformed[m].seconds };
     }
     const std::vector<std::vector<char>> outsideBones = ProvenOutsideBones(settleMotion.boneClearance);
-    measures = ResolveAndMeasure(next, muscles, fixed, restOverlap, restVolumes, parameters, outcomes, previous,
-      measures, settle ? &outsideBones : nullptr, &sharpEdges);
+    measures = ResolveAndMeasure(next, muscles, fixed, restOverlap, sharpEdges, restVolumes, parameters, outcomes,
+      previous, measures, settle ? &outsideBones : nullptr);
     if (!settle)
     {
       RefitHulls(hullPass, next, deformed, muscles, parameters, measures);

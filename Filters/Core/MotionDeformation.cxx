@@ -460,8 +460,8 @@ MotionFrameResult MotionDeformation::Advance(const MotionPose& worldPose, const 
       }
       const std::vector<std::vector<char>> outsideBones = ProvenOutsideBones(next->settle.boneClearance);
       std::vector<MuscleStepMeasures> measures =
-        ResolveAndMeasure(muscles, in.muscles, in.fixed, in.restOverlap, in.restVolumes, in.parameters, outcomes,
-          next->previous, std::vector<MuscleStepMeasures>(count), &outsideBones, &in.sharpEdges);
+        ResolveAndMeasure(muscles, in.muscles, in.fixed, in.restOverlap, in.sharpEdges, in.restVolumes, in.parameters,
+          outcomes, next->previous, std::vector<MuscleStepMeasures>(count), &outsideBones);
       for (size_t k = 0; k < count; ++k)
       {
         const int iterations = frameMeasures[k].stepIterations + measures[k].stepIterations;

@@ -195,10 +195,10 @@ std::vector<std::string> SettleWarnings(const SettleInput& in, double to, const 
 
 std::vector<MuscleStepMeasures> ResolveAndMeasure(std::vector<TriangleMesh>& next,
   const std::vector<MuscleMotion>& muscles, const std::vector<FixedObstacle>& fixed, const OverlapMasks& restOverlap,
-  const std::vector<double>& restVolumes, const InterpolationParameters& parameters,
-  const std::vector<StepOutcome>& outcomes, const std::vector<MuscleStepMeasures>& previous,
-  std::vector<MuscleStepMeasures> measures, const std::vector<std::vector<char>>* outsideBones,
-  const std::vector<NewSharpEdges>* sharpEdges)
+  const std::vector<NewSharpEdges>& sharpEdges, const std::vector<double>& restVolumes,
+  const InterpolationParameters& parameters, const std::vector<StepOutcome>& outcomes,
+  const std::vector<MuscleStepMeasures>& previous, std::vector<MuscleStepMeasures> measures,
+  const std::vector<std::vector<char>>* outsideBones)
 {
   const size_t count = next.size();
   StaticResolveResult resolved =
@@ -249,8 +249,7 @@ std::vector<MuscleStepMeasures> ResolveAndMeasure(std::vector<TriangleMesh>& nex
     s.stepStaticShift = resolved.reports[m].maxShift;
     s.maxStaticShift = std::max(previous[m].maxStaticShift, s.stepStaticShift);
     s.staticallyMovedPoints = resolved.reports[m].penetratingPoints;
-    s.sharpEdgeCount = sharpEdges ? (*sharpEdges)[m].Count(next[m].points)
-                                  : NewSharpEdges(rest.points, rest.triangles).Count(next[m].points);
+    s.sharpEdgeCount = sharpEdges[m].Count(next[m].points);
     s.flippedTriangleCount = CountFlippedTriangles(rest.points, next[m].points, rest.triangles);
     s.stepIterations = outcomes[m].iterations;
     s.iterations = previous[m].iterations + s.stepIterations;

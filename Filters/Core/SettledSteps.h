@@ -75,13 +75,13 @@ struct StepOutcome
 /// measured already (its hull seconds) and is returned complete. `outsideBones`: the settle's
 /// proof of which points are outside which bone (ProvenOutsideBones), when `next` is
 /// where a settle left the muscles. `sharpEdges`: the muscles' rest edges (MuscleSharpEdges),
-/// found once for many steps; found here when null.
+/// found once for every step.
 std::vector<MuscleStepMeasures> ResolveAndMeasure(std::vector<TriangleMesh>& next,
   const std::vector<MuscleMotion>& muscles, const std::vector<FixedObstacle>& fixed, const OverlapMasks& restOverlap,
-  const std::vector<double>& restVolumes, const InterpolationParameters& parameters,
-  const std::vector<StepOutcome>& outcomes, const std::vector<MuscleStepMeasures>& previous,
-  std::vector<MuscleStepMeasures> measures, const std::vector<std::vector<char>>* outsideBones = nullptr,
-  const std::vector<NewSharpEdges>* sharpEdges = nullptr);
+  const std::vector<NewSharpEdges>& sharpEdges, const std::vector<double>& restVolumes,
+  const InterpolationParameters& parameters, const std::vector<StepOutcome>& outcomes,
+  const std::vector<MuscleStepMeasures>& previous, std::vector<MuscleStepMeasures> measures,
+  const std::vector<std::vector<char>>* outsideBones = nullptr);
 
 /// Each muscle's NewSharpEdges at rest, found in parallel.
 std::vector<NewSharpEdges> MuscleSharpEdges(const std::vector<MuscleMotion>& muscles);

@@ -39,6 +39,14 @@ double LargestRelativeDistanceChange(const Points& a, const Points& b)
   return worst;
 }
 
+/// A rotation drawn from four coordinates uniform in [-1, 1] (a quaternion normalised).
+Eigen::Matrix3d RandomRotation(std::mt19937& generator)
+{
+  std::uniform_real_distribution<double> entry(-1, 1);
+  return Eigen::Quaterniond(Eigen::Vector4d::NullaryExpr([&](Eigen::Index) { return entry(generator); }).normalized())
+    .toRotationMatrix();
+}
+
 const Eigen::Vector3d joint(143.5, 243.4, -432.7);
 const Eigen::Vector3d axis = Eigen::Vector3d(1, 0.1, -0.05).normalized();
 }
@@ -65,8 +73,7 @@ TEST(RigidMotion, TheDirectBestRotationIsTheSvdsToRounding)
   std::mt19937 generator(7);
   std::uniform_real_distribution<double> entry(-1, 1);
   auto rotation = [&] {
-    return Eigen::Quaterniond(Eigen::Vector4d::NullaryExpr([&](Eigen::Index) { return entry(generator); }).normalized())
-      .toRotationMatrix();
+    return RandomRotation(generator);
   };
   double worst = 0;
   for (int k = 0; k < 2000; ++k)
@@ -118,8 +125,7 @@ TEST(RigidMotion, SignUnderBestRotationAgreesWithTheRotationAndDecidesForSurface
   std::mt19937 generator(11);
   std::uniform_real_distribution<double> entry(-1, 1);
   auto rotation = [&] {
-    return Eigen::Quaterniond(Eigen::Vector4d::NullaryExpr([&](Eigen::Index) { return entry(generator); }).normalized())
-      .toRotationMatrix();
+    return RandomRotation(generator);
   };
   auto vector = [&] {
     return Eigen::Vector3d(entry(generator), entry(generator), entry(generator));
