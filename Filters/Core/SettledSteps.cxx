@@ -45,8 +45,9 @@ void AddFailedAttempt(std::vector<SettleReport>& reports, const std::vector<Sett
 /// A settle that starts with the last one's contacts (SettleMotion::carryContacts) converges in
 /// 5 to 23 iterations through the LHDL hip's motions; one that has not in this many started from
 /// contacts that no longer hold and is done again from none, as every settle that carries none
-/// is. (A step whose muscles jump, where an OpenSim path point comes or goes, carries none in the
-/// first place: SettleParameters::largestCarriedMove.)
+/// is. (A step whose muscles jump, where an OpenSim path point comes or goes, is settled in parts
+/// that each move no farther than an ordinary frame's few times over: SettleParameters::
+/// largestCarriedMove.)
 constexpr int kCarriedContactIterations = 30;
 
 /// Settles the muscles (`muscles`' points out) from where `motion` is, the pose at fraction
@@ -134,10 +135,11 @@ std::vector<SettleReport> SettleStep(const SettleInput& in, double from, double 
   RefitBones(in, to);
   std::vector<Points> freeMinima = FreeMinima(in.energies, LinesAt(in, to), in.fixed);
   const double move = LargestStartMove(motion, in.energies, freeMinima);
-  const int parts = SettleParts(move, in.parameters);
-  // A step whose minimum moves farther than largestCarriedMove starts every part with no
-  // contacts: with largestCarriedMove at most half largestStartMove, each part moves farther too.
-  const bool carry = move <= in.parameters.largestCarriedMove;
+  // A motion carries each settle's contacts to the next (SettleMotion::carryContacts) in parts
+  // whose minimum moves no farther than an ordinary frame's few times over, so that even where
+  // the muscles jump (an OpenSim path point comes or goes) each part goes on from the equilibrium
+  // the last one ended in.
+  const int parts = SettleParts(move, in.parameters, motion.carryContacts);
   std::vector<SettleReport> reports;
   auto settlePart = [&](int k, std::vector<Points> minima) {
     const double start = k == 1 ? from : from + (to - from) * (k - 1) / parts;
@@ -145,10 +147,6 @@ std::vector<SettleReport> SettleStep(const SettleInput& in, double from, double 
     if (parts > 1) // one part: the bones are at `to` already
     {
       RefitBones(in, end);
-    }
-    if (!carry)
-    {
-      motion.held.clear();
     }
     const std::vector<SettleReport> part = SettleToPose(
       in, start, end, kSettleHalvings, muscles, motion, [&](double fraction) { progress((k - 1 + fraction) / parts); },

@@ -645,8 +645,13 @@ constexpr double kCreepAlignment = 0.99;
 ///   their size beyond where the tolerance stopped them.
 /// Either way the step is scaled by 1 / (1 - lambda), the step that would land on the fixed
 /// point if the factor held (Aitken's): a swing is shortened, and a creep (every point's move
-/// below kCreepMove of its muscle's size, per `sizes`, lambda from kFastestCreep up, its
+/// below kCreepMove of its muscle's size, per `sizes`, lambda from kFastestCreep up to 1, its
 /// direction within kCreepAlignment) extended, for lambda beyond kSlowestCreep as for it.
+/// Steps that grow (lambda >= 1) lead to no fixed point and are taken as they are: the muscles
+/// are leaving an equilibrium, and a step made 1000 times longer went where rounding said (LHDL
+/// hip_adduction frame 13: the iliacus and psoas slid by steps growing 1.3 times an iteration,
+/// the extended step moved them by 0.9 mm, and 1e-7 of input noise moved their answer by
+/// 0.12 mm; taken as they are, by 0.0006 mm).
 /// `lastSteps` is read and replaced by the step taken, and emptied after an extension (whose
 /// next step is the correction, no measure of the factor).
 void SteadyStep(const std::vector<TriangleMesh>& meshes, std::vector<Points>& next, std::vector<Points>& lastSteps,
@@ -669,7 +674,7 @@ void SteadyStep(const std::vector<TriangleMesh>& meshes, std::vector<Points>& ne
   }
   const double lambda = last > 0 ? along / last : 0.0;
   const bool creeps =
-    small && lambda >= kFastestCreep && along * along >= kCreepAlignment * kCreepAlignment * last * now;
+    small && lambda >= kFastestCreep && lambda < 1 && along * along >= kCreepAlignment * kCreepAlignment * last * now;
   if (lambda < 0 || creeps)
   {
     const double factor = 1 / (1 - std::min(lambda, kSlowestCreep));
@@ -1323,14 +1328,17 @@ double LargestStartMove(
   return largest;
 }
 
-int SettleParts(double startMove, const SettleParameters& parameters)
+int SettleParts(double startMove, const SettleParameters& parameters, bool carriesContacts)
 {
   constexpr int kMostParts = 64;
-  if (!(parameters.largestStartMove > 0))
+  const double largest = carriesContacts && parameters.largestCarriedMove > 0
+    ? std::min(parameters.largestStartMove, parameters.largestCarriedMove)
+    : parameters.largestStartMove;
+  if (!(largest > 0))
   {
     return 1;
   }
-  return static_cast<int>(std::clamp(std::ceil(startMove / parameters.largestStartMove), 1.0, double(kMostParts)));
+  return static_cast<int>(std::clamp(std::ceil(startMove / largest), 1.0, double(kMostParts)));
 }
 
 std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,

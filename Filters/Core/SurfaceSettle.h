@@ -70,17 +70,17 @@ struct SettleParameters
   /// the minimum, not on whether a settle converged, so that the count changes with the input
   /// only where the move crosses a multiple of this, not under rounding noise.
   double largestStartMove = 0.125;
-  /// A step of a motion whose unconstrained minimum moves by more than this
-  /// fraction of a muscle's size starts with no contacts, even where the motion carries them
-  /// (SettleMotion::carryContacts): the muscle jumps (an OpenSim path point comes or goes, and its
-  /// line with it), and the contacts that held it before no longer fit. Carried there, the
-  /// settle swung between contacts for 30 iterations or more and was done again from none
-  /// whenever it had not converged by then: whether it had, rounding decided, and the two
-  /// answers lay 1.1 mm apart (LHDL hip_flexion frame 33, minimum moved by 0.10). Decided on the
-  /// minimum's move, like SettleParts, not on whether a settle converged: the LHDL motions' frames
-  /// move 0.017 (0.039 and 0.10 where a path point comes or goes), the phantom's sweep 0.03-0.05
-  /// (0.08 and 0.16 at two frames). At most half largestStartMove, so that every part of a step
-  /// split in parts moves farther than this too.
+  /// A step of a motion that carries its contacts (SettleMotion::carryContacts) is settled in as
+  /// many equal parts as keep each part's unconstrained minimum within this fraction of a
+  /// muscle's size (SettleParts), each part starting with the contacts the last one ended with:
+  /// the muscles go on from the equilibrium they are in, even where they jump (an OpenSim path
+  /// point comes or goes, and its line with it). The LHDL motions' frames move 0.017 (0.039 and
+  /// 0.10 where a path point comes or goes), the phantom's sweep 0.03-0.05 (0.08 and 0.16 at two
+  /// frames). Before, a jump started with no contacts: the LHDL iliacus at hip_flexion frame 33
+  /// (0.10) swung between contacts with the iliac bone for 25 iterations, and where it came to rest
+  /// moved by 0.17 mm under 1e-7 of input noise; in two parts that carry their contacts, by
+  /// 0.0004 mm. (Carried in one part, it swung for 30 iterations or more, and whether it had
+  /// converged by then, which rounding decided, chose between two answers 1.1 mm apart.)
   double largestCarriedMove = 0.0625;
   /// Linearisations of the volume and of the obstacles' surfaces. The LHDL hip's slowest step
   /// (flexion 60 degrees, N = 8, step 5) takes about 75 on the exact input and fewer on
@@ -350,8 +350,9 @@ double LargestStartMove(
 
 /// How many equal parts a motion's step whose minimum moves by `startMove` (LargestStartMove's)
 /// is settled in: the fewest in which no muscle's minimum moves by more than
-/// SettleParameters::largestStartMove of its size (at most 64).
-int SettleParts(double startMove, const SettleParameters& parameters);
+/// SettleParameters::largestStartMove of its size, or, where each part `carriesContacts` to the
+/// next (SettleMotion::carryContacts), largestCarriedMove (at most 64).
+int SettleParts(double startMove, const SettleParameters& parameters, bool carriesContacts);
 
 /// Settles every muscle of `muscles` (their points in, the settled points out) to the minimum
 /// of its full-mesh energy for the pose `lines[m]` describes, holding `volumes[m]`, none of its

@@ -241,18 +241,22 @@ TEST(MotionDeformation, OnTheHipEveryFrameOfBothMotionsIsSound)
 
 TEST(MotionDeformation, OnTheHipAMotionDependsOnNoRoundingNoise)
 {
-  // hip_flexion on the exact input and with every coordinate of the bones and muscles moved by at
-  // most 1e-7 of itself (seeds 1 and 2; BenchmarkMotion for more): the surfaces at every frame.
-  // Measured (Release): seeds 1 and 3 within 0.0006 mm at every frame, seed 2 too but at frames 33 and 34, where the
-  // iliacus's path point goes and its line jumps by 19 mm: there its settle from no contacts
-  // swings between contacts with the iliac bone for 25 iterations or so, and where it comes to
-  // rest moves by 0.14 and 0.17 mm (the psoas 0.015 mm); frame 35 is within 0.001 mm again.
-  // Before such a step started with no contacts (SettleParameters::largestCarriedMove), whether
-  // its carried contacts settled within 30 iterations decided which of two answers it took,
-  // 1.1 mm apart, and rounding decided that (the exact input against seeds 1, 2 and 3).
-  auto run = [](int seed, std::vector<std::vector<md::Points>>& points) {
+  // hip_flexion and hip_adduction on the exact input and with every coordinate of the bones and
+  // muscles moved by at most 1e-7 of itself (hip_flexion seed 2, hip_adduction seed 1, the seeds
+  // that showed the two rules below wanting; BenchmarkMotion for more): the surfaces at every
+  // frame, within issue 13's 0.01 mm. Measured (Release): every frame within 0.0006 mm, on seeds
+  // 1-3 of both motions. Two rules hold that:
+  // - A motion's step is settled in parts whose minimum moves at most largestCarriedMove, each
+  //   carrying the last one's contacts (SettleParts). At hip_flexion frame 33 the iliacus's path
+  //   point goes and its line jumps by 19 mm; settled from no contacts there, it swung between
+  //   contacts with the iliac bone for 25 iterations, and where it came to rest moved by 0.17 mm
+  //   with seed 2 (and by 1.1 mm when whether carried contacts settled within 30 iterations
+  //   decided which of two answers it took).
+  // - A settle whose steps grow is not extended as a creep (SteadyStep): at hip_adduction frame 13
+  //   that extension moved the iliacus by 0.9 mm at once, and its answer by 0.12 mm with seed 1.
+  auto run = [](const char* motion, int seed, std::vector<std::vector<md::Points>>& points) {
     MotionFrames frames;
-    if (!LhdlFrames("", "hip_flexion", seed, frames))
+    if (!LhdlFrames("", motion, seed, frames))
     {
       return false;
     }
@@ -265,26 +269,31 @@ TEST(MotionDeformation, OnTheHipAMotionDependsOnNoRoundingNoise)
     }
     return true;
   };
-  std::vector<std::vector<md::Points>> exact;
-  if (!run(-1, exact))
+  for (const auto& [motion, seeds] : { std::pair<const char*, std::vector<int>>{ "hip_flexion", { 2 } },
+         std::pair<const char*, std::vector<int>>{ "hip_adduction", { 1 } } })
   {
-    GTEST_SKIP() << "the LHDL data (lhdl_hip_r) was not found";
-  }
-  for (const int seed : { 1, 2 })
-  {
-    std::vector<std::vector<md::Points>> perturbed;
-    ASSERT_TRUE(run(seed, perturbed));
-    ASSERT_EQ(perturbed.size(), exact.size());
-    double largest = 0;
-    for (size_t k = 0; k < exact.size(); ++k)
+    std::vector<std::vector<md::Points>> exact;
+    if (!run(motion, -1, exact))
     {
-      for (size_t m = 0; m < exact[k].size(); ++m)
-      {
-        const double distance = (perturbed[k][m] - exact[k][m]).rowwise().norm().maxCoeff();
-        largest = std::max(largest, distance);
-        EXPECT_LT(distance, k == 33 || k == 34 ? 0.25 : 0.01) << "seed " << seed << " frame " << k << " muscle " << m;
-      }
+      GTEST_SKIP() << "the LHDL data (lhdl_hip_r) was not found";
     }
-    std::printf("[ measured ] seed %d: largest distance from the exact input's surfaces %.6f mm\n", seed, largest);
+    for (const int seed : seeds)
+    {
+      std::vector<std::vector<md::Points>> perturbed;
+      ASSERT_TRUE(run(motion, seed, perturbed));
+      ASSERT_EQ(perturbed.size(), exact.size());
+      double largest = 0;
+      for (size_t k = 0; k < exact.size(); ++k)
+      {
+        for (size_t m = 0; m < exact[k].size(); ++m)
+        {
+          const double distance = (perturbed[k][m] - exact[k][m]).rowwise().norm().maxCoeff();
+          largest = std::max(largest, distance);
+          EXPECT_LT(distance, 0.01) << motion << " seed " << seed << " frame " << k << " muscle " << m;
+        }
+      }
+      std::printf(
+        "[ measured ] %s seed %d: largest distance from the exact input's surfaces %.6f mm\n", motion, seed, largest);
+    }
   }
 }
