@@ -235,11 +235,12 @@ bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vect
 bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves, std::string& error,
   InputCheck& checked)
 {
-  if (!CollectLeaves(input, inputName, leaves, error, !checked.Unchanged(input)))
+  const vtkMTimeType time = DataMTime(input); // the checks modify nothing
+  if (!CollectLeaves(input, inputName, leaves, error, !checked.Unchanged(input, time)))
   {
     return false;
   }
-  checked.Passed(input);
+  checked.Passed(input, time);
   return true;
 }
 

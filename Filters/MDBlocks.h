@@ -59,11 +59,12 @@ vtkMTimeType DataMTime(vtkDataObject* input);
 class InputCheck
 {
 public:
-  bool Unchanged(vtkDataObject* input) const { return input == this->Input && DataMTime(input) == this->Time; }
-  void Passed(vtkDataObject* input)
+  /// Whether `input`, whose DataMTime is `time`, is the one that last passed, unmodified since.
+  bool Unchanged(vtkDataObject* input, vtkMTimeType time) const { return input == this->Input && time == this->Time; }
+  void Passed(vtkDataObject* input, vtkMTimeType time)
   {
     this->Input = input;
-    this->Time = DataMTime(input);
+    this->Time = time;
   }
 
 private:

@@ -449,13 +449,16 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
 
   // Interpolators of the bones and of every matched action line (their
   // construction checks the pairs).
-  std::vector<PoseInterpolator> boneMotions;
+  std::vector<Points> bonesRest, bonesCurrent;
   std::vector<std::string> boneNames;
   for (const BoneMotion& b : bones)
   {
-    boneMotions.emplace_back(b.rest.points, b.current, parameters.interpolationMode);
+    bonesRest.push_back(b.rest.points);
+    bonesCurrent.push_back(b.current);
     boneNames.push_back(b.name);
   }
+  const std::vector<PoseInterpolator> boneMotions =
+    PoseInterpolators(bonesRest, bonesCurrent, parameters.interpolationMode);
   std::vector<std::vector<PoseInterpolator>> lineMotions(count);
   for (size_t m = 0; m < count; ++m)
   {

@@ -1087,6 +1087,7 @@ private:
   std::vector<std::vector<char>> InNow, WasHeld;        ///< [muscle][point * obstacles + obstacle]
   std::vector<std::pair<size_t, Eigen::Index>> Blocks;  ///< (muscle, first point)
 };
+
 /// Per muscle, for each point and bone (point * bones + bone), how much farther than the offset
 /// the last contact search (its `clearance`, ContactSearch's layout, found at the points
 /// `previous`) proves the point from the bone at the points `meshes` now hold: its clearance less
