@@ -618,6 +618,18 @@ constexpr double kClearanceReach = 0.03;
 /// The rounding of a distance to an obstacle, a fraction of the muscle's size: a clearance less
 /// this is still one (ContactSearch, ProvenOutsideBones).
 constexpr double kClearanceRounding = 1e-9;
+/// How many times an iteration's step is solved again with the watched contacts it would break
+/// (SettleParameters::contactLookahead).
+constexpr int kJoiningRounds = 10;
+/// Two muscle-muscle contact rows whose cosine in the dual system's metric is below minus this
+/// bound the same gap from opposite sides (ExcludeOpposedContacts): exactly, as where a point
+/// inside and its partner outside name each other; nearly, where watched contacts held from
+/// earlier iterations meet points inside. An iteration that blows up (a point moved by more than
+/// kBlownUp of its muscle's size) is solved again leaving out the nearly opposed rows as well
+/// and watching nothing: two spindles crossed at 45 degrees blew up at their ninth iteration
+/// (a move of 3.85 times a spindle's size) and, solved again, settled apart.
+constexpr double kExactlyOpposed = 1 - 1e-9;
+constexpr double kNearlyOpposed = 0.9;
 
 /// A step whose every point moves less than this fraction of its muscle's size, in the direction
 /// of the last step, is a creep (SteadyStep).
@@ -872,11 +884,11 @@ Eigen::VectorXd SolveActiveSet(const Eigen::MatrixXd& system, const Eigen::Vecto
 /// cycles (measured: LHDL adduction 40 degrees in one pass, on one of three perturbed inputs, a
 /// move of 6e5 times a muscle's size). The penetration is what must be resolved: the contact of
 /// the point outside is left out of this iteration (`active` off, `slack` infinite so that it
-/// does not join). Two rows are opposed when their cosine in the dual system's metric is -1.
+/// does not join). Two rows are opposed when their cosine in the dual system's metric is below
+/// -`opposed`: kExactlyOpposed, or kNearlyOpposed for an iteration that blew up without it.
 void ExcludeOpposedContacts(const std::vector<Contact>& contacts, size_t bones, const Eigen::MatrixXd& system,
-  std::vector<char>& active, std::vector<double>& slack)
+  std::vector<char>& active, std::vector<double>& slack, double opposed)
 {
-  constexpr double kOpposed = 1 - 1e-9;
   std::vector<Eigen::Index> betweenMuscles;
   for (size_t j = 0; j < slack.size(); ++j)
   {
@@ -891,7 +903,7 @@ void ExcludeOpposedContacts(const std::vector<Contact>& contacts, size_t bones, 
     {
       const Eigen::Index j = betweenMuscles[a], l = betweenMuscles[b];
       const Contact &first = contacts[static_cast<size_t>(j)], &second = contacts[static_cast<size_t>(l)];
-      if (first.inside != second.inside && system(j, l) < -kOpposed * std::sqrt(system(j, j) * system(l, l)))
+      if (first.inside != second.inside && system(j, l) < -opposed * std::sqrt(system(j, j) * system(l, l)))
       {
         const Eigen::Index outside = first.inside ? l : j;
         active[outside] = 0;
@@ -937,6 +949,7 @@ public:
     this->Moved.resize(count);
     this->LargestMove.assign(count, 0.0);
     this->Found.resize(count);
+    this->Pending.resize(count);
     this->InNow.resize(count);
     this->WasHeld.resize(count);
     for (size_t m = 0; m < count; ++m)
@@ -949,6 +962,7 @@ public:
       }
       const auto points = static_cast<size_t>(meshes[m].points.rows());
       this->Found[m].resize(points);
+      this->Pending[m].resize(points);
       this->InNow[m].assign(points * obstacles, 0);
       // Which of this muscle's pairs were held, looked up once rather than in the map at every pair.
       this->WasHeld[m].assign(points * obstacles, 0);
@@ -977,7 +991,8 @@ public:
   }
 
   /// The contacts found, muscle by muscle and point by point; `wasInside` updated.
-  std::vector<Contact> Finish()
+  /// `pending`: the watched contacts (near, not broken, not held), in the same order.
+  std::vector<Contact> Finish(std::vector<Contact>& pending)
   {
     std::vector<Contact> contacts;
     for (size_t m = 0; m < this->Meshes.size(); ++m)
@@ -988,6 +1003,13 @@ public:
         for (Contact& c : list)
         {
           contacts.push_back(std::move(c));
+        }
+      }
+      for (auto& list : this->Pending[m])
+      {
+        for (Contact& c : list)
+        {
+          pending.push_back(std::move(c));
         }
       }
     }
@@ -1014,6 +1036,7 @@ private:
     }
     const size_t bones = this->Bones.size(), obstacles = this->Obstacles();
     const double offset = this->Parameters.contactOffset * energy.Size();
+    const double lookahead = this->Parameters.contactLookahead * energy.Size(); // beyond the offset
     const double reach = kClearanceReach * energy.Size();
     const double margin = kClearanceRounding * energy.Size();
     std::vector<double>& clear = this->Clearance[m];
@@ -1027,25 +1050,30 @@ private:
       const size_t flag = static_cast<size_t>(i) * obstacles + o;
       clear[flag] -= this->Moved[m](i) + (o < bones ? 0.0 : this->LargestMove[o - bones]) + margin;
       const bool wasHeld = this->WasHeld[m][flag];
-      if (clear[flag] > 0 && !wasHeld)
+      if (clear[flag] > lookahead && !wasHeld)
       {
-        continue; // still outside and not near (inNow stays 0)
+        continue; // still outside and neither near nor watched (inNow stays 0)
       }
       const auto before = wasHeld ? this->Held.find({ m, i, o }) : this->Held.end();
       const TriangleTree& tree = this->Obstacle(o);
-      const bool inside = tree.InBounds(p) && tree.Inside(p);
+      // A positive clearance proves the point outside and beyond the offset: only its nearest
+      // triangle is needed, for the watched contact.
+      const bool inside = clear[flag] <= 0 && tree.InBounds(p) && tree.Inside(p);
       // Outside, a point closer than the offset breaks its constraint too. One search as far
       // as the clearance looks finds the nearest triangle within the offset as well (the same
       // one: the search visits the nearer triangles in the same order).
       const TriangleTree::Closest within = inside ? TriangleTree::Closest() : tree.ClosestPoint(p, reach);
       const bool nearer = within.triangle >= 0 && within.distance * within.distance < offset * offset;
-      const TriangleTree::Closest near = nearer ? within : TriangleTree::Closest();
-      if (!inside && !nearer && before == this->Held.end())
+      const double watch = offset + lookahead;
+      const bool watched = within.triangle >= 0 && within.distance * within.distance < watch * watch;
+      if (!inside && !nearer && !watched && before == this->Held.end())
       {
         clear[flag] = (within.triangle < 0 ? reach : within.distance) - offset - margin;
         continue;
       }
-      clear[flag] = 0;
+      const bool violated = inside || nearer;
+      // A watched point keeps its clearance: the next search need not test it for inside.
+      clear[flag] = violated ? 0.0 : (within.triangle < 0 ? reach : within.distance) - offset - margin;
       // A point that went in during the last iteration is held by the triangle it went in
       // through: the nearest may be on the far side of a thin bone.
       std::optional<TriangleTree::Hit> wayIn;
@@ -1055,7 +1083,7 @@ private:
       }
       this->InNow[m][flag] = inside;
       std::vector<Eigen::Index> triangles{ wayIn ? wayIn->triangle
-          : near.triangle >= 0                   ? near.triangle
+          : within.triangle >= 0                 ? within.triangle
                                                  : tree.ClosestPoint(p).triangle };
       if (before != this->Held.end())
       {
@@ -1063,10 +1091,11 @@ private:
       }
       std::sort(triangles.begin(), triangles.end());
       triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
+      // Broken or held contacts enter the step; the others are watched (Pending).
+      auto& list = (violated || before != this->Held.end() ? this->Found : this->Pending)[m][static_cast<size_t>(i)];
       for (const Eigen::Index t : triangles)
       {
-        this->Found[m][static_cast<size_t>(i)].push_back(
-          Linearise(m, i, o, t, p, inside, inside || near.triangle >= 0, tree, bones, offset));
+        list.push_back(Linearise(m, i, o, t, p, inside, violated, tree, bones, offset));
       }
     }
   }
@@ -1083,9 +1112,10 @@ private:
   std::vector<std::vector<double>>& Clearance;
   std::vector<Eigen::VectorXd> Moved;
   std::vector<double> LargestMove;
-  std::vector<std::vector<std::vector<Contact>>> Found; ///< [muscle][point]
-  std::vector<std::vector<char>> InNow, WasHeld;        ///< [muscle][point * obstacles + obstacle]
-  std::vector<std::pair<size_t, Eigen::Index>> Blocks;  ///< (muscle, first point)
+  std::vector<std::vector<std::vector<Contact>>> Found;   ///< [muscle][point]
+  std::vector<std::vector<std::vector<Contact>>> Pending; ///< [muscle][point]
+  std::vector<std::vector<char>> InNow, WasHeld;          ///< [muscle][point * obstacles + obstacle]
+  std::vector<std::pair<size_t, Eigen::Index>> Blocks;    ///< (muscle, first point)
 };
 
 /// Per muscle, for each point and bone (point * bones + bone), how much farther than the offset
@@ -1488,151 +1518,207 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       volumeRight[m] = targets[m] - volumeNow[m] + (gradients[m].array() * meshes[m].points.array()).sum() -
         (gradients[m].array() * free[m].array()).sum();
     }
-    std::vector<Contact> contacts = search.Finish();
-    const Eigen::Index nc = static_cast<Eigen::Index>(contacts.size());
-    const Eigen::Index volumeStart = nc + static_cast<Eigen::Index>(letGo.size());
-    contacts.insert(contacts.end(), letGo.begin(), letGo.end());
-
-    // The inverse's columns at every point a contact names.
-    std::vector<std::vector<Eigen::Index>> needed(count);
-    for (const Contact& c : contacts)
-    {
-      for (const Term& t : c.terms)
-      {
-        needed[t.muscle].push_back(t.point);
-      }
-    }
-    const Eigen::Index size = volumeStart + static_cast<Eigen::Index>(count);
-    Eigen::VectorXd rhs(size);
-    for (size_t m = 0; m < count; ++m)
-    {
-      rhs(volumeStart + static_cast<Eigen::Index>(m)) = volumeRight[m];
-    }
-    SurfaceEnergy::PrepareAll(energies, needed);
-    for (Contact& c : contacts)
-    {
-      for (Term& t : c.terms)
-      {
-        t.column = &energies[t.muscle]->InverseColumn(t.point);
-      }
-    }
-    Eigen::MatrixXd system = Eigen::MatrixXd::Zero(size, size);
-    for (Eigen::Index j = 0; j < volumeStart; ++j)
-    {
-      const Contact& a = contacts[static_cast<size_t>(j)];
-      double value = 0;
-      for (const Term& t : a.terms)
-      {
-        value += t.coefficient * a.normal.dot(Where(t, free[t.muscle]));
-        system(j, volumeStart + static_cast<Eigen::Index>(t.muscle)) +=
-          t.coefficient * a.normal.dot(Where(t, along[t.muscle]));
-      }
-      rhs(j) = a.target - value;
-      for (Eigen::Index l = 0; l <= j; ++l)
-      {
-        const Contact& b = contacts[static_cast<size_t>(l)];
-        double sum = 0;
-        for (const Term& s : a.terms)
-        {
-          for (const Term& t : b.terms)
-          {
-            sum += s.coefficient * t.coefficient * InverseBetween(s, t);
-          }
-        }
-        system(j, l) = system(l, j) = sum * a.normal.dot(b.normal);
-      }
-    }
-    for (Eigen::Index j = nc; j < volumeStart; ++j)
-    {
-      system(j, j) -= 1 / letGoShare[static_cast<size_t>(j - nc)];
-    }
-    for (size_t m = 0; m < count; ++m)
-    {
-      const Eigen::Index v = volumeStart + static_cast<Eigen::Index>(m);
-      system.row(v).head(volumeStart) = system.col(v).head(volumeStart).transpose();
-      system(v, v) = (gradients[m].array() * along[m].array()).sum();
-    }
-
-    // The active set: the multipliers of the active contacts and volumes, the inactive
-    // contacts' points where they would go; a contact whose multiplier pulls lets go, one whose
-    // point would be inside joins.
-    std::vector<char> active(static_cast<size_t>(size), 1);
-    for (Eigen::Index j = 0; j < nc; ++j)
-    {
-      const Contact& c = contacts[static_cast<size_t>(j)];
-      const auto before = held.find({ c.muscle, c.point, c.obstacle });
-      active[j] = c.violated ||
-        (before != held.end() &&
-          std::find(before->second.begin(), before->second.end(), c.triangle) != before->second.end());
-    }
-    std::vector<double> slack(static_cast<size_t>(nc));
-    for (Eigen::Index j = 0; j < nc; ++j)
-    {
-      slack[j] = 1e-3 * parameters.tolerance * energies[contacts[static_cast<size_t>(j)].muscle]->Size();
-    }
-    ExcludeOpposedContacts(contacts, bones.size(), system, active, slack);
-    const Eigen::VectorXd multipliers = SolveActiveSet(system, rhs, slack, active);
-
-    // The new points.
+    std::vector<Contact> pending;
+    std::vector<Contact> primary = search.Finish(pending);
     HeldContacts nowHeld;
     std::vector<std::int64_t> inContact(count, 0);
-    struct Push
+    std::vector<Points> next(count);
+    const size_t found = primary.size(); // the contacts before any watched one joined
+    bool strict = false;                 // solved again after blowing up (kNearlyOpposed)
+    for (int rounds = 0;;)
     {
-      double size;
-      const Eigen::VectorXd* column;
-      Eigen::Vector3d normal;
-    };
-    std::vector<std::vector<Push>> pushes(count); // each muscle's, in the rows' order
-    for (Eigen::Index j = 0; j < volumeStart; ++j)
-    {
-      if (!active[j])
+      std::vector<Contact> contacts = primary;
+      const Eigen::Index nc = static_cast<Eigen::Index>(contacts.size());
+      const Eigen::Index volumeStart = nc + static_cast<Eigen::Index>(letGo.size());
+      contacts.insert(contacts.end(), letGo.begin(), letGo.end());
+
+      // The inverse's columns at every point a contact names.
+      std::vector<std::vector<Eigen::Index>> needed(count);
+      for (const Contact& c : contacts)
+      {
+        for (const Term& t : c.terms)
+        {
+          needed[t.muscle].push_back(t.point);
+        }
+      }
+      const Eigen::Index size = volumeStart + static_cast<Eigen::Index>(count);
+      Eigen::VectorXd rhs(size);
+      for (size_t m = 0; m < count; ++m)
+      {
+        rhs(volumeStart + static_cast<Eigen::Index>(m)) = volumeRight[m];
+      }
+      SurfaceEnergy::PrepareAll(energies, needed);
+      for (Contact& c : contacts)
+      {
+        for (Term& t : c.terms)
+        {
+          t.column = &energies[t.muscle]->InverseColumn(t.point);
+        }
+      }
+      Eigen::MatrixXd system = Eigen::MatrixXd::Zero(size, size);
+      for (Eigen::Index j = 0; j < volumeStart; ++j)
+      {
+        const Contact& a = contacts[static_cast<size_t>(j)];
+        double value = 0;
+        for (const Term& t : a.terms)
+        {
+          value += t.coefficient * a.normal.dot(Where(t, free[t.muscle]));
+          system(j, volumeStart + static_cast<Eigen::Index>(t.muscle)) +=
+            t.coefficient * a.normal.dot(Where(t, along[t.muscle]));
+        }
+        rhs(j) = a.target - value;
+        for (Eigen::Index l = 0; l <= j; ++l)
+        {
+          const Contact& b = contacts[static_cast<size_t>(l)];
+          double sum = 0;
+          for (const Term& s : a.terms)
+          {
+            for (const Term& t : b.terms)
+            {
+              sum += s.coefficient * t.coefficient * InverseBetween(s, t);
+            }
+          }
+          system(j, l) = system(l, j) = sum * a.normal.dot(b.normal);
+        }
+      }
+      for (Eigen::Index j = nc; j < volumeStart; ++j)
+      {
+        system(j, j) -= 1 / letGoShare[static_cast<size_t>(j - nc)];
+      }
+      for (size_t m = 0; m < count; ++m)
+      {
+        const Eigen::Index v = volumeStart + static_cast<Eigen::Index>(m);
+        system.row(v).head(volumeStart) = system.col(v).head(volumeStart).transpose();
+        system(v, v) = (gradients[m].array() * along[m].array()).sum();
+      }
+
+      // The active set: the multipliers of the active contacts and volumes, the inactive
+      // contacts' points where they would go; a contact whose multiplier pulls lets go, one whose
+      // point would be inside joins.
+      std::vector<char> active(static_cast<size_t>(size), 1);
+      for (Eigen::Index j = 0; j < nc; ++j)
+      {
+        const Contact& c = contacts[static_cast<size_t>(j)];
+        const auto before = held.find({ c.muscle, c.point, c.obstacle });
+        active[j] = c.violated ||
+          (before != held.end() &&
+            std::find(before->second.begin(), before->second.end(), c.triangle) != before->second.end());
+      }
+      std::vector<double> slack(static_cast<size_t>(nc));
+      for (Eigen::Index j = 0; j < nc; ++j)
+      {
+        slack[j] = 1e-3 * parameters.tolerance * energies[contacts[static_cast<size_t>(j)].muscle]->Size();
+      }
+      ExcludeOpposedContacts(contacts, bones.size(), system, active, slack, strict ? kNearlyOpposed : kExactlyOpposed);
+      const Eigen::VectorXd multipliers = SolveActiveSet(system, rhs, slack, active);
+
+      // The new points.
+      nowHeld.clear();
+      inContact.assign(count, 0);
+      struct Push
+      {
+        double size;
+        const Eigen::VectorXd* column;
+        Eigen::Vector3d normal;
+      };
+      std::vector<std::vector<Push>> pushes(count); // each muscle's, in the rows' order
+      for (Eigen::Index j = 0; j < volumeStart; ++j)
+      {
+        if (!active[j])
+        {
+          continue;
+        }
+        const Contact& c = contacts[static_cast<size_t>(j)];
+        if (j < nc)
+        {
+          nowHeld[{ c.muscle, c.point, c.obstacle }].push_back(c.triangle);
+          ++inContact[c.muscle];
+        }
+        for (const Term& t : c.terms)
+        {
+          pushes[t.muscle].push_back({ multipliers(j) * t.coefficient, t.column, c.normal });
+        }
+      }
+      // Where the step takes point i of muscle m: the update below at one point, the same sums.
+      auto PointAt = [&](size_t m, Eigen::Index i) {
+        Eigen::RowVector3d x =
+          free[m].row(i) + multipliers(volumeStart + static_cast<Eigen::Index>(m)) * along[m].row(i);
+        for (const Push& push : pushes[m])
+        {
+          x += (push.size * (*push.column)(i)) * push.normal.transpose();
+        }
+        return Eigen::Vector3d(x.transpose());
+      };
+      // A contact near but not yet broken joins if this step would break it: the step is then that
+      // of the quadratic energy under every constraint within the lookahead, which moves
+      // continuously with the points, where a point just beyond the offset would otherwise go in
+      // unhindered and be pushed out at the next iteration (the path, and with several equilibria
+      // the answer, jumping with rounding).
+      std::vector<Contact> stillPending;
+      const size_t joinedBefore = primary.size();
+      for (Contact& c : pending)
+      {
+        double value = 0;
+        for (const Term& t : c.terms)
+        {
+          value += t.coefficient * c.normal.dot(PointAt(t.muscle, t.point));
+        }
+        const double lowest = -1e-3 * parameters.tolerance * energies[c.muscle]->Size();
+        (value - c.target < lowest ? primary : stillPending).push_back(std::move(c));
+      }
+      pending = std::move(stillPending);
+      if (primary.size() > joinedBefore && ++rounds < kJoiningRounds)
       {
         continue;
       }
-      const Contact& c = contacts[static_cast<size_t>(j)];
-      if (j < nc)
+      // x = free + mu K^-1 g + sum of the pushes, over blocks of points (of every muscle, in one
+      // parallel loop): a block's rows stay in the first-level cache while every push goes over
+      // them, where a push at a time over all the points went to the second level. Each point
+      // takes the pushes in the rows' order, as before: the same sums.
+      next.assign(count, Points());
+      std::vector<std::pair<size_t, Eigen::Index>> blocks; // (muscle, first point)
+      for (const int muscle : costliestFirst)
       {
-        nowHeld[{ c.muscle, c.point, c.obstacle }].push_back(c.triangle);
-        ++inContact[c.muscle];
-      }
-      for (const Term& t : c.terms)
-      {
-        pushes[t.muscle].push_back({ multipliers(j) * t.coefficient, t.column, c.normal });
-      }
-    }
-    // x = free + mu K^-1 g + sum of the pushes, over blocks of points (of every muscle, in one
-    // parallel loop): a block's rows stay in the first-level cache while every push goes over
-    // them, where a push at a time over all the points went to the second level. Each point
-    // takes the pushes in the rows' order, as before: the same sums.
-    std::vector<Points> next(count);
-    std::vector<std::pair<size_t, Eigen::Index>> blocks; // (muscle, first point)
-    for (const int muscle : costliestFirst)
-    {
-      const auto m = static_cast<size_t>(muscle);
-      next[m].resize(free[m].rows(), 3);
-      for (Eigen::Index first = 0; first < free[m].rows(); first += kPushBlock)
-      {
-        blocks.emplace_back(m, first);
-      }
-    }
-#pragma omp parallel for schedule(dynamic, 1)
-    for (int b = 0; b < static_cast<int>(blocks.size()); ++b)
-    {
-      const auto [m, first] = blocks[static_cast<size_t>(b)];
-      Points& x = next[m];
-      const Eigen::Index end = std::min(first + kPushBlock, x.rows());
-      const double volume = multipliers(volumeStart + static_cast<Eigen::Index>(m));
-      for (Eigen::Index i = first; i < end; ++i)
-      {
-        x.row(i) = free[m].row(i) + volume * along[m].row(i);
-      }
-      for (const Push& push : pushes[m])
-      {
-        for (Eigen::Index i = first; i < end; ++i)
+        const auto m = static_cast<size_t>(muscle);
+        next[m].resize(free[m].rows(), 3);
+        for (Eigen::Index first = 0; first < free[m].rows(); first += kPushBlock)
         {
-          x.row(i) += (push.size * (*push.column)(i)) * push.normal.transpose();
+          blocks.emplace_back(m, first);
         }
       }
+#pragma omp parallel for schedule(dynamic, 1)
+      for (int b = 0; b < static_cast<int>(blocks.size()); ++b)
+      {
+        const auto [m, first] = blocks[static_cast<size_t>(b)];
+        Points& x = next[m];
+        const Eigen::Index end = std::min(first + kPushBlock, x.rows());
+        const double volume = multipliers(volumeStart + static_cast<Eigen::Index>(m));
+        for (Eigen::Index i = first; i < end; ++i)
+        {
+          x.row(i) = free[m].row(i) + volume * along[m].row(i);
+        }
+        for (const Push& push : pushes[m])
+        {
+          for (Eigen::Index i = first; i < end; ++i)
+          {
+            x.row(i) += (push.size * (*push.column)(i)) * push.normal.transpose();
+          }
+        }
+      }
+      // Blown up: solved again as found, with the nearly opposed rows left out and nothing watched.
+      bool blownUp = false;
+      for (size_t m = 0; m < count && !strict; ++m)
+      {
+        blownUp = blownUp || (next[m] - meshes[m].points).cwiseAbs().maxCoeff() > kBlownUp * energies[m]->Size();
+      }
+      if (blownUp)
+      {
+        primary.resize(found);
+        pending.clear();
+        strict = true;
+        continue;
+      }
+      break;
     }
     for (size_t m = 0; m < count; ++m)
     {
