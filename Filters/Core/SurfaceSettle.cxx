@@ -1523,6 +1523,11 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     HeldContacts nowHeld;
     std::vector<std::int64_t> inContact(count, 0);
     std::vector<Points> next(count);
+    // How far a point may break a contact that does not hold it before the contact joins: an
+    // inactive one the active set (SolveActiveSet), a watched one the step.
+    auto joiningSlack = [&](const Contact& c) {
+      return 1e-3 * parameters.tolerance * energies[c.muscle]->Size();
+    };
     const size_t found = primary.size(); // the contacts before any watched one joined
     bool strict = false;                 // solved again after blowing up (kNearlyOpposed)
     for (int rounds = 0;;)
@@ -1607,7 +1612,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
       std::vector<double> slack(static_cast<size_t>(nc));
       for (Eigen::Index j = 0; j < nc; ++j)
       {
-        slack[j] = 1e-3 * parameters.tolerance * energies[contacts[static_cast<size_t>(j)].muscle]->Size();
+        slack[j] = joiningSlack(contacts[static_cast<size_t>(j)]);
       }
       ExcludeOpposedContacts(contacts, bones.size(), system, active, slack, strict ? kNearlyOpposed : kExactlyOpposed);
       const Eigen::VectorXd multipliers = SolveActiveSet(system, rhs, slack, active);
@@ -1663,8 +1668,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
         {
           value += t.coefficient * c.normal.dot(PointAt(t.muscle, t.point));
         }
-        const double lowest = -1e-3 * parameters.tolerance * energies[c.muscle]->Size();
-        (value - c.target < lowest ? primary : stillPending).push_back(std::move(c));
+        (value - c.target < -joiningSlack(c) ? primary : stillPending).push_back(std::move(c));
       }
       pending = std::move(stillPending);
       if (primary.size() > joinedBefore && ++rounds < kJoiningRounds)
