@@ -932,8 +932,9 @@ public:
     const std::vector<FixedObstacle>& bones, const std::vector<std::unique_ptr<TriangleTree>>& trees,
     const OverlapMasks* restOverlap, const HeldContacts& held, const std::vector<Points>& previous,
     const SettleParameters& parameters, std::vector<std::vector<char>>& wasInside,
-    std::vector<std::vector<double>>& clearance)
-    : Meshes(meshes)
+    std::vector<std::vector<double>>& clearance, bool carriesContacts)
+    : CarriesContacts(carriesContacts)
+    , Meshes(meshes)
     , Energies(energies)
     , Bones(bones)
     , Trees(trees)
@@ -1075,16 +1076,31 @@ private:
       // A watched point keeps its clearance: the next search need not test it for inside.
       clear[flag] = violated ? 0.0 : (within.triangle < 0 ? reach : within.distance) - offset - margin;
       // A point that went in during the last iteration is held by the triangle it went in
-      // through: the nearest may be on the far side of a thin bone.
+      // through: the nearest may be on the far side of a thin bone. Through a motion (contacts
+      // carried), one inside a bone that held it goes out through the triangles that held it, not
+      // by its nearest: a frame's start takes a point pressed on a slightly convex ridge of a scan
+      // inside near the ridge's bisector, where rounding chooses the nearest face, and the face it
+      // went out through chose between two equilibria, one on either side (LHDL hip_flexion frame
+      // 23: the gluteus maximus 0.128 mm apart under 1e-7 of input noise). Only there: the one pass
+      // from the rest pose, its points deep in the bones, then moved by 19 mm under noise at
+      // flexion 60 degrees; inside muscles, which change shape under the triangles that held a
+      // point, two crossed spindles stopped with points inside each other; and at a frame's start
+      // only, hip_flexion frame 35 moved by 0.73 mm on another seed (docs/DESIGN.md section 7).
       std::optional<TriangleTree::Hit> wayIn;
       if (inside && !this->WasInside[m][flag])
       {
         wayIn = tree.FirstHit(this->Previous[m].row(i).transpose(), p);
       }
       this->InNow[m][flag] = inside;
-      std::vector<Eigen::Index> triangles{ wayIn ? wayIn->triangle
-          : within.triangle >= 0                 ? within.triangle
-                                                 : tree.ClosestPoint(p).triangle };
+      std::vector<Eigen::Index> triangles;
+      if (wayIn)
+      {
+        triangles.push_back(wayIn->triangle);
+      }
+      else if (!inside || before == this->Held.end() || o >= bones || !this->CarriesContacts)
+      {
+        triangles.push_back(within.triangle >= 0 ? within.triangle : tree.ClosestPoint(p).triangle);
+      }
       if (before != this->Held.end())
       {
         triangles.insert(triangles.end(), before->second.begin(), before->second.end());
@@ -1100,6 +1116,8 @@ private:
     }
   }
 
+  /// A settle of a motion that carries its contacts from frame to frame (SettleMotion::carryContacts).
+  bool CarriesContacts = false;
   const std::vector<TriangleMesh>& Meshes;
   const std::vector<const SurfaceEnergy*>& Energies;
   const std::vector<FixedObstacle>& Bones;
@@ -1499,7 +1517,8 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     // before) and the volume's direction K^-1 g, independent of each other, in one parallel loop:
     // the gluteus maximus's solve takes one core while the other does the other muscles' and the
     // contact search (each in the same arithmetic as alone).
-    ContactSearch search(meshes, energies, bones, trees, restOverlap, held, previous, parameters, wasInside, clearance);
+    ContactSearch search(meshes, energies, bones, trees, restOverlap, held, previous, parameters, wasInside, clearance,
+      motion && motion->carryContacts);
     std::vector<Points> gradients(count), along(count);
     std::vector<double> volumeNow(count), volumeRight(count);
     const int tasks = static_cast<int>(count) + search.NumberOfBlocks();

@@ -11,7 +11,7 @@
 // present, the LHDL hip in four poses. Prints figures; asserts nothing.
 //
 //   BenchmarkStability [data folder] [case: all|phantom|flexion30|flexion60|adduction-40|adduction40]
-//                      [seeds (3)] [methods: all|one-pass|filter|N (1, 4, 8)|settle|settle-N|settle-all]
+//                      [seeds (3)] [methods: all|one-pass|filter|filter-surface|N (1, 4, 8)|settle|settle-N|settle-all]
 #include "RealData.h"
 
 #include "LocalFrame.h"
@@ -366,6 +366,9 @@ int main(int argc, char* argv[])
   if (methodsArg == "all" || methodsArg == "filter") // MuscleDeformation itself
   {
     methods.push_back({ "MuscleDeformation, hull (paper)", 1, 0.0, false, Method::Filter::PassOnHull });
+  }
+  if (methodsArg == "all" || methodsArg == "filter" || methodsArg == "filter-surface")
+  {
     methods.push_back({ "MuscleDeformation, muscle surface", 1, 0.0, true, Method::Filter::PassOnSurface });
   }
   // Each step solved on the muscles' surfaces (DeformationMesh Muscle surface, the default):
@@ -381,7 +384,8 @@ int main(int argc, char* argv[])
   if (methods.empty())
   {
     std::fprintf(stderr,
-      "unknown methods '%s': all, one-pass, filter, 1, 4, 8, settle, settle-1, settle-4, settle-8 or settle-all\n",
+      "unknown methods '%s': all, one-pass, filter, filter-surface, 1, 4, 8, settle, settle-1, settle-4, settle-8 or "
+      "settle-all\n",
       methodsArg.c_str());
     return 2;
   }

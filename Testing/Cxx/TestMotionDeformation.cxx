@@ -239,21 +239,12 @@ TEST(MotionDeformation, OnTheHipEveryFrameOfBothMotionsIsSound)
   }
 }
 
-TEST(MotionDeformation, OnTheHipAMotionDependsOnNoRoundingNoise)
+namespace
 {
-  // hip_flexion and hip_adduction on the exact input and with every coordinate of the bones and
-  // muscles moved by at most 1e-7 of itself (hip_flexion seed 2, hip_adduction seed 1, the seeds
-  // that showed the two rules below wanting; BenchmarkMotion for more): the surfaces at every
-  // frame, within issue 13's 0.01 mm. Measured (Release): every frame within 0.0006 mm, on seeds
-  // 1-3 of both motions. Two rules hold that:
-  // - A motion's step is settled in parts whose minimum moves at most largestCarriedMove, each
-  //   carrying the last one's contacts (SettleParts). At hip_flexion frame 33 the iliacus's path
-  //   point goes and its line jumps by 19 mm; settled from no contacts there, it swung between
-  //   contacts with the iliac bone for 25 iterations, and where it came to rest moved by 0.17 mm
-  //   with seed 2 (and by 1.1 mm when whether carried contacts settled within 30 iterations
-  //   decided which of two answers it took).
-  // - A settle whose steps grow is not extended as a creep (SteadyStep): at hip_adduction frame 13
-  //   that extension moved the iliacus by 0.9 mm at once, and its answer by 0.12 mm with seed 1.
+/// `motion` (LHDL) on the exact input and with every coordinate of the bones and muscles moved by
+/// at most 1e-7 of itself (each of `seeds`): the surfaces at every frame within issue 13's 0.01 mm.
+void ExpectNoRoundingNoise(const char* motion, const std::vector<int>& seeds)
+{
   auto run = [](const char* motion, int seed, std::vector<std::vector<md::Points>>& points) {
     MotionFrames frames;
     if (!LhdlFrames("", motion, seed, frames))
@@ -269,31 +260,59 @@ TEST(MotionDeformation, OnTheHipAMotionDependsOnNoRoundingNoise)
     }
     return true;
   };
-  for (const auto& [motion, seeds] : { std::pair<const char*, std::vector<int>>{ "hip_flexion", { 2 } },
-         std::pair<const char*, std::vector<int>>{ "hip_adduction", { 1 } } })
+  std::vector<std::vector<md::Points>> exact;
+  if (!run(motion, -1, exact))
   {
-    std::vector<std::vector<md::Points>> exact;
-    if (!run(motion, -1, exact))
-    {
-      GTEST_SKIP() << "the LHDL data (lhdl_hip_r) was not found";
-    }
-    for (const int seed : seeds)
-    {
-      std::vector<std::vector<md::Points>> perturbed;
-      ASSERT_TRUE(run(motion, seed, perturbed));
-      ASSERT_EQ(perturbed.size(), exact.size());
-      double largest = 0;
-      for (size_t k = 0; k < exact.size(); ++k)
-      {
-        for (size_t m = 0; m < exact[k].size(); ++m)
-        {
-          const double distance = (perturbed[k][m] - exact[k][m]).rowwise().norm().maxCoeff();
-          largest = std::max(largest, distance);
-          EXPECT_LT(distance, 0.01) << motion << " seed " << seed << " frame " << k << " muscle " << m;
-        }
-      }
-      std::printf(
-        "[ measured ] %s seed %d: largest distance from the exact input's surfaces %.6f mm\n", motion, seed, largest);
-    }
+    GTEST_SKIP() << "the LHDL data (lhdl_hip_r) was not found";
   }
+  for (const int seed : seeds)
+  {
+    std::vector<std::vector<md::Points>> perturbed;
+    ASSERT_TRUE(run(motion, seed, perturbed));
+    ASSERT_EQ(perturbed.size(), exact.size());
+    double largest = 0;
+    for (size_t k = 0; k < exact.size(); ++k)
+    {
+      for (size_t m = 0; m < exact[k].size(); ++m)
+      {
+        const double distance = (perturbed[k][m] - exact[k][m]).rowwise().norm().maxCoeff();
+        largest = std::max(largest, distance);
+        EXPECT_LT(distance, 0.01) << motion << " seed " << seed << " frame " << k << " muscle " << m;
+      }
+    }
+    std::printf(
+      "[ measured ] %s seed %d: largest distance from the exact input's surfaces %.6f mm\n", motion, seed, largest);
+  }
+}
+}
+
+TEST(MotionDeformation, OnTheHipAMotionDependsOnNoRoundingNoise)
+{
+  // hip_flexion and hip_adduction on the exact input and with every coordinate of the bones and
+  // muscles moved by at most 1e-7 of itself (hip_flexion seeds 2, 5 and 6 here, hip_adduction seed 1
+  // in the test below: the seeds that showed the rules below wanting; BenchmarkMotion for more):
+  // the surfaces at every frame, within issue 13's 0.01 mm. Three rules hold that:
+  // - A motion's step is settled in parts whose minimum moves at most largestCarriedMove, each
+  //   carrying the last one's contacts (SettleParts). At hip_flexion frame 33 the iliacus's path
+  //   point goes and its line jumps by 19 mm; settled from no contacts there, it swung between
+  //   contacts with the iliac bone for 25 iterations, and where it came to rest moved by 0.17 mm
+  //   with seed 2 (and by 1.1 mm when whether carried contacts settled within 30 iterations
+  //   decided which of two answers it took).
+  // - A settle whose steps grow is not extended as a creep (SteadyStep): at hip_adduction frame 13
+  //   that extension moved the iliacus by 0.9 mm at once, and its answer by 0.12 mm with seed 1.
+  // - Through a motion, a point inside a bone that held it goes out through the triangles that held
+  //   it, not by its nearest (SurfaceSettle's ContactSearch): at hip_flexion frame 23 the start
+  //   took a gluteus maximus point held on a slightly convex ridge of the iliac bone inside, near
+  //   the ridge's bisector, where rounding chose the nearest face, and the face it went out
+  //   through chose between two equilibria 0.128 mm apart with seed 5 (applied at the start only,
+  //   frame 35 moved by 0.73 mm with seed 6).
+  // Measured (Release): every frame within 0.0009 mm on seeds 1-7 of hip_flexion and 1-6 of
+  // hip_adduction (BenchmarkMotion).
+  ExpectNoRoundingNoise("hip_flexion", { 2, 5, 6 });
+}
+
+TEST(MotionDeformation, OnTheHipAdductionDependsOnNoRoundingNoiseEither)
+{
+  // Its own test, for the time each takes (a perturbed run loads and perturbs the whole motion).
+  ExpectNoRoundingNoise("hip_adduction", { 1 });
 }
