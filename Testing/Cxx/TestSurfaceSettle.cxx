@@ -1058,15 +1058,21 @@ TEST(SurfaceSettle, OnTheHipOneLargeStepIsSettledInPartsAsReproducibly)
   // 0.28 of a muscle's size. Settled at once, the exact input diverged and two of three
   // perturbed inputs swung to the end of their iterations, up to 5.6 mm apart. In parts that
   // move it by an eighth at most, every muscle settles (SettledHip's checks) and 1e-7 noise
-  // moves the answer by 0.0003 mm (measured), as in four steps.
-  MotionCase exact;
-  if (!LhdlMotion("hip_adduction", 0, exact))
+  // moves the answer by 0.0003 mm (measured), as in four steps. Flexion 60 degrees in one step
+  // likewise (0.0004 / 0.0005 mm): the single step that MuscleDeformation's one pass on the
+  // surface cannot make reproducibly (up to 1.4 mm there), as it is not given the bones' rest pose.
+  for (const auto& [motion, frame] : { std::pair<const char*, int>{ "hip_adduction", 0 }, { "hip_flexion", 35 } })
   {
-    GTEST_SKIP() << "LHDL data not found (set MUSCLEDEFORMATION_DATA_DIR)";
+    MotionCase exact;
+    if (!LhdlMotion(motion, frame, exact))
+    {
+      GTEST_SKIP() << "LHDL data not found (set MUSCLEDEFORMATION_DATA_DIR)";
+    }
+    const md::InterpolationResult settled = SettledHip(exact, 250, 1);
+    EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 2), 250, 1)), 0.002) << motion << ": 1e-7 noise";
+    EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 1, true), 250, 1)), 0.005)
+      << motion << ": duplicates split";
   }
-  const md::InterpolationResult settled = SettledHip(exact, 250, 1);
-  EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 2), 250, 1)), 0.002) << "1e-7 noise";
-  EXPECT_LT(LargestAtAnyStep(settled, SettledHip(Perturbed(exact, 1, true), 250, 1)), 0.005) << "duplicates split";
 }
 
 TEST(SurfaceSettle, ASettleThatCreepsIsCarriedToItsEnd)
@@ -1142,9 +1148,67 @@ TEST(SurfaceSettle, CrossedMusclesSettleApartThoughTheirContactsOppose)
   EXPECT_GT((meshes[0].points - s.muscle.points).rowwise().norm().maxCoeff(), 1.0); // it moved
 }
 
-// Open (issue 13): from the rest pose, with the lines bent towards each other, the settle of
-// two muscles in contact does not converge yet - the contacts of two moving surfaces change
-// from iteration to iteration. Disabled so that the suite passes; gtest lists it as disabled.
+namespace
+{
+/// `second`'s points mirrored about y = `apart`.y() / 2 and reordered as `first`'s: the point of
+/// `second` that mirrors `first`'s point i is the one that mirrors it at rest (`rest`, whose
+/// copy `second` is, moved by `apart`).
+md::Points MirroredAsFirst(const md::Points& rest, const md::Points& second, const Eigen::RowVector3d& apart)
+{
+  const Eigen::RowVector3d flip(1, -1, 1);
+  md::Points mirrored(rest.rows(), 3);
+  for (Eigen::Index i = 0; i < rest.rows(); ++i)
+  {
+    Eigen::Index twin = 0;
+    (rest.rowwise() - rest.row(i).cwiseProduct(flip)).rowwise().squaredNorm().minCoeff(&twin);
+    mirrored.row(i) = second.row(twin).cwiseProduct(flip) + apart;
+  }
+  return mirrored;
+}
+}
+
+TEST(SurfaceSettle, TwoMusclesPressedTogetherThroughTheMethodBothGiveWay)
+{
+  // Two spindles side by side, 2 apart, their lines bent 25 degrees towards each other (their
+  // far halves' lines cross), through the interpolation method in 4 steps: each settles with no
+  // point inside the other, each is pushed away from where it would go alone, both give way
+  // alike (mirror images about y = 13, as far as the spindle's triangulation is mirror
+  // symmetric: 0.09 mm measured), and the answer does not depend on the muscles' order (1.5e-9 mm
+  // measured). Bent 30 degrees, the order moved them by 2.6 mm (204 iterations, near a
+  // symmetric press where which one gives way more is a bifurcation); bent 40, no step count
+  // settles them (the disabled test below).
+  const Spindle s;
+  const Eigen::RowVector3d apart(0, 26, 0);
+  md::Points otherBent = Bent(s.line, -25);
+  otherBent.rowwise() += apart;
+  const md::MuscleMotion first{ "first", s.muscle, { { s.line, Bent(s.line, 25) } } };
+  const md::MuscleMotion second{ "second", { s.muscle.points.rowwise() + apart, s.muscle.triangles },
+    { { md::Points(s.line.rowwise() + apart), otherBent } } };
+  md::InterpolationParameters parameters;
+  parameters.numberOfSteps = 4;
+  parameters.settleOnSurface = true;
+  const md::InterpolationResult together = md::DeformByInterpolation({ first, second }, {}, parameters);
+  const md::InterpolationResult swapped = md::DeformByInterpolation({ second, first }, {}, parameters);
+  const std::vector<md::Points>& last = together.points.back();
+  for (size_t m = 0; m < 2; ++m)
+  {
+    const md::MuscleStepMeasures& measures = together.measures.back()[m];
+    EXPECT_TRUE(measures.converged) << "muscle " << m;
+    EXPECT_LT(std::abs(measures.volumeChangePercent), 1e-4) << "muscle " << m;
+    EXPECT_EQ(CountInside(md::TriangleTree(md::TriangleMesh{ last[1 - m], s.muscle.triangles }), last[m]), 0)
+      << "muscle " << m;
+    const md::Points alone = md::DeformByInterpolation({ m == 0 ? first : second }, {}, parameters).points.back()[0];
+    EXPECT_GT((last[m] - alone).rowwise().norm().maxCoeff(), 1.0) << "muscle " << m;
+    EXPECT_LT((last[m] - swapped.points.back()[1 - m]).rowwise().norm().maxCoeff(), 1e-6 * s.Size()) << "muscle " << m;
+  }
+  EXPECT_LT((MirroredAsFirst(s.muscle.points, last[1], apart) - last[0]).rowwise().norm().maxCoeff(), 5e-3 * s.Size());
+}
+
+// Open (docs/DESIGN.md section 7, "What is still open"): from the rest pose, with the lines
+// bent towards each other, the settle of two muscles in contact does not converge yet - the
+// contacts of two moving surfaces change from iteration to iteration; through the interpolation
+// method in 1, 2, 4 or 8 steps neither. Disabled so that the suite passes; gtest lists it as
+// disabled.
 TEST(SurfaceSettle, DISABLED_TwoMusclesPressedTogetherBothGiveWay)
 {
   // Two spindles side by side, 2 apart, their lines bent 40 degrees towards each other:
@@ -1192,7 +1256,7 @@ TEST(SurfaceSettle, DISABLED_TwoMusclesPressedTogetherBothGiveWay)
     EXPECT_NEAR(md::EnclosedVolume(together[m].points, together[m].triangles), volume, 1e-8 * volume);
   }
   // The same stiffness on both sides: they give way alike (mirror images about y = 13).
-  md::Points mirrored = together[1].points;
-  mirrored.col(1) = (26.0 - mirrored.col(1).array()).matrix();
-  EXPECT_LT((mirrored - together[0].points).rowwise().norm().maxCoeff(), 1e-3 * s.Size());
+  EXPECT_LT(
+    (MirroredAsFirst(s.muscle.points, together[1].points, apart) - together[0].points).rowwise().norm().maxCoeff(),
+    5e-3 * s.Size());
 }
