@@ -1390,6 +1390,466 @@ int SettleParts(double startMove, const SettleParameters& parameters, bool carri
   return static_cast<int>(std::clamp(std::ceil(startMove / largest), 1.0, double(kMostParts)));
 }
 
+namespace
+{
+/// The samples let go in a pose (their rows' energy taken partly or wholly away), each as an
+/// equality of the dual system per axis, a . x - y / share = target, whose multiplier y takes
+/// that share of the row's pull back out.
+struct LetGoRows
+{
+  std::vector<Contact> rows;
+  std::vector<double> shares; ///< each row's share
+};
+
+LetGoRows LetGoRowsOf(const std::vector<const SurfaceEnergy*>& energies,
+  const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones,
+  const SettleMotion* motion)
+{
+  const size_t count = energies.size();
+  LetGoRows letGo;
+  for (size_t m = 0; m < count; ++m)
+  {
+    const std::vector<double>* rest = motion && motion->restDepths.size() == count ? &motion->restDepths[m] : nullptr;
+    for (const SurfaceEnergy::LetGo& sample : energies[m]->SamplesLetGo(lines[m], bones, rest))
+    {
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        Contact row;
+        row.muscle = m;
+        row.normal = Eigen::Vector3d::Unit(axis);
+        row.target = sample.target(axis);
+        row.terms.push_back(
+          { m, SurfaceEnergy::SampleKey(sample.sample), 1.0, nullptr, &energies[m]->SampleRow(sample.sample) });
+        letGo.rows.push_back(std::move(row));
+        letGo.shares.push_back(sample.share);
+      }
+    }
+  }
+  return letGo;
+}
+
+/// One iteration's linearisation: per muscle the minimum without contact and volume (`free`),
+/// the volume's gradient g and its direction K^-1 g (`along`), and the volume's row's right-hand
+/// side; the samples let go; the muscles, costliest solve first.
+struct Linearised
+{
+  const std::vector<const SurfaceEnergy*>& energies;
+  const std::vector<Points>& free;
+  const std::vector<Points>& gradients;
+  const std::vector<Points>& along;
+  const std::vector<double>& volumeRight;
+  const LetGoRows& letGo;
+  const std::vector<int>& costliestFirst;
+};
+
+/// The dual system S y = rhs over `contacts` (the first `nc` inequalities, then the let-go
+/// equalities) and one volume row per muscle: S_jl = a_j . K^-1 a_l. Points each contact's terms
+/// at the energy's inverse columns, prepared here.
+Eigen::MatrixXd DualSystem(const Linearised& in, std::vector<Contact>& contacts, Eigen::Index nc, Eigen::VectorXd& rhs)
+{
+  const size_t count = in.energies.size();
+  const Eigen::Index volumeStart = static_cast<Eigen::Index>(contacts.size());
+  // The inverse's columns at every point a contact names.
+  std::vector<std::vector<Eigen::Index>> needed(count);
+  for (const Contact& c : contacts)
+  {
+    for (const Term& t : c.terms)
+    {
+      needed[t.muscle].push_back(t.point);
+    }
+  }
+  const Eigen::Index size = volumeStart + static_cast<Eigen::Index>(count);
+  rhs.resize(size);
+  for (size_t m = 0; m < count; ++m)
+  {
+    rhs(volumeStart + static_cast<Eigen::Index>(m)) = in.volumeRight[m];
+  }
+  SurfaceEnergy::PrepareAll(in.energies, needed);
+  for (Contact& c : contacts)
+  {
+    for (Term& t : c.terms)
+    {
+      t.column = &in.energies[t.muscle]->InverseColumn(t.point);
+    }
+  }
+  Eigen::MatrixXd system = Eigen::MatrixXd::Zero(size, size);
+  for (Eigen::Index j = 0; j < volumeStart; ++j)
+  {
+    const Contact& a = contacts[static_cast<size_t>(j)];
+    double value = 0;
+    for (const Term& t : a.terms)
+    {
+      value += t.coefficient * a.normal.dot(Where(t, in.free[t.muscle]));
+      system(j, volumeStart + static_cast<Eigen::Index>(t.muscle)) +=
+        t.coefficient * a.normal.dot(Where(t, in.along[t.muscle]));
+    }
+    rhs(j) = a.target - value;
+    for (Eigen::Index l = 0; l <= j; ++l)
+    {
+      const Contact& b = contacts[static_cast<size_t>(l)];
+      double sum = 0;
+      for (const Term& s : a.terms)
+      {
+        for (const Term& t : b.terms)
+        {
+          sum += s.coefficient * t.coefficient * InverseBetween(s, t);
+        }
+      }
+      system(j, l) = system(l, j) = sum * a.normal.dot(b.normal);
+    }
+  }
+  for (Eigen::Index j = nc; j < volumeStart; ++j)
+  {
+    system(j, j) -= 1 / in.letGo.shares[static_cast<size_t>(j - nc)];
+  }
+  for (size_t m = 0; m < count; ++m)
+  {
+    const Eigen::Index v = volumeStart + static_cast<Eigen::Index>(m);
+    system.row(v).head(volumeStart) = system.col(v).head(volumeStart).transpose();
+    system(v, v) = (in.gradients[m].array() * in.along[m].array()).sum();
+  }
+  return system;
+}
+
+/// One active row's push on a muscle's points: its multiplier times its coefficient, along the
+/// inverse's column at its point, in the row's direction.
+struct Push
+{
+  double size;
+  const Eigen::VectorXd* column;
+  Eigen::Vector3d normal;
+};
+
+/// The new points x = free + mu K^-1 g + the pushes, over blocks of points (of every muscle, in
+/// one parallel loop): a block's rows stay in the first-level cache while every push goes over
+/// them, where a push at a time over all the points went to the second level. Each point takes
+/// the pushes in the rows' order: the same sums as PointAt's.
+std::vector<Points> ApplyPushes(
+  const Linearised& in, const Eigen::VectorXd& volumeMultipliers, const std::vector<std::vector<Push>>& pushes)
+{
+  const size_t count = in.energies.size();
+  std::vector<Points> next(count);
+  std::vector<std::pair<size_t, Eigen::Index>> blocks; // (muscle, first point)
+  for (const int muscle : in.costliestFirst)
+  {
+    const auto m = static_cast<size_t>(muscle);
+    next[m].resize(in.free[m].rows(), 3);
+    for (Eigen::Index first = 0; first < in.free[m].rows(); first += kPushBlock)
+    {
+      blocks.emplace_back(m, first);
+    }
+  }
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int b = 0; b < static_cast<int>(blocks.size()); ++b)
+  {
+    const auto [m, first] = blocks[static_cast<size_t>(b)];
+    Points& x = next[m];
+    const Eigen::Index end = std::min(first + kPushBlock, x.rows());
+    const double volume = volumeMultipliers(static_cast<Eigen::Index>(m));
+    for (Eigen::Index i = first; i < end; ++i)
+    {
+      x.row(i) = in.free[m].row(i) + volume * in.along[m].row(i);
+    }
+    for (const Push& push : pushes[m])
+    {
+      for (Eigen::Index i = first; i < end; ++i)
+      {
+        x.row(i) += (push.size * (*push.column)(i)) * push.normal.transpose();
+      }
+    }
+  }
+  return next;
+}
+
+/// What one iteration's step gives: every muscle's new points, the contacts that held them
+/// (their triangles) and how many of each muscle's points were held.
+struct Step
+{
+  std::vector<Points> points;
+  HeldContacts held;
+  std::vector<std::int64_t> inContact;
+};
+
+/// The step of one iteration: the quadratic energy's minimum under the linearised contacts
+/// `primary` (and the let-go rows and the volumes), by the active set started from the contacts
+/// `held` at the last iteration. A watched contact (`pending`, near but not yet broken) joins
+/// if the step would break it, and the step is solved again with it (kJoiningRounds at most):
+/// the step is then that of the quadratic energy under every constraint within the lookahead,
+/// which moves continuously with the points, where a point just beyond the offset would
+/// otherwise go in unhindered and be pushed out at the next iteration (the path, and with
+/// several equilibria the answer, jumping with rounding). A step that blows up (moves a point
+/// by kBlownUp of its muscle's size) is solved again as found, with the nearly opposed rows left
+/// out and nothing watched.
+Step StepUnderContacts(const Linearised& in, std::vector<Contact> primary, std::vector<Contact> pending,
+  const HeldContacts& held, const std::vector<TriangleMesh>& meshes, size_t bones, const SettleParameters& parameters)
+{
+  const size_t count = in.energies.size();
+  // How far a point may break a contact that does not hold it before the contact joins: an
+  // inactive one the active set (SolveActiveSet), a watched one the step.
+  auto joiningSlack = [&](const Contact& c) {
+    return 1e-3 * parameters.tolerance * in.energies[c.muscle]->Size();
+  };
+  const size_t found = primary.size(); // the contacts before any watched one joined
+  bool strict = false;                 // solved again after blowing up (kNearlyOpposed)
+  for (int rounds = 0;;)
+  {
+    std::vector<Contact> contacts = primary;
+    const Eigen::Index nc = static_cast<Eigen::Index>(contacts.size());
+    contacts.insert(contacts.end(), in.letGo.rows.begin(), in.letGo.rows.end());
+    const Eigen::Index volumeStart = static_cast<Eigen::Index>(contacts.size());
+    Eigen::VectorXd rhs;
+    const Eigen::MatrixXd system = DualSystem(in, contacts, nc, rhs);
+
+    // The active set: the multipliers of the active contacts and volumes, the inactive
+    // contacts' points where they would go; a contact whose multiplier pulls lets go, one whose
+    // point would be inside joins.
+    std::vector<char> active(static_cast<size_t>(system.rows()), 1);
+    for (Eigen::Index j = 0; j < nc; ++j)
+    {
+      const Contact& c = contacts[static_cast<size_t>(j)];
+      const auto before = held.find({ c.muscle, c.point, c.obstacle });
+      active[j] = c.violated ||
+        (before != held.end() &&
+          std::find(before->second.begin(), before->second.end(), c.triangle) != before->second.end());
+    }
+    std::vector<double> slack(static_cast<size_t>(nc));
+    for (Eigen::Index j = 0; j < nc; ++j)
+    {
+      slack[j] = joiningSlack(contacts[static_cast<size_t>(j)]);
+    }
+    ExcludeOpposedContacts(contacts, bones, system, active, slack, strict ? kNearlyOpposed : kExactlyOpposed);
+    const Eigen::VectorXd multipliers = SolveActiveSet(system, rhs, slack, active);
+    const Eigen::VectorXd volumeMultipliers = multipliers.tail(static_cast<Eigen::Index>(count));
+
+    Step step;
+    step.inContact.assign(count, 0);
+    std::vector<std::vector<Push>> pushes(count); // each muscle's, in the rows' order
+    for (Eigen::Index j = 0; j < volumeStart; ++j)
+    {
+      if (!active[j])
+      {
+        continue;
+      }
+      const Contact& c = contacts[static_cast<size_t>(j)];
+      if (j < nc)
+      {
+        step.held[{ c.muscle, c.point, c.obstacle }].push_back(c.triangle);
+        ++step.inContact[c.muscle];
+      }
+      for (const Term& t : c.terms)
+      {
+        pushes[t.muscle].push_back({ multipliers(j) * t.coefficient, t.column, c.normal });
+      }
+    }
+    // Where the step takes point i of muscle m: ApplyPushes at one point, the same sums.
+    auto pointAt = [&](size_t m, Eigen::Index i) {
+      Eigen::RowVector3d x = in.free[m].row(i) + volumeMultipliers(static_cast<Eigen::Index>(m)) * in.along[m].row(i);
+      for (const Push& push : pushes[m])
+      {
+        x += (push.size * (*push.column)(i)) * push.normal.transpose();
+      }
+      return Eigen::Vector3d(x.transpose());
+    };
+    std::vector<Contact> stillPending;
+    const size_t joinedBefore = primary.size();
+    for (Contact& c : pending)
+    {
+      double value = 0;
+      for (const Term& t : c.terms)
+      {
+        value += t.coefficient * c.normal.dot(pointAt(t.muscle, t.point));
+      }
+      (value - c.target < -joiningSlack(c) ? primary : stillPending).push_back(std::move(c));
+    }
+    pending = std::move(stillPending);
+    if (primary.size() > joinedBefore && ++rounds < kJoiningRounds)
+    {
+      continue;
+    }
+    step.points = ApplyPushes(in, volumeMultipliers, pushes);
+    bool blownUp = false;
+    for (size_t m = 0; m < count && !strict; ++m)
+    {
+      blownUp =
+        blownUp || (step.points[m] - meshes[m].points).cwiseAbs().maxCoeff() > kBlownUp * in.energies[m]->Size();
+    }
+    if (blownUp)
+    {
+      primary.resize(found);
+      pending.clear();
+      strict = true;
+      continue;
+    }
+    return step;
+  }
+}
+
+/// Records in `motion` where the settle ended (`muscles`, `free`, the bones' clearances and
+/// placements) and, where it carries contacts, the contacts that held the muscles there; a
+/// settle that `diverged` leaves no clearances, placements or contacts.
+void RecordInMotion(SettleMotion& motion, const std::vector<TriangleMesh>& muscles, std::vector<Points> free,
+  std::vector<std::vector<double>> boneClearance, const std::vector<RigidFit>& placements, const HeldContacts& held,
+  bool diverged)
+{
+  motion.points.clear();
+  for (const TriangleMesh& muscle : muscles)
+  {
+    motion.points.push_back(muscle.points);
+  }
+  motion.free = std::move(free);
+  motion.boneClearance = std::move(boneClearance);
+  motion.bonePlacements = diverged ? std::vector<RigidFit>() : placements;
+  motion.held.clear();
+  if (motion.carryContacts && !diverged) // a diverged settle's contacts hold nothing
+  {
+    for (const auto& [key, triangles] : held)
+    {
+      for (const Eigen::Index t : triangles)
+      {
+        motion.held.push_back({ static_cast<Eigen::Index>(std::get<0>(key)), std::get<1>(key),
+          static_cast<Eigen::Index>(std::get<2>(key)), t });
+      }
+    }
+  }
+}
+
+/// Where a settle is between iterations, on the muscles' welded surfaces.
+struct SettleState
+{
+  std::vector<TriangleMesh> meshes; ///< the welded surfaces (the energies' triangles)
+  std::vector<double> targets;      ///< the volume each must hold
+  std::vector<std::unique_ptr<TriangleTree>> trees;
+  HeldContacts held; ///< the contacts active at the last iteration (the last settle's at the first)
+  /// ContactSearch's: which obstacles each point was inside at the last iteration, and how far
+  /// it is proven outside each.
+  std::vector<std::vector<char>> wasInside;
+  std::vector<std::vector<double>> clearance;
+  std::vector<Points> previous; ///< the points at the last iteration
+};
+
+/// The settle's start: with `motion`, where the last settle ended moved as the unconstrained
+/// minimum moved (from its `free` to `free`; written to `muscles`' points), with its contacts
+/// where it carries them and the clearances it proved, made good for the bones' `placements`.
+SettleState StartSettle(std::vector<TriangleMesh>& muscles, const std::vector<const SurfaceEnergy*>& energies,
+  const std::vector<double>& volumes, size_t bones, const std::vector<Points>& free, const SettleMotion* motion,
+  const std::vector<RigidFit>& placements)
+{
+  const size_t count = muscles.size();
+  const size_t obstacles = bones + count;
+  if (motion && motion->points.size() == count)
+  {
+    for (size_t m = 0; m < count; ++m)
+    {
+      muscles[m].points = motion->points[m] + (free[m] - motion->free[m]);
+      // The points the welded surface does not use go with it, so that the volume the welding
+      // takes away below is that of this start (left where the last step put them, the rest
+      // pose at the first, they took up to 3e-6 of the LHDL iliacus's volume in one pass).
+      energies[m]->CarryToUnwelded(muscles[m].points);
+    }
+  }
+  // Settled on the welded surfaces, written back at the end. The volume each must hold is the
+  // muscle's less the difference the welding makes at the start (nothing for exact duplicates,
+  // rounding for split ones).
+  SettleState s;
+  s.meshes.resize(count);
+  s.targets.resize(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    s.meshes[m] = { muscles[m].points, energies[m]->Surface() };
+    s.targets[m] = volumes[m] - EnclosedVolume(muscles[m].points, muscles[m].triangles) +
+      EnclosedVolume(s.meshes[m].points, s.meshes[m].triangles);
+  }
+  s.trees.resize(count);
+  if (motion && motion->carryContacts)
+  {
+    for (const auto& [m, point, obstacle, triangle] : motion->held)
+    {
+      s.held[{ static_cast<size_t>(m), point, static_cast<size_t>(obstacle) }].push_back(triangle);
+    }
+  }
+  // At the start every point is taken as inside every obstacle, so that a point inside at the
+  // start goes out the nearest way. What the last settle proved of the points' distances from
+  // the bones is carried here.
+  std::vector<std::vector<double>> carried =
+    motion ? BoneClearancesNow(*motion, s.meshes, placements) : std::vector<std::vector<double>>();
+  s.wasInside.resize(count);
+  s.clearance.resize(count);
+  s.previous.resize(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    s.wasInside[m].assign(static_cast<size_t>(s.meshes[m].points.rows()) * obstacles, 1);
+    if (carried.size() == count)
+    {
+      s.clearance[m] = std::move(carried[m]);
+    }
+    else
+    {
+      s.clearance[m].assign(static_cast<size_t>(s.meshes[m].points.rows()) * obstacles, 0.0);
+    }
+    s.previous[m] = s.meshes[m].points;
+  }
+  return s;
+}
+
+/// The volumes linearised at the current points: per muscle V(x), its gradient g, the
+/// direction K^-1 g and the right-hand side of g . x_new = V - V(x) + g . x.
+struct VolumeRows
+{
+  std::vector<double> now;
+  std::vector<Points> gradients;
+  std::vector<Points> along;
+  std::vector<double> right;
+};
+
+/// One iteration's linearisation at the points `s` holds (their trees refitted there): the
+/// contacts (every point inside an obstacle or nearer than the offset, and those held before;
+/// returned, the watched ones in `pending`) and the volumes, independent of each other, in one
+/// parallel loop: the gluteus maximus's solve takes one core while the other does the other
+/// muscles' and the contact search (each in the same arithmetic as alone).
+std::vector<Contact> LineariseAt(SettleState& s, const std::vector<const SurfaceEnergy*>& energies,
+  const std::vector<FixedObstacle>& bones, const OverlapMasks* restOverlap, const SettleParameters& parameters,
+  bool carriesContacts, const std::vector<Points>& free, const std::vector<int>& costliestFirst, VolumeRows& volumes,
+  std::vector<Contact>& pending)
+{
+  const size_t count = s.meshes.size();
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int m = 0; m < static_cast<int>(count); ++m)
+  {
+    if (s.trees[m])
+    {
+      s.trees[m]->Refit(s.meshes[m].points);
+    }
+    else
+    {
+      s.trees[m] = std::make_unique<TriangleTree>(s.meshes[m]);
+    }
+  }
+  ContactSearch search(s.meshes, energies, bones, s.trees, restOverlap, s.held, s.previous, parameters, s.wasInside,
+    s.clearance, carriesContacts);
+  volumes.gradients.assign(count, Points());
+  volumes.along.assign(count, Points());
+  volumes.now.assign(count, 0.0);
+  volumes.right.assign(count, 0.0);
+  const int tasks = static_cast<int>(count) + search.NumberOfBlocks();
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int task = 0; task < tasks; ++task)
+  {
+    if (task >= static_cast<int>(count))
+    {
+      search.Run(task - static_cast<int>(count));
+      continue;
+    }
+    const size_t m = static_cast<size_t>(costliestFirst[static_cast<size_t>(task)]);
+    const Points& x = s.meshes[m].points;
+    volumes.now[m] = EnclosedVolume(x, s.meshes[m].triangles, &volumes.gradients[m]);
+    volumes.along[m] = energies[m]->Solve(volumes.gradients[m]);
+    volumes.right[m] = s.targets[m] - volumes.now[m] + (volumes.gradients[m].array() * x.array()).sum() -
+      (volumes.gradients[m].array() * free[m].array()).sum();
+  }
+  return search.Finish(pending);
+}
+}
+
 std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   const std::vector<const SurfaceEnergy*>& energies, const std::vector<std::vector<MatchedLine>>& lines,
   const std::vector<double>& volumes, const std::vector<FixedObstacle>& bones, const OverlapMasks* restOverlap,
@@ -1406,89 +1866,13 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   // points in contact: columns of the inverse, kept by the energy for the whole motion.
   const auto start = Clock::now();
   const size_t count = muscles.size();
-  const size_t obstacles = bones.size() + count;
   // The minimum without contact and volume.
   std::vector<Points> free = freeMinima.size() == count ? std::move(freeMinima) : FreeMinima(energies, lines, bones);
-  // The samples let go in this pose (their rows' energy taken partly or wholly away): each is
-  // an equality of the dual system per axis, a . x - y / share = target, whose multiplier y
-  // takes that share of the row's pull back out.
-  std::vector<Contact> letGo;
-  std::vector<double> letGoShare;
-  for (size_t m = 0; m < count; ++m)
-  {
-    const std::vector<double>* rest = motion && motion->restDepths.size() == count ? &motion->restDepths[m] : nullptr;
-    for (const SurfaceEnergy::LetGo& sample : energies[m]->SamplesLetGo(lines[m], bones, rest))
-    {
-      for (int axis = 0; axis < 3; ++axis)
-      {
-        Contact row;
-        row.muscle = m;
-        row.normal = Eigen::Vector3d::Unit(axis);
-        row.target = sample.target(axis);
-        row.terms.push_back(
-          { m, SurfaceEnergy::SampleKey(sample.sample), 1.0, nullptr, &energies[m]->SampleRow(sample.sample) });
-        letGo.push_back(std::move(row));
-        letGoShare.push_back(sample.share);
-      }
-    }
-  }
-  // A motion's step starts where the last ended, moved as the unconstrained minimum moved.
-  if (motion && motion->points.size() == count)
-  {
-    for (size_t m = 0; m < count; ++m)
-    {
-      muscles[m].points = motion->points[m] + (free[m] - motion->free[m]);
-      // The points the welded surface does not use go with it, so that the volume the welding
-      // takes away below is that of this start (left where the last step put them, the rest
-      // pose at the first, they took up to 3e-6 of the LHDL iliacus's volume in one pass).
-      energies[m]->CarryToUnwelded(muscles[m].points);
-    }
-  }
-  // Settled on the welded surfaces (the energies' triangles), written back at the end. The
-  // volume each must hold is the muscle's less the difference the welding makes at the start
-  // (nothing for exact duplicates, rounding for split ones).
-  std::vector<TriangleMesh> meshes(count);
-  std::vector<double> targets(count);
-  for (size_t m = 0; m < count; ++m)
-  {
-    meshes[m] = { muscles[m].points, energies[m]->Surface() };
-    targets[m] = volumes[m] - EnclosedVolume(muscles[m].points, muscles[m].triangles) +
-      EnclosedVolume(meshes[m].points, meshes[m].triangles);
-  }
-  std::vector<SettleReport> reports(count);
-  std::vector<std::unique_ptr<TriangleTree>> trees(count);
-  HeldContacts held; // the contacts active at the last iteration (the last settle's at the first)
-  if (motion && motion->carryContacts)
-  {
-    for (const auto& [m, point, obstacle, triangle] : motion->held)
-    {
-      held[{ static_cast<size_t>(m), point, static_cast<size_t>(obstacle) }].push_back(triangle);
-    }
-  }
-  // Which obstacles each point was inside at the last iteration (at the start: as if it were
-  // inside them all, so that a point inside at the start goes out the nearest way) and where it was.
-  std::vector<std::vector<char>> wasInside(count);
-  std::vector<std::vector<double>> clearance(count); // ContactSearch's
-
-  // The bones where they are now, and what the last settle proved of the points' distances from
-  // them, carried here.
+  const LetGoRows letGo = LetGoRowsOf(energies, lines, bones, motion);
+  // The bones where they are now (to make good the clearances the last settle proved).
   const std::vector<RigidFit> placements = motion ? PlaceBones(motion->boneReference, bones) : std::vector<RigidFit>();
-  std::vector<std::vector<double>> carried =
-    motion ? BoneClearancesNow(*motion, meshes, placements) : std::vector<std::vector<double>>();
-  std::vector<Points> previous(count);
-  for (size_t m = 0; m < count; ++m)
-  {
-    wasInside[m].assign(static_cast<size_t>(meshes[m].points.rows()) * obstacles, 1);
-    if (carried.size() == count)
-    {
-      clearance[m] = std::move(carried[m]);
-    }
-    else
-    {
-      clearance[m].assign(static_cast<size_t>(meshes[m].points.rows()) * obstacles, 0.0);
-    }
-    previous[m] = meshes[m].points;
-  }
+  SettleState s = StartSettle(muscles, energies, volumes, bones.size(), free, motion, placements);
+  std::vector<SettleReport> reports(count);
   std::vector<Points> lastSteps; // each muscle's last move, for SteadyStep
   std::vector<double> sizes(count);
   for (size_t m = 0; m < count; ++m)
@@ -1501,248 +1885,15 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   int iteration = 0;
   for (; iteration < parameters.maximumIterations && !settled && !diverging; ++iteration)
   {
-#pragma omp parallel for schedule(dynamic, 1)
-    for (int m = 0; m < static_cast<int>(count); ++m)
-    {
-      if (trees[m])
-      {
-        trees[m]->Refit(meshes[m].points);
-      }
-      else
-      {
-        trees[m] = std::make_unique<TriangleTree>(meshes[m]);
-      }
-    }
-    // The contacts (every point inside an obstacle or nearer than the offset, and those held
-    // before) and the volume's direction K^-1 g, independent of each other, in one parallel loop:
-    // the gluteus maximus's solve takes one core while the other does the other muscles' and the
-    // contact search (each in the same arithmetic as alone).
-    ContactSearch search(meshes, energies, bones, trees, restOverlap, held, previous, parameters, wasInside, clearance,
-      motion && motion->carryContacts);
-    std::vector<Points> gradients(count), along(count);
-    std::vector<double> volumeNow(count), volumeRight(count);
-    const int tasks = static_cast<int>(count) + search.NumberOfBlocks();
-#pragma omp parallel for schedule(dynamic, 1)
-    for (int task = 0; task < tasks; ++task)
-    {
-      if (task >= static_cast<int>(count))
-      {
-        search.Run(task - static_cast<int>(count));
-        continue;
-      }
-      const size_t m = static_cast<size_t>(costliestFirst[static_cast<size_t>(task)]);
-      volumeNow[m] = EnclosedVolume(meshes[m].points, meshes[m].triangles, &gradients[m]);
-      along[m] = energies[m]->Solve(gradients[m]);
-      // g . x_new = V - V(x) + g . x, the volume's linearisation at x.
-      volumeRight[m] = targets[m] - volumeNow[m] + (gradients[m].array() * meshes[m].points.array()).sum() -
-        (gradients[m].array() * free[m].array()).sum();
-    }
+    VolumeRows volumeRows;
     std::vector<Contact> pending;
-    std::vector<Contact> primary = search.Finish(pending);
-    HeldContacts nowHeld;
-    std::vector<std::int64_t> inContact(count, 0);
-    std::vector<Points> next(count);
-    // How far a point may break a contact that does not hold it before the contact joins: an
-    // inactive one the active set (SolveActiveSet), a watched one the step.
-    auto joiningSlack = [&](const Contact& c) {
-      return 1e-3 * parameters.tolerance * energies[c.muscle]->Size();
-    };
-    const size_t found = primary.size(); // the contacts before any watched one joined
-    bool strict = false;                 // solved again after blowing up (kNearlyOpposed)
-    for (int rounds = 0;;)
-    {
-      std::vector<Contact> contacts = primary;
-      const Eigen::Index nc = static_cast<Eigen::Index>(contacts.size());
-      const Eigen::Index volumeStart = nc + static_cast<Eigen::Index>(letGo.size());
-      contacts.insert(contacts.end(), letGo.begin(), letGo.end());
-
-      // The inverse's columns at every point a contact names.
-      std::vector<std::vector<Eigen::Index>> needed(count);
-      for (const Contact& c : contacts)
-      {
-        for (const Term& t : c.terms)
-        {
-          needed[t.muscle].push_back(t.point);
-        }
-      }
-      const Eigen::Index size = volumeStart + static_cast<Eigen::Index>(count);
-      Eigen::VectorXd rhs(size);
-      for (size_t m = 0; m < count; ++m)
-      {
-        rhs(volumeStart + static_cast<Eigen::Index>(m)) = volumeRight[m];
-      }
-      SurfaceEnergy::PrepareAll(energies, needed);
-      for (Contact& c : contacts)
-      {
-        for (Term& t : c.terms)
-        {
-          t.column = &energies[t.muscle]->InverseColumn(t.point);
-        }
-      }
-      Eigen::MatrixXd system = Eigen::MatrixXd::Zero(size, size);
-      for (Eigen::Index j = 0; j < volumeStart; ++j)
-      {
-        const Contact& a = contacts[static_cast<size_t>(j)];
-        double value = 0;
-        for (const Term& t : a.terms)
-        {
-          value += t.coefficient * a.normal.dot(Where(t, free[t.muscle]));
-          system(j, volumeStart + static_cast<Eigen::Index>(t.muscle)) +=
-            t.coefficient * a.normal.dot(Where(t, along[t.muscle]));
-        }
-        rhs(j) = a.target - value;
-        for (Eigen::Index l = 0; l <= j; ++l)
-        {
-          const Contact& b = contacts[static_cast<size_t>(l)];
-          double sum = 0;
-          for (const Term& s : a.terms)
-          {
-            for (const Term& t : b.terms)
-            {
-              sum += s.coefficient * t.coefficient * InverseBetween(s, t);
-            }
-          }
-          system(j, l) = system(l, j) = sum * a.normal.dot(b.normal);
-        }
-      }
-      for (Eigen::Index j = nc; j < volumeStart; ++j)
-      {
-        system(j, j) -= 1 / letGoShare[static_cast<size_t>(j - nc)];
-      }
-      for (size_t m = 0; m < count; ++m)
-      {
-        const Eigen::Index v = volumeStart + static_cast<Eigen::Index>(m);
-        system.row(v).head(volumeStart) = system.col(v).head(volumeStart).transpose();
-        system(v, v) = (gradients[m].array() * along[m].array()).sum();
-      }
-
-      // The active set: the multipliers of the active contacts and volumes, the inactive
-      // contacts' points where they would go; a contact whose multiplier pulls lets go, one whose
-      // point would be inside joins.
-      std::vector<char> active(static_cast<size_t>(size), 1);
-      for (Eigen::Index j = 0; j < nc; ++j)
-      {
-        const Contact& c = contacts[static_cast<size_t>(j)];
-        const auto before = held.find({ c.muscle, c.point, c.obstacle });
-        active[j] = c.violated ||
-          (before != held.end() &&
-            std::find(before->second.begin(), before->second.end(), c.triangle) != before->second.end());
-      }
-      std::vector<double> slack(static_cast<size_t>(nc));
-      for (Eigen::Index j = 0; j < nc; ++j)
-      {
-        slack[j] = joiningSlack(contacts[static_cast<size_t>(j)]);
-      }
-      ExcludeOpposedContacts(contacts, bones.size(), system, active, slack, strict ? kNearlyOpposed : kExactlyOpposed);
-      const Eigen::VectorXd multipliers = SolveActiveSet(system, rhs, slack, active);
-
-      // The new points.
-      nowHeld.clear();
-      inContact.assign(count, 0);
-      struct Push
-      {
-        double size;
-        const Eigen::VectorXd* column;
-        Eigen::Vector3d normal;
-      };
-      std::vector<std::vector<Push>> pushes(count); // each muscle's, in the rows' order
-      for (Eigen::Index j = 0; j < volumeStart; ++j)
-      {
-        if (!active[j])
-        {
-          continue;
-        }
-        const Contact& c = contacts[static_cast<size_t>(j)];
-        if (j < nc)
-        {
-          nowHeld[{ c.muscle, c.point, c.obstacle }].push_back(c.triangle);
-          ++inContact[c.muscle];
-        }
-        for (const Term& t : c.terms)
-        {
-          pushes[t.muscle].push_back({ multipliers(j) * t.coefficient, t.column, c.normal });
-        }
-      }
-      // Where the step takes point i of muscle m: the update below at one point, the same sums.
-      auto PointAt = [&](size_t m, Eigen::Index i) {
-        Eigen::RowVector3d x =
-          free[m].row(i) + multipliers(volumeStart + static_cast<Eigen::Index>(m)) * along[m].row(i);
-        for (const Push& push : pushes[m])
-        {
-          x += (push.size * (*push.column)(i)) * push.normal.transpose();
-        }
-        return Eigen::Vector3d(x.transpose());
-      };
-      // A contact near but not yet broken joins if this step would break it: the step is then that
-      // of the quadratic energy under every constraint within the lookahead, which moves
-      // continuously with the points, where a point just beyond the offset would otherwise go in
-      // unhindered and be pushed out at the next iteration (the path, and with several equilibria
-      // the answer, jumping with rounding).
-      std::vector<Contact> stillPending;
-      const size_t joinedBefore = primary.size();
-      for (Contact& c : pending)
-      {
-        double value = 0;
-        for (const Term& t : c.terms)
-        {
-          value += t.coefficient * c.normal.dot(PointAt(t.muscle, t.point));
-        }
-        (value - c.target < -joiningSlack(c) ? primary : stillPending).push_back(std::move(c));
-      }
-      pending = std::move(stillPending);
-      if (primary.size() > joinedBefore && ++rounds < kJoiningRounds)
-      {
-        continue;
-      }
-      // x = free + mu K^-1 g + sum of the pushes, over blocks of points (of every muscle, in one
-      // parallel loop): a block's rows stay in the first-level cache while every push goes over
-      // them, where a push at a time over all the points went to the second level. Each point
-      // takes the pushes in the rows' order, as before: the same sums.
-      next.assign(count, Points());
-      std::vector<std::pair<size_t, Eigen::Index>> blocks; // (muscle, first point)
-      for (const int muscle : costliestFirst)
-      {
-        const auto m = static_cast<size_t>(muscle);
-        next[m].resize(free[m].rows(), 3);
-        for (Eigen::Index first = 0; first < free[m].rows(); first += kPushBlock)
-        {
-          blocks.emplace_back(m, first);
-        }
-      }
-#pragma omp parallel for schedule(dynamic, 1)
-      for (int b = 0; b < static_cast<int>(blocks.size()); ++b)
-      {
-        const auto [m, first] = blocks[static_cast<size_t>(b)];
-        Points& x = next[m];
-        const Eigen::Index end = std::min(first + kPushBlock, x.rows());
-        const double volume = multipliers(volumeStart + static_cast<Eigen::Index>(m));
-        for (Eigen::Index i = first; i < end; ++i)
-        {
-          x.row(i) = free[m].row(i) + volume * along[m].row(i);
-        }
-        for (const Push& push : pushes[m])
-        {
-          for (Eigen::Index i = first; i < end; ++i)
-          {
-            x.row(i) += (push.size * (*push.column)(i)) * push.normal.transpose();
-          }
-        }
-      }
-      // Blown up: solved again as found, with the nearly opposed rows left out and nothing watched.
-      bool blownUp = false;
-      for (size_t m = 0; m < count && !strict; ++m)
-      {
-        blownUp = blownUp || (next[m] - meshes[m].points).cwiseAbs().maxCoeff() > kBlownUp * energies[m]->Size();
-      }
-      if (blownUp)
-      {
-        primary.resize(found);
-        pending.clear();
-        strict = true;
-        continue;
-      }
-      break;
-    }
+    std::vector<Contact> primary = LineariseAt(s, energies, bones, restOverlap, parameters,
+      motion && motion->carryContacts, free, costliestFirst, volumeRows, pending);
+    const Linearised linearised{ energies, free, volumeRows.gradients, volumeRows.along, volumeRows.right, letGo,
+      costliestFirst };
+    Step step =
+      StepUnderContacts(linearised, std::move(primary), std::move(pending), s.held, s.meshes, bones.size(), parameters);
+    std::vector<Points>& next = step.points;
     for (size_t m = 0; m < count; ++m)
     {
       if (!next[m].allFinite())
@@ -1750,10 +1901,13 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
         throw OfMuscle(ComputationError("the full-mesh deformation of a muscle diverged"), m);
       }
     }
-    settled = nowHeld == held;
+    // Settled when the contacts are the last iteration's, no point moves more than the
+    // tolerance and every volume is within 1e-9 of its target; diverging after kFarMovesToStop
+    // far moves.
+    settled = step.held == s.held;
     if (settled)
     {
-      SteadyStep(meshes, next, lastSteps, sizes);
+      SteadyStep(s.meshes, next, lastSteps, sizes);
     }
     else
     {
@@ -1761,19 +1915,19 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     }
     for (size_t m = 0; m < count; ++m)
     {
-      const double change = (next[m] - meshes[m].points).cwiseAbs().maxCoeff();
-      farMoves += change > kFarMove * energies[m]->Size() ? 1 : 0;
-      farMoves += change > kBlownUp * energies[m]->Size() ? kFarMovesToStop : 0;
-      if (change > parameters.tolerance * energies[m]->Size() ||
-        std::abs(volumeNow[m] - targets[m]) > 1e-9 * std::abs(targets[m]))
+      const double change = (next[m] - s.meshes[m].points).cwiseAbs().maxCoeff();
+      farMoves += change > kFarMove * sizes[m] ? 1 : 0;
+      farMoves += change > kBlownUp * sizes[m] ? kFarMovesToStop : 0;
+      if (change > parameters.tolerance * sizes[m] ||
+        std::abs(volumeRows.now[m] - s.targets[m]) > 1e-9 * std::abs(s.targets[m]))
       {
         settled = false;
       }
-      previous[m] = std::move(meshes[m].points);
-      meshes[m].points = std::move(next[m]);
-      reports[m].pointsInContact = inContact[m];
+      s.previous[m] = std::move(s.meshes[m].points);
+      s.meshes[m].points = std::move(next[m]);
+      reports[m].pointsInContact = step.inContact[m];
     }
-    held = std::move(nowHeld);
+    s.held = std::move(step.held);
     diverging = farMoves >= kFarMovesToStop;
     if (progress)
     {
@@ -1784,36 +1938,17 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   // resolution after it and for the next settle).
   std::vector<std::vector<double>> boneClearance = diverging
     ? std::vector<std::vector<double>>()
-    : BoneClearancesAtEnd(meshes, previous, energies, bones.size(), clearance);
+    : BoneClearancesAtEnd(s.meshes, s.previous, energies, bones.size(), s.clearance);
   // A settle that diverged leaves the muscles where they started rather than at an iterate that
   // means nothing; one that ran out of iterations keeps its last.
   for (size_t m = 0; m < count && !diverging; ++m)
   {
-    energies[m]->CarryToUnwelded(meshes[m].points);
-    muscles[m].points = std::move(meshes[m].points);
+    energies[m]->CarryToUnwelded(s.meshes[m].points);
+    muscles[m].points = std::move(s.meshes[m].points);
   }
   if (motion)
   {
-    motion->points.clear();
-    for (size_t m = 0; m < count; ++m)
-    {
-      motion->points.push_back(muscles[m].points);
-    }
-    motion->free = std::move(free);
-    motion->boneClearance = std::move(boneClearance);
-    motion->bonePlacements = diverging ? std::vector<RigidFit>() : placements;
-    motion->held.clear();
-    if (motion->carryContacts && !diverging) // a diverged settle's contacts hold nothing
-    {
-      for (const auto& [key, triangles] : held)
-      {
-        for (const Eigen::Index t : triangles)
-        {
-          motion->held.push_back({ static_cast<Eigen::Index>(std::get<0>(key)), std::get<1>(key),
-            static_cast<Eigen::Index>(std::get<2>(key)), t });
-        }
-      }
-    }
+    RecordInMotion(*motion, muscles, std::move(free), std::move(boneClearance), placements, s.held, diverging);
   }
   // The muscles are settled together: the time is shared.
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
