@@ -404,6 +404,212 @@ void RefitHulls(HullPass& pass, const std::vector<TriangleMesh>& resolved,
   }
 }
 
+/// How the bones and every muscle's matched action lines move from the rest pose to the current
+/// pose (their construction checks the pairs).
+struct MethodMotions
+{
+  std::vector<PoseInterpolator> bones;
+  std::vector<std::vector<PoseInterpolator>> lines; ///< per muscle
+};
+
+MethodMotions Interpolators(
+  const std::vector<MuscleMotion>& muscles, const std::vector<BoneMotion>& bones, InterpolationMode mode)
+{
+  std::vector<Points> bonesRest, bonesCurrent;
+  for (const BoneMotion& b : bones)
+  {
+    bonesRest.push_back(b.rest.points);
+    bonesCurrent.push_back(b.current);
+  }
+  MethodMotions motions;
+  motions.bones = PoseInterpolators(bonesRest, bonesCurrent, mode);
+  motions.lines.resize(muscles.size());
+  for (size_t m = 0; m < muscles.size(); ++m)
+  {
+    for (const MatchedLine& line : muscles[m].lines)
+    {
+      try
+      {
+        motions.lines[m].emplace_back(line.rest, line.current, mode);
+      }
+      catch (Error& e)
+      {
+        throw OfMuscle(InputError(std::string("an action line of muscle '") + muscles[m].name + "': " + e.what()), m);
+      }
+    }
+  }
+  return motions;
+}
+
+/// What the steps solved on the muscles' surfaces share (docs/DESIGN.md section 7): the
+/// full-mesh energies (rest pose only, kept for every step), the matched lines at step 0, where
+/// the last step's settle ended (each step's settle goes on from the last one's answer, from the
+/// rest pose at the first, so the answer depends continuously on the input and not at all on a
+/// hull), and the lines' samples inside the bones at rest (the scans' own overlap).
+struct SurfaceSteps
+{
+  std::vector<std::shared_ptr<const SurfaceEnergy>> energies;
+  std::vector<const SurfaceEnergy*> energyPointers;
+  std::vector<std::vector<Points>> restLines;
+  SettleMotion settleMotion;
+  LineSamplesInside linesInBonesAtRest;
+};
+
+/// The start of the steps on the surfaces, the muscles `current` in the rest pose and the bones
+/// (`fixed`) too; the energies are built (or taken from `kept`), their seconds in `seconds`,
+/// and a muscle part of which no line drives is said in `warnings`.
+SurfaceSteps StartOnSurface(const std::vector<MuscleMotion>& muscles, const MethodMotions& motions, int steps,
+  const std::vector<TriangleMesh>& current, const std::vector<FixedObstacle>& fixed,
+  const InterpolationParameters& parameters, RestMappingCache* kept, std::vector<double>& seconds,
+  std::vector<std::string>& warnings)
+{
+  const size_t count = muscles.size();
+  SurfaceSteps s;
+  s.restLines.resize(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    for (const PoseInterpolator& line : motions.lines[m])
+    {
+      s.restLines[m].push_back(line.AtStep(0, steps));
+    }
+  }
+  s.energies = BuildEnergies(muscles, s.restLines, parameters.settle, kept, seconds);
+  for (size_t m = 0; m < count; ++m)
+  {
+    s.energyPointers.push_back(s.energies[m].get());
+    if (s.energies[m]->PointsNoLineDrives() > 0)
+    {
+      warnings.push_back(PartApartWarning(
+        muscles[m].name, s.energies[m]->PointsNoLineDrives(), s.energies[m]->PointsUsed(), "its surface"));
+    }
+  }
+  s.settleMotion = StartMotion(current, s.energyPointers, s.restLines, fixed);
+  std::vector<std::vector<MatchedLine>> still;
+  for (const std::vector<Points>& lines : s.restLines)
+  {
+    still.push_back(StillLines(lines));
+  }
+  s.linesInBonesAtRest = LineSamplesInBones(still, fixed, parameters.settle.samplesPerSegment);
+  return s;
+}
+
+/// Step j of `steps` solved on the muscles' surfaces (`in`): `next` gets the muscles settled
+/// from where the last step left them (`current`, as `surface`'s settle motion holds them) to
+/// the pose of step j; what to warn of is added to `warnings` (each once: `warned`).
+std::vector<StepOutcome> SettleMethodStep(const SettleInput& in, int j, int steps,
+  const std::vector<MuscleMotion>& muscles, const std::vector<TriangleMesh>& current,
+  const std::vector<std::string>& names, SurfaceSteps& surface, std::vector<TriangleMesh>& next,
+  std::set<std::string>& warned, std::vector<std::string>& warnings, const std::function<void(double)>& progress)
+{
+  const size_t count = muscles.size();
+  for (size_t m = 0; m < count; ++m)
+  {
+    next[m].triangles = muscles[m].muscle.triangles; // the points come from settleMotion
+    next[m].points = current[m].points;
+  }
+  const double to = static_cast<double>(j) / steps; // AtStep(j, steps)'s fraction
+  const std::vector<SettleReport> settled =
+    SettleStep(in, static_cast<double>(j - 1) / steps, to, next, surface.settleMotion, progress);
+  for (const std::string& warning : SettleWarnings(in, to, names, surface.linesInBonesAtRest, settled, warned))
+  {
+    warnings.push_back("step " + std::to_string(j) + ": " + warning);
+  }
+  std::vector<StepOutcome> outcomes(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    outcomes[m] = { settled[m].iterations, settled[m].converged, 0, settled[m].seconds };
+  }
+  return outcomes;
+}
+
+/// Step j of `steps` solved on the hulls (DeformHullStep), the bones' trees refitted to its
+/// pose first: `next` gets the deformed muscles, `deformed` the pass's results; what to warn of
+/// is added to `warnings` (each once: `warned`).
+std::vector<StepOutcome> HullMethodStep(HullPass& pass, int j, int steps, const std::vector<MuscleMotion>& muscles,
+  const MethodMotions& motions, const std::vector<TriangleMesh>& current, const std::vector<double>& restVolumes,
+  const std::vector<Obstacle>& obstacles, const InterpolationParameters& parameters,
+  std::vector<MuscleStepMeasures>& measures, std::vector<TriangleMesh>& next, std::vector<DeformationResult>& deformed,
+  std::set<std::string>& warned, std::vector<std::string>& warnings, const std::function<void(double)>& progress)
+{
+  const size_t count = muscles.size();
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int b = 0; b < static_cast<int>(obstacles.size()); ++b)
+  {
+    obstacles[b].tree->Refit(motions.bones[b].AtStep(j, steps));
+  }
+  deformed = DeformHullStep(
+    pass, j, steps, muscles, motions.lines, current, restVolumes, obstacles, parameters, measures, warnings, progress);
+  std::vector<StepOutcome> outcomes(count);
+  for (size_t m = 0; m < count; ++m)
+  {
+    next[m] = { deformed[m].points, muscles[m].muscle.triangles };
+    for (const std::string& warning : deformed[m].warnings)
+    {
+      if (warned.insert(warning).second) // said once, at the first step that has it
+      {
+        warnings.push_back("step " + std::to_string(j) + ": " + warning);
+      }
+    }
+    outcomes[m] = { deformed[m].iterations, deformed[m].converged, deformed[m].verticesFrozen, deformed[m].seconds };
+  }
+  return outcomes;
+}
+
+/// The bones' hierarchies in the rest pose.
+std::vector<Obstacle> RestBoneObstacles(const std::vector<BoneMotion>& bones)
+{
+  std::vector<std::string> names;
+  std::vector<TriangleMesh> meshes;
+  for (const BoneMotion& b : bones)
+  {
+    names.push_back(b.name);
+    meshes.push_back(b.rest);
+  }
+  return BuildObstacles(names, meshes);
+}
+
+/// The method's result with its step 0, the rest pose, and room for `steps` more.
+InterpolationResult RestPoseResult(const std::vector<MuscleMotion>& muscles, int steps)
+{
+  InterpolationResult result;
+  result.numberOfSteps = steps;
+  std::vector<Points> restPoints;
+  for (const MuscleMotion& m : muscles)
+  {
+    restPoints.push_back(m.muscle.points);
+  }
+  result.points.assign(1, restPoints);
+  result.measures.assign(1, std::vector<MuscleStepMeasures>(muscles.size()));
+  result.stepSeconds.assign(1, 0.0);
+  result.restHullSeconds.assign(muscles.size(), 0.0);
+  return result;
+}
+
+/// Each muscle's overlap at rest with the bones alone (OverlapMasks puts the `bones` first).
+OverlapMasks BoneOverlapOf(const OverlapMasks& restOverlap, size_t bones)
+{
+  OverlapMasks overlap(restOverlap.size());
+  for (size_t m = 0; m < restOverlap.size(); ++m)
+  {
+    overlap[m].assign(restOverlap[m].begin(), restOverlap[m].begin() + static_cast<std::ptrdiff_t>(bones));
+  }
+  return overlap;
+}
+
+/// Nothing moves: every step is the rest pose, exactly.
+void ZeroMotion(InterpolationResult& result)
+{
+  result.zeroMotion = true;
+  result.warnings.push_back("the motion has zero length (the current pose equals the rest pose): "
+                            "the muscles are returned as they are");
+  for (int j = 1; j <= result.numberOfSteps; ++j)
+  {
+    result.points.push_back(result.points[0]);
+    result.measures.push_back(result.measures[0]);
+    result.stepSeconds.push_back(0.0);
+  }
+}
+
 /// DeformByInterpolation on input already in its local frame.
 InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles, const std::vector<BoneMotion>& bones,
   const InterpolationParameters& parameters, const std::function<void(double)>& progress, RestMappingCache* kept)
@@ -417,64 +623,17 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   };
   ValidateBones(bones);
   const size_t count = muscles.size();
-  InterpolationResult result;
   const int steps = ResolveNumberOfSteps(bones, parameters);
-  result.numberOfSteps = steps;
-  std::vector<Points> restPoints;
-  for (const MuscleMotion& m : muscles)
-  {
-    restPoints.push_back(m.muscle.points);
-  }
-  result.points.assign(1, restPoints);
-  result.measures.assign(1, std::vector<MuscleStepMeasures>(count));
-  result.stepSeconds.assign(1, 0.0);
-  result.restHullSeconds.assign(count, 0.0);
-
+  InterpolationResult result = RestPoseResult(muscles, steps);
   if (LargestMotion(muscles, bones) == 0)
   {
-    // Nothing moves: every step is the rest pose, exactly.
-    result.zeroMotion = true;
-    result.warnings.push_back("the motion has zero length (the current pose equals the rest pose): "
-                              "the muscles are returned as they are");
-    for (int j = 1; j <= steps; ++j)
-    {
-      result.points.push_back(restPoints);
-      result.measures.push_back(result.measures[0]);
-      result.stepSeconds.push_back(0.0);
-    }
+    ZeroMotion(result);
     result.totalSeconds = SecondsSince(start);
     report(1.0);
     return result;
   }
 
-  // Interpolators of the bones and of every matched action line (their
-  // construction checks the pairs).
-  std::vector<Points> bonesRest, bonesCurrent;
-  std::vector<std::string> boneNames;
-  for (const BoneMotion& b : bones)
-  {
-    bonesRest.push_back(b.rest.points);
-    bonesCurrent.push_back(b.current);
-    boneNames.push_back(b.name);
-  }
-  const std::vector<PoseInterpolator> boneMotions =
-    PoseInterpolators(bonesRest, bonesCurrent, parameters.interpolationMode);
-  std::vector<std::vector<PoseInterpolator>> lineMotions(count);
-  for (size_t m = 0; m < count; ++m)
-  {
-    for (const MatchedLine& line : muscles[m].lines)
-    {
-      try
-      {
-        lineMotions[m].emplace_back(line.rest, line.current, parameters.interpolationMode);
-      }
-      catch (Error& e)
-      {
-        throw OfMuscle(InputError(std::string("an action line of muscle '") + muscles[m].name + "': " + e.what()), m);
-      }
-    }
-  }
-
+  const MethodMotions motions = Interpolators(muscles, bones, parameters.interpolationMode);
   std::vector<double> restVolumes(count);
   for (size_t m = 0; m < count; ++m)
   {
@@ -492,14 +651,7 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   // boxes tight, and a refit costs far less than a build. Overlap the rest
   // pose already has (the scans overlap the bones) is left alone by the
   // static resolution and not counted as new penetration.
-  const std::vector<Obstacle> obstacles = BuildObstacles(boneNames, [&] {
-    std::vector<TriangleMesh> meshes;
-    for (const BoneMotion& b : bones)
-    {
-      meshes.push_back(b.rest);
-    }
-    return meshes;
-  }());
+  const std::vector<Obstacle> obstacles = RestBoneObstacles(bones);
   std::vector<FixedObstacle> fixed;
   for (const Obstacle& o : obstacles)
   {
@@ -512,57 +664,22 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   }
   const OverlapMasks restOverlap = FindOverlaps(current, fixed);
   const std::vector<NewSharpEdges> sharpEdges = MuscleSharpEdges(muscles);
-
-  // The full-mesh energies (rest pose only), kept for every step; each step's settle goes on
-  // from the last one's answer (from the rest pose at the first), so the answer depends
-  // continuously on the input and not at all on a hull (docs/DESIGN.md section 7).
-  std::vector<std::shared_ptr<const SurfaceEnergy>> energies;
-  std::vector<const SurfaceEnergy*> energyPointers;
-  std::vector<std::vector<Points>> restLines(count); // the matched lines at step 0
-  SettleMotion settleMotion;
-  LineSamplesInside linesInBonesAtRest; // the scans' own overlap
   std::vector<std::string> names;
   for (const MuscleMotion& m : muscles)
   {
     names.push_back(m.name);
   }
+  SurfaceSteps surface;
   if (settle)
   {
-    for (size_t m = 0; m < count; ++m)
-    {
-      for (const PoseInterpolator& line : lineMotions[m])
-      {
-        restLines[m].push_back(line.AtStep(0, steps));
-      }
-    }
-    energies = BuildEnergies(muscles, restLines, parameters.settle, kept, result.restHullSeconds);
+    surface = StartOnSurface(
+      muscles, motions, steps, current, fixed, parameters, kept, result.restHullSeconds, result.warnings);
     report(0.2);
-    for (size_t m = 0; m < count; ++m)
-    {
-      energyPointers.push_back(energies[m].get());
-      if (energies[m]->PointsNoLineDrives() > 0)
-      {
-        result.warnings.push_back(PartApartWarning(
-          muscles[m].name, energies[m]->PointsNoLineDrives(), energies[m]->PointsUsed(), "its surface"));
-      }
-    }
-    settleMotion = StartMotion(current, energyPointers, restLines, fixed);
-    std::vector<std::vector<MatchedLine>> still;
-    for (const std::vector<Points>& lines : restLines)
-    {
-      still.push_back(StillLines(lines));
-    }
-    linesInBonesAtRest = LineSamplesInBones(still, fixed, parameters.settle.samplesPerSegment);
   }
   else
   {
     // Contact rows leave the rest pose's overlap with each bone alone.
-    hullPass.boneOverlap.resize(count);
-    for (size_t m = 0; m < count; ++m)
-    {
-      hullPass.boneOverlap[m].assign(
-        restOverlap[m].begin(), restOverlap[m].begin() + static_cast<std::ptrdiff_t>(bones.size()));
-    }
+    hullPass.boneOverlap = BoneOverlapOf(restOverlap, bones.size());
   }
   double stepStart = 0.2;
   const double stepShare = 0.8 / steps;
@@ -571,60 +688,26 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   for (int j = 1; j <= steps; ++j)
   {
     const auto stepClock = Clock::now();
-    if (!settle) // the settle refits them to each pose it settles to
-    {
-#pragma omp parallel for schedule(dynamic, 1)
-      for (int b = 0; b < static_cast<int>(bones.size()); ++b)
-      {
-        obstacles[b].tree->Refit(boneMotions[b].AtStep(j, steps));
-      }
-    }
-
+    auto stepProgress = [&](double fraction) {
+      report(stepStart + 0.9 * stepShare * fraction);
+    };
     std::vector<MuscleStepMeasures> measures(count);
     std::vector<TriangleMesh> next(count);
     std::vector<DeformationResult> deformed(count); // the hull-based pass's
-    std::vector<SettleReport> settled(count);
+    std::vector<StepOutcome> outcomes(count);
     if (settle)
     {
-      for (size_t m = 0; m < count; ++m)
-      {
-        next[m].triangles = muscles[m].muscle.triangles; // the points come from settleMotion
-        next[m].points = current[m].points;
-      }
-      const SettleInput in{ obstacles, boneMotions, lineMotions, restLines, energyPointers, restVolumes, fixed,
-        restOverlap, parameters.settle };
-      const double to = static_cast<double>(j) / steps; // AtStep(j, steps)'s fraction
-      settled = SettleStep(in, static_cast<double>(j - 1) / steps, to, next, settleMotion,
-        [&](double fraction) { report(stepStart + 0.9 * stepShare * fraction); });
-      for (const std::string& warning : SettleWarnings(in, to, names, linesInBonesAtRest, settled, warned))
-      {
-        result.warnings.push_back("step " + std::to_string(j) + ": " + warning);
-      }
+      const SettleInput in{ obstacles, motions.bones, motions.lines, surface.restLines, surface.energyPointers,
+        restVolumes, fixed, restOverlap, parameters.settle };
+      outcomes =
+        SettleMethodStep(in, j, steps, muscles, current, names, surface, next, warned, result.warnings, stepProgress);
     }
     else
     {
-      deformed = DeformHullStep(hullPass, j, steps, muscles, lineMotions, current, restVolumes, obstacles, parameters,
-        measures, result.warnings, [&](double fraction) { report(stepStart + 0.9 * stepShare * fraction); });
-      for (size_t m = 0; m < count; ++m)
-      {
-        next[m] = { deformed[m].points, muscles[m].muscle.triangles };
-        for (const std::string& warning : deformed[m].warnings)
-        {
-          if (warned.insert(warning).second) // said once, at the first step that has it
-          {
-            result.warnings.push_back("step " + std::to_string(j) + ": " + warning);
-          }
-        }
-      }
+      outcomes = HullMethodStep(hullPass, j, steps, muscles, motions, current, restVolumes, obstacles, parameters,
+        measures, next, deformed, warned, result.warnings, stepProgress);
     }
-    std::vector<StepOutcome> outcomes(count);
-    for (size_t m = 0; m < count; ++m)
-    {
-      outcomes[m] = settle
-        ? StepOutcome{ settled[m].iterations, settled[m].converged, 0, settled[m].seconds }
-        : StepOutcome{ deformed[m].iterations, deformed[m].converged, deformed[m].verticesFrozen, deformed[m].seconds };
-    }
-    const std::vector<std::vector<char>> outsideBones = ProvenOutsideBones(settleMotion.boneClearance);
+    const std::vector<std::vector<char>> outsideBones = ProvenOutsideBones(surface.settleMotion.boneClearance);
     measures = ResolveAndMeasure(next, muscles, fixed, restOverlap, sharpEdges, restVolumes, parameters, outcomes,
       previous, measures, settle ? &outsideBones : nullptr);
     if (!settle)

@@ -5,8 +5,9 @@
 // resolution), the interpolation method with the hull refitted (Refit) and
 // rebuilt before every step (Rebuild, the paper), side by side; the one-pass
 // method with the paper's deformation step and with the method's own. Per muscle and
-// in total: hull time, per-step time, total, and every quality measure.
-// Prints figures; asserts nothing (see the tests).
+// in total: hull time, per-step time, total, and every quality measure, and a checksum of every
+// step's points and measures (to compare two builds to the bit). Prints figures; asserts nothing
+// (see the tests).
 //
 //   BenchmarkInterpolation [data folder] [number of steps] [phantom flexion]
 //   [all|one-pass|refit|rebuild|refit-paper-step|settle]
@@ -14,6 +15,7 @@
 //                          [perturbation]  (-1: none, the default; 0: inputs rounded to float; s > 0: rounded
 //                                           after a seeded random move of 1e-7 of each coordinate)
 #include "RealData.h"
+#include "StepChecksum.h"
 
 #include <cstdio>
 #include <cstdlib>
@@ -84,6 +86,13 @@ void Run(const MotionCase& c, const char* label, int steps, md::HullMode mode, d
     }
     std::printf("\n");
   }
+  md::Fnv1a checksum; // every step's points and measures: two runs compared to the bit
+  for (int j = 0; j <= r.numberOfSteps; ++j)
+  {
+    AddStepToChecksum(checksum, r.points[static_cast<size_t>(j)], r.measures[static_cast<size_t>(j)]);
+  }
+  std::printf(
+    "  checksum of every step's points and measures: %016llx\n", static_cast<unsigned long long>(checksum.Value()));
   for (const std::string& w : r.warnings)
   {
     std::printf("  warning: %s\n", w.c_str());

@@ -14,6 +14,7 @@
 //   BenchmarkMotion [data folder] [hip_flexion|hip_adduction|phantom] [seed: -1 none, 0 float, s > 0 noise]
 #include "Fnv1a.h"
 #include "MotionFrames.h"
+#include "StepChecksum.h"
 
 #include <algorithm>
 #include <chrono>
@@ -69,23 +70,7 @@ int main(int argc, char** argv)
       frameSeconds.push_back(r.seconds);
     }
     points.push_back(r.points);
-    for (const md::Points& p : r.points)
-    {
-      checksum.Add(p.data(), sizeof(double) * static_cast<size_t>(p.size()));
-    }
-    for (const md::MuscleStepMeasures& s : r.measures)
-    {
-      for (const double value : { s.volumeChangePercent, s.maxNewPenetrationDepth, s.maxNewBonePenetrationDepth,
-             s.stepStaticShift, s.maxStaticShift })
-      {
-        checksum.Add(value);
-      }
-      for (const std::int64_t count : { s.newPenetrationCount, s.newBonePenetrationCount, s.staticallyMovedPoints,
-             s.sharpEdgeCount, s.flippedTriangleCount, static_cast<std::int64_t>(s.stepIterations) })
-      {
-        checksum.Add(count);
-      }
-    }
+    AddStepToChecksum(checksum, r.points, r.measures);
     int iterations = 0;
     double volume = 0, depth = 0;
     std::int64_t flips = 0, sharp = 0;
