@@ -1037,17 +1037,14 @@ std::vector<Obstacle> BuildObstacles(const std::vector<std::string>& names, cons
   return obstacles;
 }
 
-std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& muscles,
-  const std::vector<Obstacle>& bones, const DeformationParameters& parameters,
-  const std::function<void(double)>& progress)
+namespace
 {
-  auto report = [&](double fraction) {
-    if (progress)
-    {
-      progress(fraction);
-    }
-  };
-  std::vector<MuscleState> states(muscles.size());
+/// Each muscle checked, set up and taken through the coarse phase on its hull (then pushed off
+/// the bones where bones push): the first half of `report`'s range.
+void RunCoarsePhases(std::vector<MuscleState>& states, const std::vector<MuscleToDeform>& muscles,
+  const std::vector<Obstacle>& bones, const DeformationParameters& parameters,
+  const std::function<void(double)>& report)
+{
   const double share = 1.0 / std::max<size_t>(1, muscles.size());
   for (size_t m = 0; m < muscles.size(); ++m)
   {
@@ -1082,205 +1079,283 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
     s.time += Clock::now() - start;
     report((m + 1) * share * 0.5);
   }
+}
 
-  // The fine phase starts from the coarse result, W X. Overlap with a bone
-  // there (present in the rest pose already, or made by the bone's motion)
-  // is what the dynamic rule cannot undo: those points stay, as the paper's
-  // rule says; the static resolution deals with them afterwards.
+/// The fine phase starts from the coarse result, W X. Overlap with a bone there (present in the
+/// rest pose already, or made by the bone's motion) is what the dynamic rule cannot undo: those
+/// points stay, as the paper's rule says; the static resolution deals with them afterwards.
+void StartFinePhase(MuscleState& s, const std::vector<MuscleToDeform>& muscles, const std::vector<Obstacle>& bones,
+  const DeformationParameters& parameters)
+{
+  const auto start = Clock::now();
+  s.fineStep = parameters.stepLength;
+  s.points = *s.weights * s.hull;
+  if (s.input->detail)
+  {
+    s.points += *s.input->detail;
+  }
+  // The coarse result torn apart (the muscle grown far beyond its size) is no start for the
+  // fine phase, nor a result it could fall back on. (A hull point far off that hardly weighs on
+  // the muscle is no harm.)
+  if (Growth(s) > maximumGrowth)
+  {
+    throw OfMuscle(ComputationError("the deformation of muscle '" + s.input->name +
+                     "' diverged on its hull: the muscle spans " + std::to_string(Growth(s)) +
+                     " times its starting size after " + std::to_string(s.result.coarseIterations) + " iterations"),
+      IndexOf(s, muscles));
+  }
+  if (parameters.dynamicIntersections)
+  {
+    const std::int64_t used = UsedPoints(*s.input->muscle).rows();
+    for (const Obstacle& bone : bones)
+    {
+      std::int64_t inside = 0;
+#pragma omp parallel for reduction(+ : inside) schedule(dynamic, 64)
+      for (Eigen::Index i = 0; i < s.points.rows(); ++i)
+      {
+        const Eigen::Vector3d p = s.points.row(i).transpose();
+        if (bone.tree->InBounds(p) && bone.tree->Inside(p))
+        {
+          s.frozen[i] = 1;
+          ++inside;
+        }
+      }
+      if (2 * inside > used)
+      {
+        s.result.warnings.push_back(std::to_string(inside) + " of " + std::to_string(used) + " points of muscle '" +
+          s.input->name + "' are inside obstacle '" + bone.name +
+          "'; they cannot move (are the obstacles in the current pose?)");
+      }
+    }
+    s.tree = std::make_unique<TriangleTree>(TriangleMesh{ s.points, s.input->muscle->triangles });
+  }
+  s.time += Clock::now() - start;
+}
+
+/// Muscles as obstacles for each other: the coarse phase moved each one without regard to the
+/// others. A point that now lies inside another muscle but did not in the rest pose (new
+/// overlap) moves out to the nearest point of that muscle's surface (in turn, each muscle
+/// against the others' latest shape; back along its way would drag it far when both muscles
+/// moved together). Overlap the scans already had is left alone.
+void SeparateMuscles(std::vector<MuscleState>& states)
+{
+  std::vector<std::unique_ptr<TriangleTree>> restTrees;
+  for (const MuscleState& s : states)
+  {
+    restTrees.push_back(std::make_unique<TriangleTree>(*s.input->muscle));
+  }
   for (MuscleState& s : states)
   {
     const auto start = Clock::now();
-    s.fineStep = parameters.stepLength;
-    s.points = *s.weights * s.hull;
-    if (s.input->detail)
+    for (size_t o = 0; o < states.size(); ++o)
     {
-      s.points += *s.input->detail;
-    }
-    // The coarse result torn apart (the muscle grown far beyond its size) is
-    // no start for the fine phase, nor a result it could fall back on. (A
-    // hull point far off that hardly weighs on the muscle is no harm.)
-    if (Growth(s) > maximumGrowth)
-    {
-      throw OfMuscle(ComputationError("the deformation of muscle '" + s.input->name +
-                       "' diverged on its hull: the muscle spans " + std::to_string(Growth(s)) +
-                       " times its starting size after " + std::to_string(s.result.coarseIterations) + " iterations"),
-        IndexOf(s, muscles));
-    }
-    if (parameters.dynamicIntersections)
-    {
-      const std::int64_t used = UsedPoints(*s.input->muscle).rows();
-      for (const Obstacle& bone : bones)
+      const MuscleState& other = states[o];
+      if (&other == &s)
       {
-        std::int64_t inside = 0;
-#pragma omp parallel for reduction(+ : inside) schedule(dynamic, 64)
-        for (Eigen::Index i = 0; i < s.points.rows(); ++i)
-        {
-          const Eigen::Vector3d p = s.points.row(i).transpose();
-          if (bone.tree->InBounds(p) && bone.tree->Inside(p))
-          {
-            s.frozen[i] = 1;
-            ++inside;
-          }
-        }
-        if (2 * inside > used)
-        {
-          s.result.warnings.push_back(std::to_string(inside) + " of " + std::to_string(used) + " points of muscle '" +
-            s.input->name + "' are inside obstacle '" + bone.name +
-            "'; they cannot move (are the obstacles in the current pose?)");
-        }
+        continue;
       }
-      s.tree = std::make_unique<TriangleTree>(TriangleMesh{ s.points, s.input->muscle->triangles });
-    }
-    s.time += Clock::now() - start;
-  }
-
-  // Muscles as obstacles for each other: the coarse phase moved each one
-  // without regard to the others. A point that now lies inside another
-  // muscle but did not in the rest pose (new overlap) moves out to the
-  // nearest point of that muscle's surface (in turn, each muscle against the
-  // others' latest shape; back along its way would drag it far when both
-  // muscles moved together). Overlap the scans already had is left alone.
-  if (parameters.dynamicIntersections && states.size() > 1)
-  {
-    std::vector<std::unique_ptr<TriangleTree>> restTrees;
-    for (const MuscleState& s : states)
-    {
-      restTrees.push_back(std::make_unique<TriangleTree>(*s.input->muscle));
-    }
-    for (MuscleState& s : states)
-    {
-      const auto start = Clock::now();
-      for (size_t o = 0; o < states.size(); ++o)
+#pragma omp parallel for schedule(dynamic, 64)
+      for (Eigen::Index i = 0; i < s.points.rows(); ++i)
       {
-        const MuscleState& other = states[o];
-        if (&other == &s)
+        const Eigen::Vector3d p = s.points.row(i).transpose(), rest = s.start.row(i).transpose();
+        if (s.frozen[i] || !other.tree->InBounds(p) || !other.tree->Inside(p) ||
+          (restTrees[o]->InBounds(rest) && restTrees[o]->Inside(rest)))
         {
           continue;
         }
-#pragma omp parallel for schedule(dynamic, 64)
-        for (Eigen::Index i = 0; i < s.points.rows(); ++i)
+        const TriangleTree::Closest closest = other.tree->ClosestPoint(p);
+        if (closest.distance > 0)
         {
-          const Eigen::Vector3d p = s.points.row(i).transpose(), rest = s.start.row(i).transpose();
-          if (s.frozen[i] || !other.tree->InBounds(p) || !other.tree->Inside(p) ||
-            (restTrees[o]->InBounds(rest) && restTrees[o]->Inside(rest)))
-          {
-            continue;
-          }
-          const TriangleTree::Closest closest = other.tree->ClosestPoint(p);
-          if (closest.distance > 0)
-          {
-            s.points.row(i) = JustOutside(closest, p, 1e-6 * s.size).transpose();
-            s.touched[i] = 1;
-          }
+          s.points.row(i) = JustOutside(closest, p, 1e-6 * s.size).transpose();
+          s.touched[i] = 1;
         }
       }
+    }
+    s.tree->Refit(s.points);
+    s.time += Clock::now() - start;
+  }
+}
+
+/// One fine-phase iteration of muscle `s` against the bones and the other muscles' latest shape
+/// (`states`): a Gauss-Newton step of its hull with the full mesh's volume, the muscle moved with
+/// it as the obstacles allow; on convergence any fold undone and the volume let settle again
+/// (a few times at most); a muscle torn apart keeps its coarse result.
+void FineIteration(MuscleState& s, std::vector<MuscleState>& states, const std::vector<MuscleToDeform>& muscles,
+  const std::vector<Obstacle>& bones, const DeformationParameters& parameters)
+{
+  Points next;
+  if (parameters.preserveVolume)
+  {
+    Points gradient;
+    const double volume = FullVolume(s, gradient);
+    next = s.solver->Step(s.hull, s.targets, volume - s.restVolume, gradient, s.fineStep);
+  }
+  else
+  {
+    next = s.solver->Step(s.hull, s.targets, 0.0, Points(), s.fineStep);
+  }
+  if (!next.allFinite())
+  {
+    throw OfMuscle(ComputationError("the deformation of muscle '" + s.input->name + "' diverged on its full mesh"),
+      IndexOf(s, muscles));
+  }
+  const Points change = next - s.hull;
+  const double largest = change.cwiseAbs().maxCoeff();
+  // Points held by obstacles make the full mesh's volume respond less than the step assumes,
+  // and full steps can then swing back and forth: a change larger than the last halves the
+  // step length.
+  if (largest > s.lastChange)
+  {
+    s.fineStep = std::max(0.5 * s.fineStep, 0.05);
+  }
+  s.lastChange = largest;
+  s.hull = next;
+  const Points candidate = s.points + *s.weights * change;
+  if (parameters.dynamicIntersections)
+  {
+    MoveWithObstacles(s, candidate, bones, OthersOf(s, states));
+    s.tree->Refit(s.points);
+  }
+  else
+  {
+    s.points = candidate;
+  }
+  ++s.result.iterations;
+  const int total = s.result.coarseIterations + s.result.iterations;
+  const bool pushedByBones = parameters.contactWeight > 0 && parameters.dynamicIntersections;
+  if (Growth(s) > maximumGrowth)
+  {
+    // With many points held by obstacles the hull, which knows nothing of them, can run on
+    // through a bone while the volume held on the full mesh inflates the rest: the muscle is
+    // torn apart. It keeps its coarse result (the static resolution settles its overlap).
+    s.points = s.fineStartPoints;
+    s.hull = s.fineStartHull;
+    if (s.tree)
+    {
       s.tree->Refit(s.points);
-      s.time += Clock::now() - start;
+    }
+    s.fellBack = s.fineDone = true;
+    s.result.warnings.push_back("the fine phase of muscle '" + s.input->name + "' diverged (" +
+      std::to_string(
+        std::count(s.frozen.begin(), s.frozen.end(), 1) + std::count(s.touched.begin(), s.touched.end(), 1)) +
+      " points held by obstacles): the muscle keeps its coarse result, without the volume of its full mesh held");
+  }
+  else if (largest < parameters.convergenceTolerance)
+  {
+    // Converged: undo any fold, then let the volume settle again (a few times at most).
+    if (s.unfoldings < maximumUnfoldings && !s.unfoldingBlocked &&
+      UnfoldFlippedTriangles(s, bones, parameters.dynamicIntersections, pushedByBones))
+    {
+      ++s.unfoldings;
+      s.lastChange = std::numeric_limits<double>::max();
+      if (s.tree)
+      {
+        s.tree->Refit(s.points);
+      }
+    }
+    else
+    {
+      s.converged = s.fineDone = true;
+      // The check just found none and nothing moved since (unless folds were left held at a bone).
+      s.flipsCheckedClean = s.unfoldings < maximumUnfoldings && !s.unfoldingBlocked;
     }
   }
+  else if (total >= parameters.maximumIterations)
+  {
+    s.fineDone = true;
+  }
+}
 
-  // Fine phase: all muscles step in turn, each against the others' latest shape.
-  // (each muscle stops at its own limit: maximumIterations less its coarse iterations)
+/// What muscle `s`'s pass gives: its points and hull, volume change, flips, points held, and
+/// whether it converged (one unconverged and torn apart throws; one unconverged but sound warns).
+DeformationResult ResultOf(
+  MuscleState& s, const std::vector<MuscleToDeform>& muscles, const DeformationParameters& parameters)
+{
+  const auto start = Clock::now();
+  DeformationResult& r = s.result;
+  r.iterations += r.coarseIterations;
+  r.converged = s.converged;
+  r.points = s.points;
+  r.hullPoints = s.hull;
+  const double volume = EnclosedVolume(s.points, s.input->muscle->triangles);
+  r.volumeChangePercent = 100.0 * (volume - s.restVolume) / s.restVolume;
+  r.flippedTriangles =
+    s.flipsCheckedClean ? 0 : CountFlippedTriangles(*s.reference, s.points, s.input->muscle->triangles);
+  for (size_t i = 0; i < s.frozen.size(); ++i)
+  {
+    r.verticesFrozen += s.frozen[i];
+    r.verticesStopped += s.stopped[i];
+  }
+  if (parameters.measureSamplesInside)
+  {
+    r.currentSamplesInside =
+      FractionInside(TriangleTree(TriangleMesh{ s.points, s.input->muscle->triangles }), s.currentSamples);
+  }
+  if (!r.converged)
+  {
+    // Unconverged but sound (a small swing) is a warning; unconverged and torn apart (volume far
+    // off, or the muscle grown far beyond its size) is no result to hand on.
+    if (!s.fellBack &&
+      ((parameters.preserveVolume && std::abs(r.volumeChangePercent) > 10.0) || Growth(s) > maximumGrowth))
+    {
+      throw OfMuscle(ComputationError("the deformation of muscle '" + s.input->name + "' diverged: after " +
+                       std::to_string(parameters.maximumIterations) + " iterations its volume is off by " +
+                       std::to_string(r.volumeChangePercent) + " % and it spans " + std::to_string(Growth(s)) +
+                       " times its starting size"),
+        IndexOf(s, muscles));
+    }
+    if (!s.fellBack)
+    {
+      r.warnings.push_back("muscle '" + s.input->name + "' did not converge in " +
+        std::to_string(parameters.maximumIterations) + " iterations");
+    }
+  }
+  s.time += Clock::now() - start;
+  r.seconds = std::chrono::duration<double>(s.time).count();
+  return std::move(r);
+}
+}
+
+std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& muscles,
+  const std::vector<Obstacle>& bones, const DeformationParameters& parameters,
+  const std::function<void(double)>& progress)
+{
+  const std::function<void(double)> report = [&](double fraction) {
+    if (progress)
+    {
+      progress(fraction);
+    }
+  };
+  std::vector<MuscleState> states(muscles.size());
+  RunCoarsePhases(states, muscles, bones, parameters, report);
+  for (MuscleState& s : states)
+  {
+    StartFinePhase(s, muscles, bones, parameters);
+  }
+  if (parameters.dynamicIntersections && states.size() > 1)
+  {
+    SeparateMuscles(states);
+  }
+  // Fine phase: all muscles step in turn, each against the others' latest shape (each stops at
+  // its own limit: maximumIterations less its coarse iterations).
   for (MuscleState& s : states)
   {
     s.fineStartPoints = s.points;
     s.fineStartHull = s.hull;
   }
   const int fineLimit = parameters.maximumIterations;
-  const bool pushedByBones = parameters.contactWeight > 0 && parameters.dynamicIntersections;
   for (int k = 0; k < fineLimit; ++k)
   {
     bool anyActive = false;
-    for (size_t m = 0; m < states.size(); ++m)
+    for (MuscleState& s : states)
     {
-      MuscleState& s = states[m];
       if (s.fineDone)
       {
         continue;
       }
       const auto start = Clock::now();
       anyActive = true;
-      Points next;
-      if (parameters.preserveVolume)
-      {
-        Points gradient;
-        const double volume = FullVolume(s, gradient);
-        next = s.solver->Step(s.hull, s.targets, volume - s.restVolume, gradient, s.fineStep);
-      }
-      else
-      {
-        next = s.solver->Step(s.hull, s.targets, 0.0, Points(), s.fineStep);
-      }
-      if (!next.allFinite())
-      {
-        throw OfMuscle(ComputationError("the deformation of muscle '" + s.input->name + "' diverged on its full mesh"),
-          IndexOf(s, muscles));
-      }
-      const Points change = next - s.hull;
-      const double largest = change.cwiseAbs().maxCoeff();
-      // Points held by obstacles make the full mesh's volume respond less
-      // than the step assumes, and full steps can then swing back and forth:
-      // a change larger than the last halves the step length.
-      if (largest > s.lastChange)
-      {
-        s.fineStep = std::max(0.5 * s.fineStep, 0.05);
-      }
-      s.lastChange = largest;
-      s.hull = next;
-      const Points candidate = s.points + *s.weights * change;
-      if (parameters.dynamicIntersections)
-      {
-        MoveWithObstacles(s, candidate, bones, OthersOf(s, states));
-        s.tree->Refit(s.points);
-      }
-      else
-      {
-        s.points = candidate;
-      }
-      ++s.result.iterations;
-      const int total = s.result.coarseIterations + s.result.iterations;
-      if (Growth(s) > maximumGrowth)
-      {
-        // With many points held by obstacles the hull, which knows nothing of
-        // them, can run on through a bone while the volume held on the full
-        // mesh inflates the rest: the muscle is torn apart. It keeps its
-        // coarse result (the static resolution settles its overlap).
-        s.points = s.fineStartPoints;
-        s.hull = s.fineStartHull;
-        if (s.tree)
-        {
-          s.tree->Refit(s.points);
-        }
-        s.fellBack = s.fineDone = true;
-        s.result.warnings.push_back("the fine phase of muscle '" + s.input->name + "' diverged (" +
-          std::to_string(
-            std::count(s.frozen.begin(), s.frozen.end(), 1) + std::count(s.touched.begin(), s.touched.end(), 1)) +
-          " points held by obstacles): the muscle keeps its coarse result, without the volume of its full mesh held");
-      }
-      else if (largest < parameters.convergenceTolerance)
-      {
-        // Converged: undo any fold, then let the volume settle again (a few times at most).
-        if (s.unfoldings < maximumUnfoldings && !s.unfoldingBlocked &&
-          UnfoldFlippedTriangles(s, bones, parameters.dynamicIntersections, pushedByBones))
-        {
-          ++s.unfoldings;
-          s.lastChange = std::numeric_limits<double>::max();
-          if (s.tree)
-          {
-            s.tree->Refit(s.points);
-          }
-        }
-        else
-        {
-          s.converged = s.fineDone = true;
-          // The check just found none and nothing moved since (unless folds were left held at a bone).
-          s.flipsCheckedClean = s.unfoldings < maximumUnfoldings && !s.unfoldingBlocked;
-        }
-      }
-      else if (total >= parameters.maximumIterations)
-      {
-        s.fineDone = true;
-      }
+      FineIteration(s, states, muscles, bones, parameters);
       s.time += Clock::now() - start;
     }
     report(0.5 + 0.5 * (k + 1) / std::max(1, fineLimit));
@@ -1289,53 +1364,10 @@ std::vector<DeformationResult> DeformMuscles(const std::vector<MuscleToDeform>& 
       break;
     }
   }
-
   std::vector<DeformationResult> results;
   for (MuscleState& s : states)
   {
-    const auto start = Clock::now();
-    DeformationResult& r = s.result;
-    r.iterations += r.coarseIterations;
-    r.converged = s.converged;
-    r.points = s.points;
-    r.hullPoints = s.hull;
-    const double volume = EnclosedVolume(s.points, s.input->muscle->triangles);
-    r.volumeChangePercent = 100.0 * (volume - s.restVolume) / s.restVolume;
-    r.flippedTriangles =
-      s.flipsCheckedClean ? 0 : CountFlippedTriangles(*s.reference, s.points, s.input->muscle->triangles);
-    for (size_t i = 0; i < s.frozen.size(); ++i)
-    {
-      r.verticesFrozen += s.frozen[i];
-      r.verticesStopped += s.stopped[i];
-    }
-    if (parameters.measureSamplesInside)
-    {
-      r.currentSamplesInside =
-        FractionInside(TriangleTree(TriangleMesh{ s.points, s.input->muscle->triangles }), s.currentSamples);
-    }
-    if (!r.converged)
-    {
-      // Unconverged but sound (a small swing) is a warning; unconverged and
-      // torn apart (volume far off, or the muscle grown far beyond its size)
-      // is no result to hand on.
-      if (!s.fellBack &&
-        ((parameters.preserveVolume && std::abs(r.volumeChangePercent) > 10.0) || Growth(s) > maximumGrowth))
-      {
-        throw OfMuscle(ComputationError("the deformation of muscle '" + s.input->name + "' diverged: after " +
-                         std::to_string(parameters.maximumIterations) + " iterations its volume is off by " +
-                         std::to_string(r.volumeChangePercent) + " % and it spans " + std::to_string(Growth(s)) +
-                         " times its starting size"),
-          IndexOf(s, muscles));
-      }
-      if (!s.fellBack)
-      {
-        r.warnings.push_back("muscle '" + s.input->name + "' did not converge in " +
-          std::to_string(parameters.maximumIterations) + " iterations");
-      }
-    }
-    s.time += Clock::now() - start;
-    r.seconds = std::chrono::duration<double>(s.time).count();
-    results.push_back(std::move(r));
+    results.push_back(ResultOf(s, muscles, parameters));
   }
   report(1.0);
   return results;
