@@ -47,6 +47,68 @@ std::string ProblemOf(const MotionDeformation::Muscle& m)
   }
   return {};
 }
+
+/// The bones of the rest pose checked: each has a surface and finite coordinates.
+void CheckRestBones(const std::vector<MotionDeformation::Bone>& bones)
+{
+  for (const MotionDeformation::Bone& b : bones)
+  {
+    if (b.rest.triangles.rows() == 0)
+    {
+      throw InputError("bone '" + b.name + "' has no surface (no triangles)");
+    }
+    if (!AllFinite(b.rest.points))
+    {
+      throw InputError("bone '" + b.name + "' has non-finite coordinates (NaN or infinity)");
+    }
+  }
+}
+
+/// The full-mesh energies of the muscles (`local`, their rest lines `localLines`) whose
+/// `failures` entry is empty, as WithoutFailedMuscles: a muscle whose energy cannot be built gets
+/// its message there and is left out. `active` gets the muscles that go, in order; `kept` (when
+/// given) keeps the energies by muscle for a later motion of the same rest pose.
+std::vector<std::shared_ptr<const SurfaceEnergy>> ActiveEnergies(const std::vector<MuscleMotion>& local,
+  const std::vector<std::vector<Points>>& localLines, const SettleParameters& parameters, RestMappingCache* kept,
+  std::vector<std::string>& failures, std::vector<size_t>& active)
+{
+  RestMappingCache scratch;
+  RestMappingCache& cache = kept ? *kept : scratch;
+  cache.muscles.resize(local.size());
+  std::vector<double> seconds(local.size(), 0.0);
+  return WithoutFailedMuscles(failures, [&](const std::vector<size_t>& going) {
+    std::vector<MuscleMotion> subset;
+    std::vector<std::vector<Points>> subsetLines;
+    RestMappingCache subCache; // the kept energies in the subset's order, and back
+    subCache.energyBuildCount = cache.energyBuildCount;
+    for (size_t m : going)
+    {
+      subset.push_back(local[m]);
+      subsetLines.push_back(localLines[m]);
+      subCache.muscles.push_back(std::move(cache.muscles[m]));
+    }
+    auto keep = [&] {
+      for (size_t k = 0; k < going.size(); ++k)
+      {
+        cache.muscles[going[k]] = std::move(subCache.muscles[k]);
+      }
+      cache.energyBuildCount = subCache.energyBuildCount;
+    };
+    std::vector<std::shared_ptr<const SurfaceEnergy>> built;
+    try
+    {
+      built = BuildEnergies(subset, subsetLines, parameters, &subCache, seconds);
+    }
+    catch (...)
+    {
+      keep();
+      throw;
+    }
+    keep();
+    active = going;
+    return built;
+  });
+}
 }
 
 Points AtRestParameters(const Points& restLine, const Points& line)
@@ -132,17 +194,7 @@ MotionDeformation::MotionDeformation(const std::vector<Muscle>& muscles, const s
   const auto start = Clock::now();
   Internals& in = *this->In;
   in.muscleCount = muscles.size();
-  for (const Bone& b : bones)
-  {
-    if (b.rest.triangles.rows() == 0)
-    {
-      throw InputError("bone '" + b.name + "' has no surface (no triangles)");
-    }
-    if (!AllFinite(b.rest.points))
-    {
-      throw InputError("bone '" + b.name + "' has non-finite coordinates (NaN or infinity)");
-    }
-  }
+  CheckRestBones(bones);
   in.failures.resize(muscles.size());
   std::transform(muscles.begin(), muscles.end(), in.failures.begin(), ProblemOf);
   std::vector<const Points*> restPoints;
@@ -172,42 +224,7 @@ MotionDeformation::MotionDeformation(const std::vector<Muscle>& muscles, const s
       in.frame.ToLocal(line);
     }
   }
-  RestMappingCache scratch;
-  RestMappingCache& cache = kept ? *kept : scratch;
-  cache.muscles.resize(muscles.size());
-  std::vector<double> seconds(muscles.size(), 0.0);
-  in.energies = WithoutFailedMuscles(in.failures, [&](const std::vector<size_t>& active) {
-    std::vector<MuscleMotion> subset;
-    std::vector<std::vector<Points>> subsetLines;
-    RestMappingCache subCache; // the kept energies in the subset's order, and back
-    subCache.energyBuildCount = cache.energyBuildCount;
-    for (size_t m : active)
-    {
-      subset.push_back(local[m]);
-      subsetLines.push_back(localLines[m]);
-      subCache.muscles.push_back(std::move(cache.muscles[m]));
-    }
-    auto keep = [&] {
-      for (size_t k = 0; k < active.size(); ++k)
-      {
-        cache.muscles[active[k]] = std::move(subCache.muscles[k]);
-      }
-      cache.energyBuildCount = subCache.energyBuildCount;
-    };
-    std::vector<std::shared_ptr<const SurfaceEnergy>> built;
-    try
-    {
-      built = BuildEnergies(subset, subsetLines, in.parameters.settle, &subCache, seconds);
-    }
-    catch (...)
-    {
-      keep();
-      throw;
-    }
-    keep();
-    in.active = active;
-    return built;
-  });
+  in.energies = ActiveEnergies(local, localLines, in.parameters.settle, kept, in.failures, in.active);
   for (size_t k = 0; k < in.active.size(); ++k)
   {
     const size_t m = in.active[k];
@@ -331,12 +348,10 @@ size_t MotionDeformation::StateBytes(const State& state)
   return bytes;
 }
 
-MotionFrameResult MotionDeformation::Advance(const MotionPose& worldPose, const std::function<void(double)>& progress)
+MotionPose MotionDeformation::ToLocalPose(const MotionPose& worldPose) const
 {
-  const auto start = Clock::now();
   const Internals& in = *this->In;
   const State& from = *this->Now;
-  // The pose, checked against the rest pose and brought into the local frame.
   if (worldPose.bones.size() != in.obstacles.size())
   {
     throw InputError("the pose has " + std::to_string(worldPose.bones.size()) + " bones, the rest pose " +
@@ -385,9 +400,13 @@ MotionFrameResult MotionDeformation::Advance(const MotionPose& worldPose, const 
       in.frame.ToLocal(pose.lines.back().back());
     }
   }
+  return pose;
+}
 
-  // As many steps as keep each bone point's move within the largest step (the first frame: the
-  // method's NumberOfSteps when given).
+int MotionDeformation::FrameSteps(const MotionPose& pose) const
+{
+  const Internals& in = *this->In;
+  const State& from = *this->Now;
   double largest = 0;
   for (size_t b = 0; b < pose.bones.size(); ++b)
   {
@@ -401,19 +420,94 @@ MotionFrameResult MotionDeformation::Advance(const MotionPose& worldPose, const 
       linesMove = std::max(linesMove, MaximumDisplacement(from.pose.lines[k][l], pose.lines[k][l]));
     }
   }
-  const bool first = from.frames == 0;
-  const int steps = largest == 0 && linesMove == 0
-    ? 0
-    : (first && in.parameters.numberOfSteps > 0
-          ? in.parameters.numberOfSteps
-          : AutomaticNumberOfSteps(largest, in.parameters.maximumStepDisplacement));
+  if (largest == 0 && linesMove == 0)
+  {
+    return 0;
+  }
+  return from.frames == 0 && in.parameters.numberOfSteps > 0
+    ? in.parameters.numberOfSteps
+    : AutomaticNumberOfSteps(largest, in.parameters.maximumStepDisplacement);
+}
 
+void MotionDeformation::SettleFrame(const MotionPose& pose, int steps, State& next,
+  std::vector<MuscleStepMeasures>& frameMeasures, std::vector<std::string>& warnings,
+  const std::function<void(double)>& progress) const
+{
+  const Internals& in = *this->In;
+  const State& from = *this->Now;
+  const size_t count = in.muscles.size();
+  const std::vector<PoseInterpolator> boneMotions =
+    PoseInterpolators(from.pose.bones, pose.bones, in.parameters.interpolationMode);
+  std::vector<std::vector<PoseInterpolator>> lineMotions(count);
+  for (size_t k = 0; k < count; ++k)
+  {
+    for (size_t l = 0; l < pose.lines[k].size(); ++l)
+    {
+      lineMotions[k].emplace_back(from.pose.lines[k][l], pose.lines[k][l], in.parameters.interpolationMode);
+    }
+  }
+  const SettleInput settleInput{ in.obstacles, boneMotions, lineMotions, in.restLines, in.energyPointers,
+    in.restVolumes, in.fixed, in.restOverlap, in.parameters.settle };
+  for (int j = 1; j <= steps; ++j)
+  {
+    std::vector<TriangleMesh> muscles = next.current;
+    const double to = static_cast<double>(j) / steps;
+    const std::vector<SettleReport> settled =
+      SettleStep(settleInput, static_cast<double>(j - 1) / steps, to, muscles, next.settle, [&](double fraction) {
+        if (progress)
+        {
+          progress((j - 1 + 0.9 * fraction) / steps);
+        }
+      });
+    for (std::string& warning : SettleWarnings(settleInput, to, in.names, in.linesInBonesAtRest, settled, next.warned))
+    {
+      warnings.push_back(std::move(warning));
+    }
+    std::vector<StepOutcome> outcomes(count);
+    for (size_t k = 0; k < count; ++k)
+    {
+      outcomes[k] = { settled[k].iterations, settled[k].converged, 0, settled[k].seconds };
+    }
+    const std::vector<std::vector<char>> outsideBones = ProvenOutsideBones(next.settle.boneClearance);
+    std::vector<MuscleStepMeasures> measures =
+      ResolveAndMeasure(muscles, in.muscles, in.fixed, in.restOverlap, in.sharpEdges, in.restVolumes, in.parameters,
+        outcomes, next.previous, std::vector<MuscleStepMeasures>(count), &outsideBones);
+    // The frame's measures: the last step's, with the iterations and seconds of all its steps
+    // and the largest step static shift.
+    for (size_t k = 0; k < count; ++k)
+    {
+      const int iterations = frameMeasures[k].stepIterations + measures[k].stepIterations;
+      const double seconds = frameMeasures[k].deformationSeconds + measures[k].deformationSeconds;
+      const double stepShift = std::max(frameMeasures[k].stepStaticShift, measures[k].stepStaticShift);
+      frameMeasures[k] = measures[k];
+      frameMeasures[k].stepIterations = iterations;
+      frameMeasures[k].deformationSeconds = seconds;
+      frameMeasures[k].stepStaticShift = stepShift;
+    }
+    next.current = std::move(muscles);
+    next.previous = std::move(measures);
+    if (progress)
+    {
+      progress(static_cast<double>(j) / steps);
+    }
+  }
+}
+
+MotionFrameResult MotionDeformation::Advance(const MotionPose& worldPose, const std::function<void(double)>& progress)
+{
+  const auto start = Clock::now();
+  const Internals& in = *this->In;
+  const State& from = *this->Now;
+  // The pose, checked against the rest pose and brought into the local frame; as many steps as
+  // keep each bone point's move within the largest step (the first frame: the method's
+  // NumberOfSteps when given).
+  const MotionPose pose = this->ToLocalPose(worldPose);
+  const int steps = this->FrameSteps(pose);
   auto next = std::make_shared<State>(from);
   next->pose = pose;
   ++next->frames;
   MotionFrameResult result;
   result.steps = steps;
-  const size_t count = in.muscles.size();
   std::vector<MuscleStepMeasures> frameMeasures = from.previous;
   for (MuscleStepMeasures& s : frameMeasures)
   {
@@ -425,65 +519,12 @@ MotionFrameResult MotionDeformation::Advance(const MotionPose& worldPose, const 
   }
   if (steps > 0)
   {
-    const std::vector<PoseInterpolator> boneMotions =
-      PoseInterpolators(from.pose.bones, pose.bones, in.parameters.interpolationMode);
-    std::vector<std::vector<PoseInterpolator>> lineMotions(count);
-    for (size_t k = 0; k < count; ++k)
-    {
-      for (size_t l = 0; l < pose.lines[k].size(); ++l)
-      {
-        lineMotions[k].emplace_back(from.pose.lines[k][l], pose.lines[k][l], in.parameters.interpolationMode);
-      }
-    }
-    const SettleInput settleInput{ in.obstacles, boneMotions, lineMotions, in.restLines, in.energyPointers,
-      in.restVolumes, in.fixed, in.restOverlap, in.parameters.settle };
-    for (int j = 1; j <= steps; ++j)
-    {
-      std::vector<TriangleMesh> muscles = next->current;
-      const double to = static_cast<double>(j) / steps;
-      const std::vector<SettleReport> settled =
-        SettleStep(settleInput, static_cast<double>(j - 1) / steps, to, muscles, next->settle, [&](double fraction) {
-          if (progress)
-          {
-            progress((j - 1 + 0.9 * fraction) / steps);
-          }
-        });
-      for (std::string& warning :
-        SettleWarnings(settleInput, to, in.names, in.linesInBonesAtRest, settled, next->warned))
-      {
-        result.warnings.push_back(std::move(warning));
-      }
-      std::vector<StepOutcome> outcomes(count);
-      for (size_t k = 0; k < count; ++k)
-      {
-        outcomes[k] = { settled[k].iterations, settled[k].converged, 0, settled[k].seconds };
-      }
-      const std::vector<std::vector<char>> outsideBones = ProvenOutsideBones(next->settle.boneClearance);
-      std::vector<MuscleStepMeasures> measures =
-        ResolveAndMeasure(muscles, in.muscles, in.fixed, in.restOverlap, in.sharpEdges, in.restVolumes, in.parameters,
-          outcomes, next->previous, std::vector<MuscleStepMeasures>(count), &outsideBones);
-      for (size_t k = 0; k < count; ++k)
-      {
-        const int iterations = frameMeasures[k].stepIterations + measures[k].stepIterations;
-        const double seconds = frameMeasures[k].deformationSeconds + measures[k].deformationSeconds;
-        const double stepShift = std::max(frameMeasures[k].stepStaticShift, measures[k].stepStaticShift);
-        frameMeasures[k] = measures[k];
-        frameMeasures[k].stepIterations = iterations;
-        frameMeasures[k].deformationSeconds = seconds;
-        frameMeasures[k].stepStaticShift = stepShift;
-      }
-      next->current = std::move(muscles);
-      next->previous = std::move(measures);
-      if (progress)
-      {
-        progress(static_cast<double>(j) / steps);
-      }
-    }
+    this->SettleFrame(pose, steps, *next, frameMeasures, result.warnings, progress);
   }
   // Into the data's coordinates, one entry per muscle given.
   result.points.assign(in.muscleCount, Points(0, 3));
   result.measures.assign(in.muscleCount, MuscleStepMeasures{});
-  for (size_t k = 0; k < count; ++k)
+  for (size_t k = 0; k < in.muscles.size(); ++k)
   {
     result.points[in.active[k]] = next->current[k].points;
     in.frame.ToWorld(result.points[in.active[k]]);

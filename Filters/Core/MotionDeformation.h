@@ -110,6 +110,16 @@ public:
 
 private:
   struct Internals;
+  /// `pose` checked against the rest pose and brought into the local frame (Advance's errors).
+  MotionPose ToLocalPose(const MotionPose& pose) const;
+  /// How many steps the frame to `pose` (local) is settled in: as many as keep each bone point's
+  /// move within MaximumStepDisplacement (the first frame: NumberOfSteps when given); 0 where
+  /// nothing moves.
+  int FrameSteps(const MotionPose& pose) const;
+  /// The muscles settled from where the motion stands to `pose` in `steps` steps, into `next`;
+  /// `frameMeasures` gets the last step's measures with the iterations and seconds of all.
+  void SettleFrame(const MotionPose& pose, int steps, State& next, std::vector<MuscleStepMeasures>& frameMeasures,
+    std::vector<std::string>& warnings, const std::function<void(double)>& progress) const;
   std::unique_ptr<Internals> In;
   std::shared_ptr<const State> Now;  ///< where the motion stands
   std::shared_ptr<const State> Rest; ///< the rest pose
