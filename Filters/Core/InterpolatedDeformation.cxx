@@ -789,33 +789,12 @@ InterpolationResult DeformByInterpolation(const std::vector<MuscleMotion>& muscl
   const std::function<void(double)> forward = ForwardOnly(progress);
   InterpolationResult result = WithoutFailedMuscles(failures, [&](const std::vector<size_t>& active) {
     std::vector<MuscleMotion> subset;
-    RestMappingCache subCache;
-    subCache.hullBuildCount = cache.hullBuildCount;
-    subCache.energyBuildCount = cache.energyBuildCount;
     for (size_t m : active)
     {
       subset.push_back(muscles[m]);
-      subCache.muscles.push_back(std::move(cache.muscles[m]));
     }
-    auto keep = [&] {
-      for (size_t k = 0; k < active.size(); ++k)
-      {
-        cache.muscles[active[k]] = std::move(subCache.muscles[k]);
-      }
-      cache.hullBuildCount = subCache.hullBuildCount;
-      cache.energyBuildCount = subCache.energyBuildCount;
-    };
-    InterpolationResult some;
-    try
-    {
-      some = DeformEveryMuscle(subset, bones, parameters, forward, &subCache);
-    }
-    catch (...)
-    {
-      keep();
-      throw;
-    }
-    keep();
+    InterpolationResult some = WithCacheSubset(cache, active,
+      [&](RestMappingCache& subCache) { return DeformEveryMuscle(subset, bones, parameters, forward, &subCache); });
     if (active.size() == count)
     {
       return some;

@@ -164,6 +164,41 @@ struct RestMappingCache
   int energyBuildCount = 0; ///< full-mesh energies built so far
 };
 
+/// Runs `work` (called with a RestMappingCache) on the entries of `cache` for the muscles
+/// `active` alone, moved into a cache of their own in that order with `cache`'s counts, and
+/// gives them and the counts back afterwards, also when `work` throws: the method run on a
+/// subset of the muscles (those that can go) keeps what it built by muscle.
+template<class Work>
+auto WithCacheSubset(RestMappingCache& cache, const std::vector<size_t>& active, Work&& work)
+{
+  RestMappingCache subset;
+  subset.hullBuildCount = cache.hullBuildCount;
+  subset.energyBuildCount = cache.energyBuildCount;
+  for (size_t m : active)
+  {
+    subset.muscles.push_back(std::move(cache.muscles[m]));
+  }
+  auto giveBack = [&] {
+    for (size_t k = 0; k < active.size(); ++k)
+    {
+      cache.muscles[active[k]] = std::move(subset.muscles[k]);
+    }
+    cache.hullBuildCount = subset.hullBuildCount;
+    cache.energyBuildCount = subset.energyBuildCount;
+  };
+  try
+  {
+    auto result = work(subset);
+    giveBack();
+    return result;
+  }
+  catch (...)
+  {
+    giveBack();
+    throw;
+  }
+}
+
 /// Number of steps: `parameters.numberOfSteps`, or when 0 enough steps that no
 /// bone point moves more than `parameters.maximumStepDisplacement` in one.
 int ResolveNumberOfSteps(const std::vector<BoneMotion>& bones, const InterpolationParameters& parameters);

@@ -79,32 +79,13 @@ std::vector<std::shared_ptr<const SurfaceEnergy>> ActiveEnergies(const std::vect
   return WithoutFailedMuscles(failures, [&](const std::vector<size_t>& going) {
     std::vector<MuscleMotion> subset;
     std::vector<std::vector<Points>> subsetLines;
-    RestMappingCache subCache; // the kept energies in the subset's order, and back
-    subCache.energyBuildCount = cache.energyBuildCount;
     for (size_t m : going)
     {
       subset.push_back(local[m]);
       subsetLines.push_back(localLines[m]);
-      subCache.muscles.push_back(std::move(cache.muscles[m]));
     }
-    auto keep = [&] {
-      for (size_t k = 0; k < going.size(); ++k)
-      {
-        cache.muscles[going[k]] = std::move(subCache.muscles[k]);
-      }
-      cache.energyBuildCount = subCache.energyBuildCount;
-    };
-    std::vector<std::shared_ptr<const SurfaceEnergy>> built;
-    try
-    {
-      built = BuildEnergies(subset, subsetLines, parameters, &subCache, seconds);
-    }
-    catch (...)
-    {
-      keep();
-      throw;
-    }
-    keep();
+    auto built = WithCacheSubset(cache, going,
+      [&](RestMappingCache& subCache) { return BuildEnergies(subset, subsetLines, parameters, &subCache, seconds); });
     active = going;
     return built;
   });
