@@ -262,6 +262,173 @@ std::vector<Penetration> MeasureNewPenetration(
   return result;
 }
 
+namespace
+{
+/// Where a muscle's penetrating points go out: each point's move (`shift`), the outward normal
+/// of the obstacle where it goes out (the tangent plane there is the half-space it must reach),
+/// the width of its group's rim (> 0 marks a penetrating point) and the obstacle it leaves (a
+/// bone, or a muscle it leaves wholly; null where it takes a share of the way).
+struct Prints
+{
+  Points shift;
+  Points normal;
+  std::vector<double> rim;
+  std::vector<const TriangleTree*> leaving;
+};
+
+/// The ways out of obstacle `tree` (`share` of each) of the points `d` finds deepest in it: each
+/// connected group of them goes out along its mean way where that leaves the obstacle within
+/// twice the point's depth, else to the nearest surface point; `backOff` beyond. Adds the
+/// groups to `report`.
+void WaysOut(const TriangleMesh& mesh, const Deepest& d, int o, const TriangleTree& tree, double share, double falloff,
+  double backOff, Prints& prints, StaticResolveReport& report)
+{
+  const Eigen::Index n = mesh.points.rows();
+  std::vector<char> member(static_cast<size_t>(n), 0);
+  bool any = false;
+  for (Eigen::Index i = 0; i < n; ++i)
+  {
+    member[i] = d.obstacle[i] == o;
+    any = any || member[i];
+  }
+  if (!any)
+  {
+    return;
+  }
+  const double reach = 2 * BoxDiagonal(tree.Mesh().points);
+  int groups = 0;
+  const std::vector<int> group = Components(mesh.triangles, n, groups, &member);
+  report.groups += groups;
+  Points direction = Points::Zero(groups, 3);
+  for (Eigen::Index i = 0; i < n; ++i)
+  {
+    if (group[i] >= 0)
+    {
+      direction.row(group[i]) += d.nearest.row(i) - mesh.points.row(i);
+    }
+  }
+  for (int g = 0; g < groups; ++g)
+  {
+    const double length = direction.row(g).norm();
+    direction.row(g) = length > 0 ? Eigen::RowVector3d(direction.row(g) / length) : Eigen::RowVector3d::Zero();
+  }
+#pragma omp parallel for schedule(dynamic, 64)
+  for (Eigen::Index i = 0; i < n; ++i)
+  {
+    if (group[i] < 0)
+    {
+      continue;
+    }
+    const Eigen::Vector3d p = mesh.points.row(i).transpose();
+    const Eigen::Vector3d nearest = d.nearest.row(i).transpose();
+    const Eigen::Vector3d way = direction.row(group[i]).transpose();
+    Eigen::Vector3d target = nearest;
+    Eigen::Vector3d out = nearest - p;
+    Eigen::Vector3d surfaceNormal = out.normalized(); // at the nearest point, the way there
+    if (way.squaredNorm() > 0)
+    {
+      const auto exit = tree.FirstHit(p, p + reach * way);
+      if (exit && (exit->point - p).norm() <= 2 * d.depth[i] + backOff)
+      {
+        target = exit->point;
+        out = way;
+        surfaceNormal = tree.Normal(exit->triangle);
+        if (surfaceNormal.dot(way) < 0)
+        {
+          surfaceNormal = -surfaceNormal; // outward: the way leaves through it
+        }
+      }
+    }
+    const double outLength = out.norm();
+    if (outLength > 0)
+    {
+      target += (backOff / outLength) * out;
+    }
+    prints.shift.row(i) = share * (target - p).transpose();
+    prints.normal.row(i) = (surfaceNormal.allFinite() ? surfaceNormal : way).transpose();
+    prints.leaving[i] = share == 1.0 ? &tree : nullptr; // a share of the way need not leave
+  }
+  std::vector<double> deepest(static_cast<size_t>(groups), 0.0);
+  for (Eigen::Index i = 0; i < n; ++i)
+  {
+    if (group[i] >= 0)
+    {
+      deepest[group[i]] = std::max(deepest[group[i]], prints.shift.row(i).norm());
+    }
+  }
+  for (Eigen::Index i = 0; i < n; ++i)
+  {
+    if (group[i] >= 0)
+    {
+      // Every penetrating point is marked, however small its group's move.
+      prints.rim[i] = std::max(falloff * deepest[group[i]], std::numeric_limits<double>::min());
+    }
+  }
+}
+
+/// The prints smoothed over their rims (SmoothPrints). Smoothing can leave a point of a concave
+/// obstacle inside it: such a point (its move does not cross the obstacle's surface an odd
+/// number of times) is pinned to its own way out and the rest smoothed again.
+void SmoothPinned(const TriangleMesh& mesh, Prints& prints)
+{
+  const Eigen::Index n = mesh.points.rows();
+  const Points target = prints.shift;
+  const std::vector<std::vector<std::int64_t>> neighbours = PointNeighbours(mesh.triangles, n);
+  std::vector<char> pinned(static_cast<size_t>(n), 0);
+  for (int round = 0; round < 4; ++round)
+  {
+    SmoothPrints(mesh.points, neighbours, prints.rim, prints.normal, pinned, prints.shift);
+    std::int64_t failed = 0;
+#pragma omp parallel for reduction(+ : failed) schedule(dynamic, 64)
+    for (Eigen::Index i = 0; i < n; ++i)
+    {
+      const Eigen::Vector3d p = mesh.points.row(i).transpose();
+      if (prints.leaving[i] && !pinned[i] &&
+        prints.leaving[i]->Crossings(p, p + prints.shift.row(i).transpose()) % 2 == 0)
+      {
+        pinned[i] = 1;
+        prints.shift.row(i) = target.row(i);
+        ++failed;
+      }
+    }
+    if (failed == 0)
+    {
+      break;
+    }
+  }
+}
+
+/// No move may enter a fixed obstacle (a bone) on the way: one out of another muscle, or spread
+/// around a print, stops at the bone's surface (`backOff` short), but for the bone the point
+/// leaves (`d`) and those it overlapped at rest (`existing`).
+void StopAtBones(const TriangleMesh& mesh, size_t m, const Deepest& d, const std::vector<FixedObstacle>& fixed,
+  const OverlapMasks* existing, double backOff, Points& shift)
+{
+#pragma omp parallel for schedule(dynamic, 64)
+  for (Eigen::Index i = 0; i < mesh.points.rows(); ++i)
+  {
+    const double length = shift.row(i).norm();
+    if (length == 0)
+    {
+      continue;
+    }
+    const Eigen::Vector3d p = mesh.points.row(i).transpose();
+    const Eigen::Vector3d to = p + shift.row(i).transpose();
+    for (size_t o = 0; o < fixed.size(); ++o)
+    {
+      if (d.obstacle[i] == static_cast<int>(o) || InOverlap(existing, m, o, i))
+      {
+        continue; // leaving this one, or inside it in the rest pose
+      }
+      if (const auto hit = fixed[o].tree->FirstHit(p, p + (to - p) * (1 + backOff / length)))
+      {
+        shift.row(i) *= std::max(0.0, hit->t * (1 + backOff / length) - backOff / length);
+      }
+    }
+  }
+}
+}
+
 StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& meshes,
   const std::vector<FixedObstacle>& fixed, const OverlapMasks* existing, const StaticResolveParameters& parameters,
   const std::vector<std::vector<char>>* outsideFixed)
@@ -287,156 +454,22 @@ StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& 
       continue;
     }
     const double backOff = 1e-5 * BoxDiagonal(mesh.points);
-    Points shift = Points::Zero(n, 3);
-    // Of each penetrating point: the obstacle's outward normal where it goes
-    // out (the tangent plane there is the half-space it must reach), and its
-    // group's rim width.
-    Points normal = Points::Zero(n, 3);
-    std::vector<double> rim(static_cast<size_t>(n), 0.0);
-    std::vector<const TriangleTree*> leaving(static_cast<size_t>(n), nullptr); // the obstacle it goes out of
+    Prints prints{ Points::Zero(n, 3), Points::Zero(n, 3), std::vector<double>(static_cast<size_t>(n), 0.0),
+      std::vector<const TriangleTree*>(static_cast<size_t>(n), nullptr) };
     StaticResolveReport report;
     for (size_t o = 0; o < set.all.size(); ++o)
     {
-      const TriangleTree* tree = set.For(m, o, fixed.size());
-      if (!tree)
+      if (const TriangleTree* tree = set.For(m, o, fixed.size()))
       {
-        continue;
-      }
-      std::vector<char> member(static_cast<size_t>(n), 0);
-      bool any = false;
-      for (Eigen::Index i = 0; i < n; ++i)
-      {
-        member[i] = d.obstacle[i] == static_cast<int>(o);
-        any = any || member[i];
-      }
-      if (!any)
-      {
-        continue;
-      }
-      const double share = o < fixed.size() ? 1.0 : parameters.deformableShare;
-      const double reach = 2 * BoxDiagonal(tree->Mesh().points);
-      int groups = 0;
-      const std::vector<int> group = Components(mesh.triangles, n, groups, &member);
-      report.groups += groups;
-      Points direction = Points::Zero(groups, 3);
-      for (Eigen::Index i = 0; i < n; ++i)
-      {
-        if (group[i] >= 0)
-        {
-          direction.row(group[i]) += d.nearest.row(i) - mesh.points.row(i);
-        }
-      }
-      for (int g = 0; g < groups; ++g)
-      {
-        const double length = direction.row(g).norm();
-        direction.row(g) = length > 0 ? Eigen::RowVector3d(direction.row(g) / length) : Eigen::RowVector3d::Zero();
-      }
-#pragma omp parallel for schedule(dynamic, 64)
-      for (Eigen::Index i = 0; i < n; ++i)
-      {
-        if (group[i] < 0)
-        {
-          continue;
-        }
-        const Eigen::Vector3d p = mesh.points.row(i).transpose();
-        const Eigen::Vector3d nearest = d.nearest.row(i).transpose();
-        const Eigen::Vector3d way = direction.row(group[i]).transpose();
-        Eigen::Vector3d target = nearest;
-        Eigen::Vector3d out = nearest - p;
-        Eigen::Vector3d surfaceNormal = out.normalized(); // at the nearest point, the way there
-        if (way.squaredNorm() > 0)
-        {
-          const auto exit = tree->FirstHit(p, p + reach * way);
-          if (exit && (exit->point - p).norm() <= 2 * d.depth[i] + backOff)
-          {
-            target = exit->point;
-            out = way;
-            surfaceNormal = tree->Normal(exit->triangle);
-            if (surfaceNormal.dot(way) < 0)
-            {
-              surfaceNormal = -surfaceNormal; // outward: the way leaves through it
-            }
-          }
-        }
-        const double outLength = out.norm();
-        if (outLength > 0)
-        {
-          target += (backOff / outLength) * out;
-        }
-        shift.row(i) = share * (target - p).transpose();
-        normal.row(i) = (surfaceNormal.allFinite() ? surfaceNormal : way).transpose();
-        leaving[i] = share == 1.0 ? tree : nullptr; // a share of the way need not leave
-      }
-      std::vector<double> deepest(static_cast<size_t>(groups), 0.0);
-      for (Eigen::Index i = 0; i < n; ++i)
-      {
-        if (group[i] >= 0)
-        {
-          deepest[group[i]] = std::max(deepest[group[i]], shift.row(i).norm());
-        }
-      }
-      for (Eigen::Index i = 0; i < n; ++i)
-      {
-        if (group[i] >= 0)
-        {
-          // Every penetrating point is marked, however small its group's move.
-          rim[i] = std::max(parameters.falloff * deepest[group[i]], std::numeric_limits<double>::min());
-        }
+        const double share = o < fixed.size() ? 1.0 : parameters.deformableShare;
+        WaysOut(mesh, d, static_cast<int>(o), *tree, share, parameters.falloff, backOff, prints, report);
       }
     }
     if (parameters.falloff > 0)
     {
-      // Smoothing can leave a point of a concave obstacle inside it: such a
-      // point (its move does not cross the obstacle's surface an odd number
-      // of times) is pinned to its own way out and the rest smoothed again.
-      const Points target = shift;
-      const std::vector<std::vector<std::int64_t>> neighbours = PointNeighbours(mesh.triangles, n);
-      std::vector<char> pinned(static_cast<size_t>(n), 0);
-      for (int round = 0; round < 4; ++round)
-      {
-        SmoothPrints(mesh.points, neighbours, rim, normal, pinned, shift);
-        std::int64_t failed = 0;
-#pragma omp parallel for reduction(+ : failed) schedule(dynamic, 64)
-        for (Eigen::Index i = 0; i < n; ++i)
-        {
-          const Eigen::Vector3d p = mesh.points.row(i).transpose();
-          if (leaving[i] && !pinned[i] && leaving[i]->Crossings(p, p + shift.row(i).transpose()) % 2 == 0)
-          {
-            pinned[i] = 1;
-            shift.row(i) = target.row(i);
-            ++failed;
-          }
-        }
-        if (failed == 0)
-        {
-          break;
-        }
-      }
+      SmoothPinned(mesh, prints);
     }
-    // No move may enter a fixed obstacle (a bone) on the way: one out of
-    // another muscle, or spread around a print, stops at the bone's surface.
-#pragma omp parallel for schedule(dynamic, 64)
-    for (Eigen::Index i = 0; i < n; ++i)
-    {
-      const double length = shift.row(i).norm();
-      if (length == 0)
-      {
-        continue;
-      }
-      const Eigen::Vector3d p = mesh.points.row(i).transpose();
-      const Eigen::Vector3d to = p + shift.row(i).transpose();
-      for (size_t o = 0; o < fixed.size(); ++o)
-      {
-        if (d.obstacle[i] == static_cast<int>(o) || InOverlap(existing, m, o, i))
-        {
-          continue; // leaving this one, or inside it in the rest pose
-        }
-        if (const auto hit = fixed[o].tree->FirstHit(p, p + (to - p) * (1 + backOff / length)))
-        {
-          shift.row(i) *= std::max(0.0, hit->t * (1 + backOff / length) - backOff / length);
-        }
-      }
-    }
+    StopAtBones(mesh, m, d, fixed, existing, backOff, prints.shift);
     for (Eigen::Index i = 0; i < n; ++i)
     {
       if (d.obstacle[i] >= 0)
@@ -444,10 +477,10 @@ StaticResolveResult ResolveStaticIntersections(const std::vector<TriangleMesh>& 
         ++report.penetratingPoints;
         report.maxDepth = std::max(report.maxDepth, d.depth[i]);
       }
-      report.maxShift = std::max(report.maxShift, shift.row(i).norm());
+      report.maxShift = std::max(report.maxShift, prints.shift.row(i).norm());
     }
-    result.points.push_back(mesh.points + shift);
-    result.shift.push_back(std::move(shift));
+    result.points.push_back(mesh.points + prints.shift);
+    result.shift.push_back(std::move(prints.shift));
     result.reports.push_back(report);
   }
   return result;
