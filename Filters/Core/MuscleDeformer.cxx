@@ -560,6 +560,165 @@ std::int64_t PinDeeperInBones(MuscleState& s, const std::vector<Obstacle>& bones
   return count;
 }
 
+/// The rings of neighbours of every point and the triangles at every point of `s`'s muscle,
+/// found once.
+void EnsureRings(MuscleState& s)
+{
+  if (!s.neighbours.empty())
+  {
+    return;
+  }
+  const Triangles& triangles = s.input->muscle->triangles;
+  const Eigen::Index n = s.points.rows();
+  s.neighbours = PointNeighbours(triangles, n);
+  s.trianglesOf.assign(static_cast<size_t>(n), {});
+  for (Eigen::Index t = 0; t < triangles.rows(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      s.trianglesOf[triangles(t, k)].push_back(t);
+    }
+  }
+}
+
+/// `region` grown by the corners of the `flipped` triangles and then by two rings (so that an
+/// attempt that left the same triangles flipped works on a wider region).
+void GrowRegion(const std::vector<Eigen::Index>& flipped, const Triangles& triangles,
+  const std::vector<std::vector<std::int64_t>>& ring, std::vector<char>& region)
+{
+  for (Eigen::Index t : flipped)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      region[triangles(t, k)] = 1;
+    }
+  }
+  std::vector<Eigen::Index> frontier;
+  for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(region.size()); ++i)
+  {
+    if (region[i])
+    {
+      frontier.push_back(i);
+    }
+  }
+  for (int grow = 0; grow < 2; ++grow)
+  {
+    std::vector<Eigen::Index> next;
+    for (Eigen::Index i : frontier)
+    {
+      for (std::int64_t j : ring[i])
+      {
+        if (!region[j])
+        {
+          region[j] = 1;
+          next.push_back(j);
+        }
+      }
+    }
+    frontier = std::move(next);
+  }
+}
+
+/// The points `members` (their places among the unknowns in `slot`, -1 for the others, which
+/// stay) given back the rest shape of their neighbourhoods (`s.reference`) as far as the fixed
+/// border allows: five rounds of local rotations (fitted to each point's ring) and a global
+/// solve of the uniform Laplacian. With `onBones` a point carried into a bone slides on it.
+void ReshapeRegion(MuscleState& s, const std::vector<Eigen::Index>& members, const std::vector<Eigen::Index>& slot,
+  const std::vector<Obstacle>& bones, bool onBones)
+{
+  const std::vector<std::vector<std::int64_t>>& ring = s.neighbours;
+  const Points& reference = *s.reference;
+  const Eigen::Index k = static_cast<Eigen::Index>(members.size());
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index a = 0; a < k; ++a)
+  {
+    const Eigen::Index i = members[a];
+    entries.emplace_back(a, a, static_cast<double>(ring[i].size()));
+    for (std::int64_t j : ring[i])
+    {
+      if (slot[j] >= 0)
+      {
+        entries.emplace_back(a, slot[j], -1.0);
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> system(k, k);
+  system.setFromTriplets(entries.begin(), entries.end());
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(system);
+  Points& shape = s.points; // the region reshaped, the rest unchanged
+  std::vector<Eigen::Matrix3d> rotation(static_cast<size_t>(shape.rows()));
+  Eigen::MatrixXd rhs(k, 3);
+  for (int local = 0; local < 5 && solver.info() == Eigen::Success; ++local)
+  {
+#pragma omp parallel for schedule(static)
+    for (Eigen::Index a = 0; a < k; ++a)
+    {
+      const Eigen::Index i = members[a];
+      Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+      for (std::int64_t j : ring[i])
+      {
+        covariance += (shape.row(j) - shape.row(i)).transpose() * (reference.row(j) - reference.row(i));
+      }
+      rotation[i] = BestRotation(covariance);
+    }
+#pragma omp parallel for schedule(static)
+    for (Eigen::Index a = 0; a < k; ++a)
+    {
+      const Eigen::Index i = members[a];
+      Eigen::RowVector3d row = Eigen::RowVector3d::Zero();
+      for (std::int64_t j : ring[i])
+      {
+        const Eigen::Matrix3d r = slot[j] >= 0 ? Eigen::Matrix3d(0.5 * (rotation[i] + rotation[j])) : rotation[i];
+        row += (r * (reference.row(i) - reference.row(j)).transpose()).transpose();
+        if (slot[j] < 0)
+        {
+          row += shape.row(j);
+        }
+      }
+      rhs.row(a) = row;
+    }
+    const Eigen::MatrixXd solved = solver.solve(rhs);
+    for (Eigen::Index a = 0; a < k; ++a)
+    {
+      shape.row(members[a]) = solved.row(a);
+    }
+    if (onBones)
+    {
+      SlideOnBones(s, bones, members);
+    }
+  }
+}
+
+/// The triangles that can have changed when `members` moved: those with a corner among them or
+/// next to them.
+std::vector<Eigen::Index> TrianglesNear(const MuscleState& s, const std::vector<Eigen::Index>& members)
+{
+  std::vector<char> candidate(static_cast<size_t>(s.input->muscle->triangles.rows()), 0);
+  for (Eigen::Index i : members)
+  {
+    for (Eigen::Index t : s.trianglesOf[i])
+    {
+      candidate[t] = 1;
+    }
+    for (std::int64_t j : s.neighbours[i])
+    {
+      for (Eigen::Index t : s.trianglesOf[j])
+      {
+        candidate[t] = 1;
+      }
+    }
+  }
+  std::vector<Eigen::Index> candidates;
+  for (Eigen::Index t = 0; t < static_cast<Eigen::Index>(candidate.size()); ++t)
+  {
+    if (candidate[t])
+    {
+      candidates.push_back(t);
+    }
+  }
+  return candidates;
+}
+
 /// Undoes folds of the full mesh (triangles the mapping turned over, where
 /// the hull deformed too unevenly for its mean value coordinates): the points
 /// around the flipped triangles take back the shape their neighbourhood has
@@ -573,165 +732,40 @@ std::int64_t PinDeeperInBones(MuscleState& s, const std::vector<Obstacle>& bones
 bool UnfoldFlippedTriangles(MuscleState& s, const std::vector<Obstacle>& bones, bool dynamicIntersections, bool onBones)
 {
   const Triangles& triangles = s.input->muscle->triangles;
-  const Points& reference = *s.reference;
-  std::vector<Eigen::Index> flipped = FlippedTriangles(reference, s.points, triangles);
+  std::vector<Eigen::Index> flipped = FlippedTriangles(*s.reference, s.points, triangles);
   if (flipped.empty())
   {
     return false;
   }
   const Eigen::Index n = s.points.rows();
-  if (s.neighbours.empty())
-  {
-    s.neighbours = PointNeighbours(triangles, n);
-    s.trianglesOf.assign(static_cast<size_t>(n), {});
-    for (Eigen::Index t = 0; t < triangles.rows(); ++t)
-    {
-      for (int k = 0; k < 3; ++k)
-      {
-        s.trianglesOf[triangles(t, k)].push_back(t);
-      }
-    }
-  }
-  const std::vector<std::vector<std::int64_t>>& ring = s.neighbours;
-  const std::vector<std::vector<Eigen::Index>>& trianglesOf = s.trianglesOf;
+  EnsureRings(s);
   std::vector<char> region(static_cast<size_t>(n), 0);
   std::vector<Eigen::Index> members;
-  std::vector<Eigen::Matrix3d> rotation(static_cast<size_t>(n));
   std::vector<char> pinned(static_cast<size_t>(n), 0); // held where they were (onBones)
   const Points before = s.points;
   for (int attempt = 0; attempt < 8 && !flipped.empty(); ++attempt)
   {
-    // The region: the region of the attempts before and the corners of the
-    // flipped triangles, grown by two rings (so that an attempt that left
-    // the same triangles flipped works on a wider region).
-    for (Eigen::Index t : flipped)
-    {
-      for (int k = 0; k < 3; ++k)
-      {
-        region[triangles(t, k)] = 1;
-      }
-    }
-    std::vector<Eigen::Index> frontier;
-    for (Eigen::Index i = 0; i < n; ++i)
-    {
-      if (region[i])
-      {
-        frontier.push_back(i);
-      }
-    }
-    for (int grow = 0; grow < 2; ++grow)
-    {
-      std::vector<Eigen::Index> next;
-      for (Eigen::Index i : frontier)
-      {
-        for (std::int64_t j : ring[i])
-        {
-          if (!region[j])
-          {
-            region[j] = 1;
-            next.push_back(j);
-          }
-        }
-      }
-      frontier = std::move(next);
-    }
+    // The region: the region of the attempts before and the corners of the flipped triangles,
+    // grown by two rings.
+    GrowRegion(flipped, triangles, s.neighbours, region);
     members.clear();
     std::vector<Eigen::Index> slot(static_cast<size_t>(n), -1);
     for (Eigen::Index i = 0; i < n; ++i)
     {
-      if (region[i] && !ring[i].empty() && !pinned[i])
+      if (region[i] && !s.neighbours[i].empty() && !pinned[i])
       {
         slot[i] = static_cast<Eigen::Index>(members.size());
         members.push_back(i);
       }
     }
-    const Eigen::Index k = static_cast<Eigen::Index>(members.size());
-    std::vector<Eigen::Triplet<double>> entries;
-    for (Eigen::Index a = 0; a < k; ++a)
-    {
-      const Eigen::Index i = members[a];
-      entries.emplace_back(a, a, static_cast<double>(ring[i].size()));
-      for (std::int64_t j : ring[i])
-      {
-        if (slot[j] >= 0)
-        {
-          entries.emplace_back(a, slot[j], -1.0);
-        }
-      }
-    }
-    Eigen::SparseMatrix<double> system(k, k);
-    system.setFromTriplets(entries.begin(), entries.end());
-    const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(system);
-    Points& shape = s.points; // the region reshaped, the rest unchanged
-    Eigen::MatrixXd rhs(k, 3);
-    for (int local = 0; local < 5 && solver.info() == Eigen::Success; ++local)
-    {
-#pragma omp parallel for schedule(static)
-      for (Eigen::Index a = 0; a < k; ++a)
-      {
-        const Eigen::Index i = members[a];
-        Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-        for (std::int64_t j : ring[i])
-        {
-          covariance += (shape.row(j) - shape.row(i)).transpose() * (reference.row(j) - reference.row(i));
-        }
-        rotation[i] = BestRotation(covariance);
-      }
-#pragma omp parallel for schedule(static)
-      for (Eigen::Index a = 0; a < k; ++a)
-      {
-        const Eigen::Index i = members[a];
-        Eigen::RowVector3d row = Eigen::RowVector3d::Zero();
-        for (std::int64_t j : ring[i])
-        {
-          const Eigen::Matrix3d r = slot[j] >= 0 ? Eigen::Matrix3d(0.5 * (rotation[i] + rotation[j])) : rotation[i];
-          row += (r * (reference.row(i) - reference.row(j)).transpose()).transpose();
-          if (slot[j] < 0)
-          {
-            row += shape.row(j);
-          }
-        }
-        rhs.row(a) = row;
-      }
-      const Eigen::MatrixXd solved = solver.solve(rhs);
-      for (Eigen::Index a = 0; a < k; ++a)
-      {
-        shape.row(members[a]) = solved.row(a);
-      }
-      if (onBones)
-      {
-        SlideOnBones(s, bones, members);
-      }
-    }
+    ReshapeRegion(s, members, slot, bones, onBones);
     if (onBones && attempt + 1 < 8 && PinDeeperInBones(s, bones, members, before, pinned) > 0)
     {
       continue; // the same folds, the region reshaped again around the held points
     }
     // Only triangles with a corner in the region or next to it can have changed.
-    std::vector<char> candidate(static_cast<size_t>(triangles.rows()), 0);
-    for (Eigen::Index i : members)
-    {
-      for (Eigen::Index t : trianglesOf[i])
-      {
-        candidate[t] = 1;
-      }
-      for (std::int64_t j : ring[i])
-      {
-        for (Eigen::Index t : trianglesOf[j])
-        {
-          candidate[t] = 1;
-        }
-      }
-    }
-    std::vector<Eigen::Index> candidates;
-    for (Eigen::Index t = 0; t < triangles.rows(); ++t)
-    {
-      if (candidate[t])
-      {
-        candidates.push_back(t);
-      }
-    }
-    flipped = FlippedTriangles(reference, s.points, triangles, &candidates);
+    const std::vector<Eigen::Index> candidates = TrianglesNear(s, members);
+    flipped = FlippedTriangles(*s.reference, s.points, triangles, &candidates);
   }
   // Held at the bones, a fold may stay: unfolding again would not undo it.
   s.unfoldingBlocked = onBones && !flipped.empty();
