@@ -168,6 +168,68 @@ void Validate(const MuscleToDeform& m)
   }
 }
 
+/// Throws InputError when an action line of muscle `m` does not pass through it: none of its
+/// rest-pose samples (`restSamples`, each line's after the last's) is inside the muscle's hull.
+void CheckLinesPassThrough(const MuscleToDeform& m, const Points& restSamples, int samplesPerSegment)
+{
+  const TriangleTree hullTree(*m.hull);
+  Eigen::Index first = 0; // each line's samples follow the previous line's
+  for (size_t l = 0; l < m.lines.size(); ++l)
+  {
+    const Eigen::Index count = (m.lines[l].rest.rows() - 1) * std::max(1, samplesPerSegment) + 1;
+    const bool passes = CountInsideTree(hullTree, restSamples.middleRows(first, count)) > 0;
+    first += count;
+    if (!passes)
+    {
+      throw InputError("action line " + std::to_string(l + 1) + " of muscle '" + m.name +
+        "' does not pass through the muscle (none of its rest-pose samples is inside the muscle's hull): "
+        "are the action lines in the rest pose, in the same units, paired with the right muscle?");
+    }
+  }
+}
+
+/// The points of the pieces of `hull` that no action-line sample (`restSamples`) lies in: a scan
+/// can leave one (cut apart at a pinch), and nothing places it; its points follow their nearest
+/// action-line segment, as soft rows.
+std::vector<Eigen::Index> HullPointsNoLineDrives(const TriangleMesh& hull, const Points& restSamples)
+{
+  int pieces = 0;
+  const std::vector<int> piece = Components(hull.triangles, hull.points.rows(), pieces);
+  std::vector<Eigen::Index> anchored;
+  for (int c = 0; pieces > 1 && c < pieces; ++c)
+  {
+    std::vector<Eigen::Index> faces;
+    for (Eigen::Index t = 0; t < hull.triangles.rows(); ++t)
+    {
+      if (piece[hull.triangles(t, 0)] == c)
+      {
+        faces.push_back(t);
+      }
+    }
+    Triangles pieceTriangles(static_cast<Eigen::Index>(faces.size()), 3);
+    for (size_t f = 0; f < faces.size(); ++f)
+    {
+      pieceTriangles.row(static_cast<Eigen::Index>(f)) = hull.triangles.row(faces[f]);
+    }
+    bool driven = false;
+    for (Eigen::Index r = 0; r < restSamples.rows() && !driven; ++r)
+    {
+      driven = WindingNumber(hull.points, pieceTriangles, restSamples.row(r).transpose()) > 0.5;
+    }
+    if (!driven)
+    {
+      for (Eigen::Index i = 0; i < hull.points.rows(); ++i)
+      {
+        if (piece[i] == c)
+        {
+          anchored.push_back(i);
+        }
+      }
+    }
+  }
+  return anchored;
+}
+
 /// Builds the least-squares system and the mapping of one muscle.
 void SetUp(MuscleState& s, const DeformationParameters& parameters)
 {
@@ -192,66 +254,13 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
   Points restSamples;
   Points& currentSamples = s.currentSamples;
   SampleMatchedLines(m.lines, parameters.samplesPerSegment, restSamples, currentSamples);
-  const TriangleTree hullTree(hull);
-  Eigen::Index first = 0; // each line's samples follow the previous line's
-  for (size_t l = 0; l < m.lines.size(); ++l)
-  {
-    const Eigen::Index count = (m.lines[l].rest.rows() - 1) * std::max(1, parameters.samplesPerSegment) + 1;
-    const bool passes = CountInsideTree(hullTree, restSamples.middleRows(first, count)) > 0;
-    first += count;
-    if (!passes)
-    {
-      throw InputError("action line " + std::to_string(l + 1) + " of muscle '" + m.name +
-        "' does not pass through the muscle (none of its rest-pose samples is inside the muscle's hull): "
-        "are the action lines in the rest pose, in the same units, paired with the right muscle?");
-    }
-  }
+  CheckLinesPassThrough(m, restSamples, parameters.samplesPerSegment);
   const WeightMatrix sampleWeights = coordinates.Compute(restSamples);
-
-  // A piece of the hull that no action line passes through (a scan can leave
-  // one, e.g. cut apart at a pinch) has nothing to place it: its points follow
-  // their nearest action-line segment, as soft rows.
-  int pieces = 0;
-  const std::vector<int> piece = Components(hull.triangles, hull.points.rows(), pieces);
-  std::vector<Eigen::Index> anchored;
-  if (pieces > 1)
+  const std::vector<Eigen::Index> anchored = HullPointsNoLineDrives(hull, restSamples);
+  if (!anchored.empty())
   {
-    for (int c = 0; c < pieces; ++c)
-    {
-      std::vector<Eigen::Index> faces;
-      for (Eigen::Index t = 0; t < hull.triangles.rows(); ++t)
-      {
-        if (piece[hull.triangles(t, 0)] == c)
-        {
-          faces.push_back(t);
-        }
-      }
-      Triangles pieceTriangles(static_cast<Eigen::Index>(faces.size()), 3);
-      for (size_t f = 0; f < faces.size(); ++f)
-      {
-        pieceTriangles.row(static_cast<Eigen::Index>(f)) = hull.triangles.row(faces[f]);
-      }
-      bool driven = false;
-      for (Eigen::Index r = 0; r < restSamples.rows() && !driven; ++r)
-      {
-        driven = WindingNumber(hull.points, pieceTriangles, restSamples.row(r).transpose()) > 0.5;
-      }
-      if (!driven)
-      {
-        for (Eigen::Index i = 0; i < hull.points.rows(); ++i)
-        {
-          if (piece[i] == c)
-          {
-            anchored.push_back(i);
-          }
-        }
-      }
-    }
-    if (!anchored.empty())
-    {
-      s.result.warnings.push_back(PartApartWarning(m.name, static_cast<std::int64_t>(anchored.size()),
-        static_cast<std::int64_t>(hull.points.rows()), "its coarse hull"));
-    }
+    s.result.warnings.push_back(PartApartWarning(m.name, static_cast<std::int64_t>(anchored.size()),
+      static_cast<std::int64_t>(hull.points.rows()), "its coarse hull"));
   }
 
   const SparseMatrix laplacian = CotangentLaplacian(hull);
