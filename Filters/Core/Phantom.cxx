@@ -243,72 +243,69 @@ TriangleMesh BuildTube(const TubeSpecification& spec)
   return mesh;
 }
 
-Phantom BuildPhantom(const PhantomParameters& parameters)
+namespace
 {
-  if (!(parameters.scale > 0) || parameters.resolution < 6 || !std::isfinite(parameters.flexionDegrees))
-  {
-    throw InputError("the phantom needs a positive scale, a finite flexion angle and a resolution of "
-                     "at least 6");
-  }
-  const double k = parameters.scale;
-  const int resolution = parameters.resolution;
-  const double spacing = 1.0 * k; // centreline sampling, mm
-  Phantom phantom;
-  phantom.hipCentre = Vec3::Zero();
-  const double flexion = parameters.flexionDegrees * M_PI / 180.0;
-  phantom.femurMotion = RigidTransform::AboutPoint(Vec3::UnitX(), flexion, phantom.hipCentre);
+/// The pelvis: a flat curved plate from the ischium over the hip to the iliac crest (`k` the
+/// scale; tubes of `resolution` points round, sampled every `spacing` along).
+PhantomBone Pelvis(double k, int resolution, double spacing)
+{
+  TubeSpecification pelvis;
+  pelvis.centreline =
+    RoundedPolyline(k * Rows({ { -20, -18, -85 }, { -42, 0, 5 }, { -46, -6, 100 }, { -36, 0, 175 } }), 40 * k, spacing);
+  pelvis.radii = [k](double x, double length) {
+    const double cap = CapFactor(x, length, 12 * k);
+    const double width = 20 * k + 14 * k * SmoothStep(0.3 * length, 0.7 * length, x);
+    return Eigen::Vector2d(11 * k * cap, width * cap);
+  };
+  pelvis.normalHint = Vec3::UnitX();
+  pelvis.resolution = resolution;
+  PhantomBone bone{ "Pelvis", BuildTube(pelvis), {} };
+  bone.currentPoints = bone.rest.points;
+  return bone;
+}
 
-  // Pelvis: a flat curved plate from the ischium over the hip to the iliac crest.
-  {
-    TubeSpecification pelvis;
-    pelvis.centreline = RoundedPolyline(
-      k * Rows({ { -20, -18, -85 }, { -42, 0, 5 }, { -46, -6, 100 }, { -36, 0, 175 } }), 40 * k, spacing);
-    pelvis.radii = [k](double x, double length) {
-      const double cap = CapFactor(x, length, 12 * k);
-      const double width = 20 * k + 14 * k * SmoothStep(0.3 * length, 0.7 * length, x);
-      return Eigen::Vector2d(11 * k * cap, width * cap);
-    };
-    pelvis.normalHint = Vec3::UnitX();
-    pelvis.resolution = resolution;
-    PhantomBone bone{ "Pelvis", BuildTube(pelvis), {} };
-    bone.currentPoints = bone.rest.points;
-    phantom.bones.push_back(std::move(bone));
-  }
-  // Femur: head (sphere about the hip centre), neck, shaft, condyles.
-  {
-    const double headRadius = 22 * k;
-    const Vec3 neckCorner = k * Vec3(50, 0, -45);
-    const Vec3 headPole = phantom.hipCentre - headRadius * (neckCorner - phantom.hipCentre).normalized();
-    TubeSpecification femur;
-    femur.centreline = RoundedPolyline(Rows({ headPole, neckCorner, k * Vec3(58, 0, -400) }), 30 * k, spacing);
-    femur.radii = [k, headRadius](double x, double length) {
-      const double neck = 13 * k, shaft = 14 * k, condyle = 26 * k;
-      const double fromHeadCentre = x - headRadius;
-      double r;
-      if (fromHeadCentre < 0)
+/// The femur: head (a sphere about `hipCentre`), neck, shaft, condyles; in the current pose
+/// moved by `motion`.
+PhantomBone Femur(double k, int resolution, double spacing, const Vec3& hipCentre, const RigidTransform& motion)
+{
+  const double headRadius = 22 * k;
+  const Vec3 neckCorner = k * Vec3(50, 0, -45);
+  const Vec3 headPole = hipCentre - headRadius * (neckCorner - hipCentre).normalized();
+  TubeSpecification femur;
+  femur.centreline = RoundedPolyline(Rows({ headPole, neckCorner, k * Vec3(58, 0, -400) }), 30 * k, spacing);
+  femur.radii = [k, headRadius](double x, double length) {
+    const double neck = 13 * k, shaft = 14 * k, condyle = 26 * k;
+    const double fromHeadCentre = x - headRadius;
+    double r;
+    if (fromHeadCentre < 0)
+    {
+      r = std::sqrt(std::max(0.0, headRadius * headRadius - fromHeadCentre * fromHeadCentre));
+    }
+    else
+    {
+      const double sphere = std::sqrt(std::max(0.0, headRadius * headRadius - fromHeadCentre * fromHeadCentre));
+      const double body = neck + (shaft - neck) * SmoothStep(60 * k, 120 * k, x) +
+        (condyle - shaft) * SmoothStep(length - 90 * k, length - condyle, x);
+      r = std::max(sphere, body * CapFactor(x, length, condyle));
+      if (x > length - condyle)
       {
-        r = std::sqrt(std::max(0.0, headRadius * headRadius - fromHeadCentre * fromHeadCentre));
+        r = condyle * CapFactor(x, length, condyle);
       }
-      else
-      {
-        const double sphere = std::sqrt(std::max(0.0, headRadius * headRadius - fromHeadCentre * fromHeadCentre));
-        const double body = neck + (shaft - neck) * SmoothStep(60 * k, 120 * k, x) +
-          (condyle - shaft) * SmoothStep(length - 90 * k, length - condyle, x);
-        r = std::max(sphere, body * CapFactor(x, length, condyle));
-        if (x > length - condyle)
-        {
-          r = condyle * CapFactor(x, length, condyle);
-        }
-      }
-      return Eigen::Vector2d(r, r);
-    };
-    femur.normalHint = Vec3::UnitY();
-    femur.resolution = resolution;
-    PhantomBone bone{ "Femur", BuildTube(femur), {} };
-    bone.currentPoints = phantom.femurMotion.Apply(bone.rest.points);
-    phantom.bones.push_back(std::move(bone));
-  }
+    }
+    return Eigen::Vector2d(r, r);
+  };
+  femur.normalHint = Vec3::UnitY();
+  femur.resolution = resolution;
+  PhantomBone bone{ "Femur", BuildTube(femur), {} };
+  bone.currentPoints = motion.Apply(bone.rest.points);
+  return bone;
+}
 
+/// The three muscles with their action lines in both poses: the iliopsoas, the gluteus maximus
+/// (two bundles) and the rectus femoris; the points of a line fixed to the femur moved by
+/// `phantom`'s femur motion.
+void AddMuscles(Phantom& phantom, double k, int resolution, double spacing, double flexionDegrees)
+{
   const RigidTransform& femurMotion = phantom.femurMotion;
   auto muscleTube = [&](const Points& path, double width, double thickness, const Vec3& widthDirection) {
     TubeSpecification tube;
@@ -333,7 +330,6 @@ Phantom BuildPhantom(const PhantomParameters& parameters)
     }
     return current;
   };
-
   // Iliopsoas: iliac fossa, over the anterior rim of the hip (a conditional via
   // point, active below 40 degrees of flexion), to the lesser trochanter.
   {
@@ -344,7 +340,7 @@ Phantom BuildPhantom(const PhantomParameters& parameters)
     muscle.actionLineNames = { "iliopsoas" };
     muscle.actionLinesRest = { path };
     Points current = currentPath(path, { false, false, true });
-    if (parameters.flexionDegrees >= 40)
+    if (flexionDegrees >= 40)
     {
       current = Rows({ Vec3(current.row(0).transpose()), Vec3(current.row(2).transpose()) });
     }
@@ -387,6 +383,26 @@ Phantom BuildPhantom(const PhantomParameters& parameters)
     muscle.actionLinesCurrent = { currentPath(path, { false, false, true }) };
     phantom.muscles.push_back(std::move(muscle));
   }
+}
+}
+
+Phantom BuildPhantom(const PhantomParameters& parameters)
+{
+  if (!(parameters.scale > 0) || parameters.resolution < 6 || !std::isfinite(parameters.flexionDegrees))
+  {
+    throw InputError("the phantom needs a positive scale, a finite flexion angle and a resolution of "
+                     "at least 6");
+  }
+  const double k = parameters.scale;
+  const int resolution = parameters.resolution;
+  const double spacing = 1.0 * k; // centreline sampling, mm
+  Phantom phantom;
+  phantom.hipCentre = Vec3::Zero();
+  const double flexion = parameters.flexionDegrees * M_PI / 180.0;
+  phantom.femurMotion = RigidTransform::AboutPoint(Vec3::UnitX(), flexion, phantom.hipCentre);
+  phantom.bones.push_back(Pelvis(k, resolution, spacing));
+  phantom.bones.push_back(Femur(k, resolution, spacing, phantom.hipCentre, phantom.femurMotion));
+  AddMuscles(phantom, k, resolution, spacing, parameters.flexionDegrees);
   return phantom;
 }
 }
