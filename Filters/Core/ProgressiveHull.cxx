@@ -685,10 +685,10 @@ private:
   }
 
   // --- the collapse itself, after every check
-  bool Collapse(int a, int b, const Vec3& position, double cost)
+  /// Link condition: a and b share exactly the two neighbours across their edge (its two
+  /// triangles in `shared`), and neither of those would be left with two triangles.
+  bool LinkConditionHolds(int a, int b, std::vector<int>& shared) const
   {
-    // Link condition: a and b share exactly the two neighbours across their edge.
-    std::vector<int> shared;
     for (int f : this->VF[a])
     {
       const Face& face = this->F[f];
@@ -715,57 +715,15 @@ private:
         return false; // w would be left with two triangles
       }
     }
+    return true;
+  }
 
-    // The new triangles: every triangle of a or b but the two on the edge,
-    // with a and b replaced by the new point.
-    std::vector<int> changed;
-    std::vector<Face> created;
-    for (int v : { a, b })
-    {
-      for (int f : this->VF[v])
-      {
-        if (std::find(shared.begin(), shared.end(), f) != shared.end() ||
-          std::find(changed.begin(), changed.end(), f) != changed.end())
-        {
-          continue;
-        }
-        Face face = this->F[f];
-        std::replace(face.begin(), face.end(), b, a);
-        changed.push_back(f);
-        created.push_back(face);
-      }
-    }
-    const Vec3 saved = this->P[a];
-    this->P[a] = position;
-    std::vector<char> inheritsCrossing(created.size(), 0);
-    if (!this->NewFacesAcceptable(changed, created, shared, a, saved, inheritsCrossing))
-    {
-      this->P[a] = saved;
-      return false;
-    }
-    // Commit.
-    for (int f : shared)
-    {
-      this->KillFace(f);
-    }
-    for (int f : changed)
-    {
-      this->KillFace(f);
-    }
-    this->VertexAlive[b] = 0;
-    this->VF[b].clear();
-    --this->LiveVertices;
-    for (size_t i = 0; i < created.size(); ++i)
-    {
-      const int id = this->AddFace(created[i]);
-      this->Folded[id] = inheritsCrossing[i];
-    }
-    this->MaintainGrid();
-
-    // Every edge whose neighbourhood changed needs a new cost: the edges of a
-    // now (pushed in a fixed order); the other edges of its
-    // neighbours lazily, as placeholders at their last cost (or this one's)
-    // that are costed when they come to the top, perhaps after more changes.
+  /// Every edge whose neighbourhood changed when `a` took its new place needs a new cost: the
+  /// edges of a now (pushed in a fixed order); the other edges of its neighbours lazily, as
+  /// placeholders at their last cost (or `cost`, this collapse's) that are costed when they come
+  /// to the top, perhaps after more changes.
+  void RequeueAround(int a, double cost)
+  {
     std::vector<int> ring = this->Neighbours(a);
     ring.push_back(a);
     std::sort(ring.begin(), ring.end());
@@ -814,6 +772,62 @@ private:
         this->Heap.push(placeholder);
       }
     }
+  }
+
+  bool Collapse(int a, int b, const Vec3& position, double cost)
+  {
+    std::vector<int> shared;
+    if (!this->LinkConditionHolds(a, b, shared))
+    {
+      return false;
+    }
+
+    // The new triangles: every triangle of a or b but the two on the edge,
+    // with a and b replaced by the new point.
+    std::vector<int> changed;
+    std::vector<Face> created;
+    for (int v : { a, b })
+    {
+      for (int f : this->VF[v])
+      {
+        if (std::find(shared.begin(), shared.end(), f) != shared.end() ||
+          std::find(changed.begin(), changed.end(), f) != changed.end())
+        {
+          continue;
+        }
+        Face face = this->F[f];
+        std::replace(face.begin(), face.end(), b, a);
+        changed.push_back(f);
+        created.push_back(face);
+      }
+    }
+    const Vec3 saved = this->P[a];
+    this->P[a] = position;
+    std::vector<char> inheritsCrossing(created.size(), 0);
+    if (!this->NewFacesAcceptable(changed, created, shared, a, saved, inheritsCrossing))
+    {
+      this->P[a] = saved;
+      return false;
+    }
+    // Commit.
+    for (int f : shared)
+    {
+      this->KillFace(f);
+    }
+    for (int f : changed)
+    {
+      this->KillFace(f);
+    }
+    this->VertexAlive[b] = 0;
+    this->VF[b].clear();
+    --this->LiveVertices;
+    for (size_t i = 0; i < created.size(); ++i)
+    {
+      const int id = this->AddFace(created[i]);
+      this->Folded[id] = inheritsCrossing[i];
+    }
+    this->MaintainGrid();
+    this->RequeueAround(a, cost);
     return true;
   }
 
