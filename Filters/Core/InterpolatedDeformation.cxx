@@ -484,12 +484,7 @@ SurfaceSteps StartOnSurface(const std::vector<MuscleMotion>& muscles, const Meth
     }
   }
   s.settleMotion = StartMotion(current, s.energyPointers, s.restLines, fixed);
-  std::vector<std::vector<MatchedLine>> still;
-  for (const std::vector<Points>& lines : s.restLines)
-  {
-    still.push_back(StillLines(lines));
-  }
-  s.linesInBonesAtRest = LineSamplesInBones(still, fixed, parameters.settle.samplesPerSegment);
+  s.linesInBonesAtRest = RestLineSamplesInBones(s.restLines, fixed, parameters.settle.samplesPerSegment);
   return s;
 }
 

@@ -242,12 +242,7 @@ MotionDeformation::MotionDeformation(const std::vector<Muscle>& muscles, const s
   in.sharpEdges = MuscleSharpEdges(in.muscles);
   state->settle = StartMotion(state->current, in.energyPointers, in.restLines, in.fixed);
   state->settle.carryContacts = true; // a frame's contacts are the last frame's, moved on
-  std::vector<std::vector<MatchedLine>> still;
-  for (const std::vector<Points>& lines : in.restLines)
-  {
-    still.push_back(StillLines(lines));
-  }
-  in.linesInBonesAtRest = LineSamplesInBones(still, in.fixed, in.parameters.settle.samplesPerSegment);
+  in.linesInBonesAtRest = RestLineSamplesInBones(in.restLines, in.fixed, in.parameters.settle.samplesPerSegment);
   state->previous.resize(in.muscles.size());
   for (const TriangleMesh& b : restBones)
   {

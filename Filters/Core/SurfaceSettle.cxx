@@ -1214,6 +1214,17 @@ LineSamplesInside LineSamplesInBones(
   return inside;
 }
 
+LineSamplesInside RestLineSamplesInBones(
+  const std::vector<std::vector<Points>>& restLines, const std::vector<FixedObstacle>& bones, int samplesPerSegment)
+{
+  std::vector<std::vector<MatchedLine>> still;
+  for (const std::vector<Points>& lines : restLines)
+  {
+    still.push_back(StillLines(lines));
+  }
+  return LineSamplesInBones(still, bones, samplesPerSegment);
+}
+
 std::vector<std::string> LinesThroughBones(const std::vector<std::string>& names,
   const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones,
   const LineSamplesInside* atRest, int samplesPerSegment)
@@ -1428,16 +1439,23 @@ LetGoRows LetGoRowsOf(const std::vector<const SurfaceEnergy*>& energies,
   return letGo;
 }
 
-/// One iteration's linearisation: per muscle the minimum without contact and volume (`free`),
-/// the volume's gradient g and its direction K^-1 g (`along`), and the volume's row's right-hand
-/// side; the samples let go; the muscles, costliest solve first.
+/// The volumes linearised at the current points: per muscle V(x), its gradient g, the
+/// direction K^-1 g and the right-hand side of g . x_new = V - V(x) + g . x.
+struct VolumeRows
+{
+  std::vector<double> now;
+  std::vector<Points> gradients;
+  std::vector<Points> along;
+  std::vector<double> right;
+};
+
+/// One iteration's linearisation: per muscle the minimum without contact and volume (`free`)
+/// and the volume's rows; the samples let go; the muscles, costliest solve first.
 struct Linearised
 {
   const std::vector<const SurfaceEnergy*>& energies;
   const std::vector<Points>& free;
-  const std::vector<Points>& gradients;
-  const std::vector<Points>& along;
-  const std::vector<double>& volumeRight;
+  const VolumeRows& volumes;
   const LetGoRows& letGo;
   const std::vector<int>& costliestFirst;
 };
@@ -1462,7 +1480,7 @@ Eigen::MatrixXd DualSystem(const Linearised& in, std::vector<Contact>& contacts,
   rhs.resize(size);
   for (size_t m = 0; m < count; ++m)
   {
-    rhs(volumeStart + static_cast<Eigen::Index>(m)) = in.volumeRight[m];
+    rhs(volumeStart + static_cast<Eigen::Index>(m)) = in.volumes.right[m];
   }
   SurfaceEnergy::PrepareAll(in.energies, needed);
   for (Contact& c : contacts)
@@ -1481,7 +1499,7 @@ Eigen::MatrixXd DualSystem(const Linearised& in, std::vector<Contact>& contacts,
     {
       value += t.coefficient * a.normal.dot(Where(t, in.free[t.muscle]));
       system(j, volumeStart + static_cast<Eigen::Index>(t.muscle)) +=
-        t.coefficient * a.normal.dot(Where(t, in.along[t.muscle]));
+        t.coefficient * a.normal.dot(Where(t, in.volumes.along[t.muscle]));
     }
     rhs(j) = a.target - value;
     for (Eigen::Index l = 0; l <= j; ++l)
@@ -1506,7 +1524,7 @@ Eigen::MatrixXd DualSystem(const Linearised& in, std::vector<Contact>& contacts,
   {
     const Eigen::Index v = volumeStart + static_cast<Eigen::Index>(m);
     system.row(v).head(volumeStart) = system.col(v).head(volumeStart).transpose();
-    system(v, v) = (in.gradients[m].array() * in.along[m].array()).sum();
+    system(v, v) = (in.volumes.gradients[m].array() * in.volumes.along[m].array()).sum();
   }
   return system;
 }
@@ -1523,7 +1541,7 @@ struct Push
 /// The new points x = free + mu K^-1 g + the pushes, over blocks of points (of every muscle, in
 /// one parallel loop): a block's rows stay in the first-level cache while every push goes over
 /// them, where a push at a time over all the points went to the second level. Each point takes
-/// the pushes in the rows' order: the same sums as PointAt's.
+/// the pushes in the rows' order: the same sums as StepUnderContacts' pointAt.
 std::vector<Points> ApplyPushes(
   const Linearised& in, const Eigen::VectorXd& volumeMultipliers, const std::vector<std::vector<Push>>& pushes)
 {
@@ -1548,7 +1566,7 @@ std::vector<Points> ApplyPushes(
     const double volume = volumeMultipliers(static_cast<Eigen::Index>(m));
     for (Eigen::Index i = first; i < end; ++i)
     {
-      x.row(i) = in.free[m].row(i) + volume * in.along[m].row(i);
+      x.row(i) = in.free[m].row(i) + volume * in.volumes.along[m].row(i);
     }
     for (const Push& push : pushes[m])
     {
@@ -1643,7 +1661,8 @@ Step StepUnderContacts(const Linearised& in, std::vector<Contact> primary, std::
     }
     // Where the step takes point i of muscle m: ApplyPushes at one point, the same sums.
     auto pointAt = [&](size_t m, Eigen::Index i) {
-      Eigen::RowVector3d x = in.free[m].row(i) + volumeMultipliers(static_cast<Eigen::Index>(m)) * in.along[m].row(i);
+      Eigen::RowVector3d x =
+        in.free[m].row(i) + volumeMultipliers(static_cast<Eigen::Index>(m)) * in.volumes.along[m].row(i);
       for (const Push& push : pushes[m])
       {
         x += (push.size * (*push.column)(i)) * push.normal.transpose();
@@ -1791,16 +1810,6 @@ SettleState StartSettle(std::vector<TriangleMesh>& muscles, const std::vector<co
   return s;
 }
 
-/// The volumes linearised at the current points: per muscle V(x), its gradient g, the
-/// direction K^-1 g and the right-hand side of g . x_new = V - V(x) + g . x.
-struct VolumeRows
-{
-  std::vector<double> now;
-  std::vector<Points> gradients;
-  std::vector<Points> along;
-  std::vector<double> right;
-};
-
 /// One iteration's linearisation at the points `s` holds (their trees refitted there): the
 /// contacts (every point inside an obstacle or nearer than the offset, and those held before;
 /// returned, the watched ones in `pending`) and the volumes, independent of each other, in one
@@ -1889,8 +1898,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     std::vector<Contact> pending;
     std::vector<Contact> primary = LineariseAt(s, energies, bones, restOverlap, parameters,
       motion && motion->carryContacts, free, costliestFirst, volumeRows, pending);
-    const Linearised linearised{ energies, free, volumeRows.gradients, volumeRows.along, volumeRows.right, letGo,
-      costliestFirst };
+    const Linearised linearised{ energies, free, volumeRows, letGo, costliestFirst };
     Step step =
       StepUnderContacts(linearised, std::move(primary), std::move(pending), s.held, s.meshes, bones.size(), parameters);
     std::vector<Points>& next = step.points;

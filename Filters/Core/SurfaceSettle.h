@@ -260,6 +260,10 @@ using LineSamplesInside = std::vector<std::vector<std::vector<std::vector<char>>
 /// LineSamplesInside of `lines[m]` (every muscle's matched lines) with `bones` in that pose.
 LineSamplesInside LineSamplesInBones(
   const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones, int samplesPerSegment);
+/// LineSamplesInBones of the rest pose: every muscle's lines `restLines[m]` (StillLines) with
+/// `bones` at rest, the scans' own overlap, which LinesThroughBones is not to warn of.
+LineSamplesInside RestLineSamplesInBones(
+  const std::vector<std::vector<Points>>& restLines, const std::vector<FixedObstacle>& bones, int samplesPerSegment);
 
 /// What to say of every muscle (`names[m]`) one of whose action lines (`lines[m]`, their current
 /// pose the bones') crosses a bone it did not cross at rest (`atRest`, LineSamplesInBones' of the
