@@ -1059,8 +1059,9 @@ TEST(SurfaceSettle, OnTheHipOneLargeStepIsSettledInPartsAsReproducibly)
   // perturbed inputs swung to the end of their iterations, up to 5.6 mm apart. In parts that
   // move it by an eighth at most, every muscle settles (SettledHip's checks) and 1e-7 noise
   // moves the answer by 0.0003 mm (measured), as in four steps. Flexion 60 degrees in one step
-  // likewise (0.0004 / 0.0005 mm): the single step that MuscleDeformation's one pass on the
-  // surface cannot make reproducibly (up to 1.4 mm there), as it is not given the bones' rest pose.
+  // likewise (0.0004 / 0.0005 mm): the README's reproducible single step, where MuscleDeformation's
+  // one pass on the surface moves by up to 1.4 mm. (These two seeds at flexion 60 also pass settled
+  // in one part; it is adduction -40 that fails without the parts.)
   for (const auto& [motion, frame] : { std::pair<const char*, int>{ "hip_adduction", 0 }, { "hip_flexion", 35 } })
   {
     MotionCase exact;
