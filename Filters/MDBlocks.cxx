@@ -1,13 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "MDBlocks.h"
 
-#include "InterpolatedDeformation.h"
+#include "Method/InterpolatedDeformation.h"
 
 #include <vtkStreamingDemandDrivenPipeline.h>
 
 #include <vtkAOSDataArrayTemplate.h>
 #include <vtkAbstractArray.h>
 #include <vtkAlgorithm.h>
+#include <vtkAlgorithmOutput.h>
 #include <vtkCellArray.h>
 #include <vtkCellArrayIterator.h>
 #include <vtkCellData.h>
@@ -29,6 +30,8 @@
 #include <vtkTriangleFilter.h>
 #include <vtkUnsignedCharArray.h>
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <optional>
 #include <set>
@@ -344,6 +347,12 @@ std::function<void(double)> ProgressOrCancel(vtkAlgorithm* filter, double offset
   };
 }
 
+bool ProgressOrStop(vtkAlgorithm* filter, double fraction)
+{
+  filter->UpdateProgress(fraction);
+  return filter->CheckAbort() != 0;
+}
+
 bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::function<void()>& work, int& result,
   std::string* reported)
 {
@@ -382,6 +391,168 @@ bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::funct
     *reported = message;
   }
   return false;
+}
+
+std::string NameOf(const Leaf& leaf)
+{
+  return leaf.name.empty() ? leaf.label : leaf.name;
+}
+
+bool ReadMuscleSurface(const Leaf& leaf, TriangleMesh& surface, std::string& error)
+{
+  ReadTriangles(leaf.data, surface);
+  if (surface.triangles.rows() == 0)
+  {
+    error = leaf.label + " has no surface (no polygons); a muscle must be a closed triangle surface";
+    return false;
+  }
+  return true;
+}
+
+void FailBlock(vtkObject* filter, std::map<size_t, std::string>& failedBlocks, size_t block, const std::string& message,
+  bool reported)
+{
+  if (!reported)
+  {
+    vtkErrorWithObjectMacro(filter, << message);
+  }
+  failedBlocks[block] = message;
+}
+
+vtkSmartPointer<vtkPolyData> MovedCopy(vtkPolyData* input, const Points& points)
+{
+  auto output = vtkSmartPointer<vtkPolyData>::New();
+  output->ShallowCopy(input);
+  vtkNew<vtkFieldData> fieldData;
+  fieldData->DeepCopy(input->GetFieldData());
+  output->SetFieldData(fieldData);
+  output->SetPoints(ToVtkPoints(points));
+  return output;
+}
+
+vtkSmartPointer<vtkPolyData> MovedMuscle(vtkPolyData* input, const Points& points, const Points& displacement)
+{
+  vtkSmartPointer<vtkPolyData> output = MovedCopy(input, points);
+  output->GetPointData()->AddArray(ToVtkArray(DisplacementArrayName, displacement));
+  return output;
+}
+
+void AddMeasures(vtkFieldData* fieldData, const std::vector<Measure>& measures)
+{
+  for (const Measure& measure : measures)
+  {
+    if (measure.count)
+    {
+      AddFieldValue(fieldData, measure.name, static_cast<int>(measure.value));
+    }
+    else
+    {
+      AddFieldValue(fieldData, measure.name, measure.value);
+    }
+  }
+}
+
+std::vector<Measure> StepMeasures(const md::MuscleStepMeasures& s, int iterations, bool stepShift)
+{
+  auto count = [](std::int64_t value) {
+    return static_cast<double>(value);
+  };
+  std::vector<Measure> measures = {
+    { VolumeChangeArrayName, s.volumeChangePercent },
+    { array::NewPenetrationCount, count(s.newPenetrationCount), true },
+    { array::MaxNewPenetrationDepth, s.maxNewPenetrationDepth },
+    { array::NewBonePenetrationCount, count(s.newBonePenetrationCount), true },
+    { array::MaxNewBonePenetrationDepth, s.maxNewBonePenetrationDepth },
+    { array::MaxStaticShift, s.maxStaticShift },
+  };
+  if (stepShift)
+  {
+    measures.push_back({ array::StepStaticShift, s.stepStaticShift });
+  }
+  measures.push_back({ array::SharpEdgeCount, count(s.sharpEdgeCount), true });
+  measures.push_back({ array::FlippedTriangleCount, count(s.flippedTriangleCount), true });
+  measures.push_back({ array::NumberOfIterations, count(iterations), true });
+  measures.push_back({ array::Converged, s.converged ? 1.0 : 0.0, true });
+  return measures;
+}
+
+std::vector<double> StepTimes(int steps)
+{
+  std::vector<double> times(static_cast<size_t>(steps) + 1);
+  for (int j = 0; j <= steps; ++j)
+  {
+    times[j] = j;
+  }
+  return times;
+}
+
+void AdvertiseTimes(vtkInformationVector* outputVector, const std::vector<double>& times)
+{
+  using SDDP = vtkStreamingDemandDrivenPipeline;
+  for (int port = 0; port < outputVector->GetNumberOfInformationObjects(); ++port)
+  {
+    vtkInformation* info = outputVector->GetInformationObject(port);
+    info->Remove(SDDP::TIME_STEPS());
+    info->Remove(SDDP::TIME_RANGE());
+    if (!times.empty())
+    {
+      info->Set(SDDP::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
+      const double range[2] = { times.front(), times.back() };
+      info->Set(SDDP::TIME_RANGE(), range, 2);
+    }
+  }
+}
+
+int StepAsked(vtkInformation* outInfo, int steps, int fallback)
+{
+  using SDDP = vtkStreamingDemandDrivenPipeline;
+  if (!outInfo->Has(SDDP::UPDATE_TIME_STEP()))
+  {
+    return fallback;
+  }
+  const double time = outInfo->Get(SDDP::UPDATE_TIME_STEP());
+  return static_cast<int>(std::lround(std::clamp(time, 0.0, static_cast<double>(steps))));
+}
+
+void InputsAtTheirOwnTime(vtkInformationVector** inputVector, int ports)
+{
+  for (int port = 0; port < ports; ++port)
+  {
+    for (int i = 0; i < inputVector[port]->GetNumberOfInformationObjects(); ++i)
+    {
+      inputVector[port]->GetInformationObject(i)->Remove(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+    }
+  }
+}
+
+void UpdateInputs(vtkAlgorithm* filter, const std::vector<int>& ports)
+{
+  for (int port : ports)
+  {
+    if (filter->GetNumberOfInputConnections(port) > 0)
+    {
+      filter->GetInputAlgorithm(port, 0)->Update(filter->GetInputConnection(port, 0)->GetIndex());
+    }
+  }
+}
+
+int NearestTime(const std::vector<double>& times, double time)
+{
+  const auto after = std::lower_bound(times.begin(), times.end(), time);
+  size_t k = static_cast<size_t>(after - times.begin());
+  if (k == times.size() || (k > 0 && time - times[k - 1] < times[k] - time))
+  {
+    k = k == 0 ? 0 : k - 1;
+  }
+  return static_cast<int>(k);
+}
+
+void SetDataTime(vtkInformationVector* outputVector, double time)
+{
+  for (int port = 0; port < outputVector->GetNumberOfInformationObjects(); ++port)
+  {
+    vtkDataObject::GetData(outputVector, port)->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), time);
+  }
 }
 
 vtkSmartPointer<vtkPolyData> FailedMuscle(vtkPolyData* input, const std::string& message)

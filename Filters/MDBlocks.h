@@ -4,12 +4,13 @@
 // the Eigen-based core. Not part of the public API.
 #pragma once
 
-#include "MeshTypes.h"
+#include "Common/MeshTypes.h"
 
 #include <vtkSmartPointer.h>
 #include <vtkType.h>
 
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,7 @@ class vtkPolyData;
 namespace md
 {
 struct BoneMotion;
+struct MuscleStepMeasures;
 }
 
 namespace mdvtk
@@ -108,6 +110,32 @@ constexpr const char* StaticShiftArrayName = "StaticShift";         ///< the sta
 constexpr const char* VolumeChangeArrayName = "VolumeChangePercent";
 constexpr const char* FailedArrayName = "DeformationFailed"; ///< field data of a muscle not processed
 constexpr const char* FailureMessageArrayName = "FailureMessage";
+/// The measures the filters write as field data and table columns (docs/DESIGN.md, "Measures").
+namespace array
+{
+constexpr const char* NewPenetrationCount = "NewPenetrationCount";
+constexpr const char* MaxNewPenetrationDepth = "MaxNewPenetrationDepth";
+constexpr const char* NewBonePenetrationCount = "NewBonePenetrationCount";
+constexpr const char* MaxNewBonePenetrationDepth = "MaxNewBonePenetrationDepth";
+constexpr const char* MaxStaticShift = "MaxStaticShift";
+constexpr const char* StepStaticShift = "StepStaticShift";
+constexpr const char* SharpEdgeCount = "SharpEdgeCount";
+constexpr const char* FlippedTriangleCount = "FlippedTriangleCount";
+constexpr const char* NumberOfIterations = "NumberOfIterations";
+constexpr const char* Converged = "Converged";
+constexpr const char* PointsFrozenInObstacles = "PointsFrozenInObstacles";
+constexpr const char* InterpolationStep = "InterpolationStep";
+constexpr const char* NumberOfSteps = "NumberOfSteps";
+constexpr const char* HullSeconds = "HullSeconds";
+constexpr const char* StepSeconds = "StepSeconds";
+constexpr const char* ElapsedSeconds = "ElapsedSeconds";
+constexpr const char* SecondDifference = "SecondDifference";
+constexpr const char* SmoothnessRatio = "SmoothnessRatio";
+constexpr const char* FrameSeconds = "FrameSeconds";
+constexpr const char* Frame = "Frame";
+constexpr const char* Time = "Time";
+constexpr const char* ActionLineName = "ActionLineName";
+}
 
 /// Writes `role` as the cell array Role of every polydata leaf of `data` (in leaf order: muscle
 /// k gets shade k modulo MuscleShades), the active cell scalars unless the leaf has other active
@@ -144,6 +172,9 @@ void CopyTimeSteps(vtkInformation* from, vtkInformation* to);
 /// progress and throws md::Cancelled when the user has asked the filter to stop (ParaView's
 /// abort). Call only from the filter's own thread.
 std::function<void(double)> ProgressOrCancel(vtkAlgorithm* filter, double offset = 0.0, double share = 1.0);
+/// Reports `fraction` as the filter's progress; true when the user has asked it to stop (the
+/// executive then empties the outputs, and RequestData returns 1).
+bool ProgressOrStop(vtkAlgorithm* filter, double fraction);
 /// Runs `work` (calls into the core) and turns the core's exceptions into what a filter reports:
 /// md::InputError becomes an error (`context` + its message) and RequestData's result 0;
 /// md::Cancelled (the user stopped the run) notes the abort, so that the executive empties the
@@ -152,6 +183,56 @@ std::function<void(double)> ProgressOrCancel(vtkAlgorithm* filter, double offset
 /// user stopped the run), for a filter that goes on with its other muscles.
 bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::function<void()>& work, int& result,
   std::string* reported = nullptr);
+
+/// How messages and tables name a leaf: its block name, else its label.
+std::string NameOf(const Leaf& leaf);
+
+/// The surface of muscle `leaf` (ReadTriangles); false, with `error` naming the leaf, when it has
+/// no triangles.
+bool ReadMuscleSurface(const Leaf& leaf, TriangleMesh& surface, std::string& error);
+
+/// Reports `message` as an error of `filter` (unless `reported`) and records it as the failure of
+/// muscle block `block`: one muscle's fault leaves that muscle out, the others go on.
+void FailBlock(vtkObject* filter, std::map<size_t, std::string>& failedBlocks, size_t block, const std::string& message,
+  bool reported = false);
+
+/// A copy of `input` at `points`: its cells and arrays shared, its field data its own (for the
+/// measures a filter adds).
+vtkSmartPointer<vtkPolyData> MovedCopy(vtkPolyData* input, const Points& points);
+/// MovedCopy of a muscle, with point array Displacement (`displacement`, a row per point).
+vtkSmartPointer<vtkPolyData> MovedMuscle(vtkPolyData* input, const Points& points, const Points& displacement);
+
+/// One measure of a muscle, as the filters write it: to the muscle's field data (an int array for
+/// a count, a double array otherwise) and to a column of their measures table.
+struct Measure
+{
+  const char* name;
+  double value;
+  bool count = false;
+};
+/// Adds each of `measures` to `fieldData` (AddFieldValue).
+void AddMeasures(vtkFieldData* fieldData, const std::vector<Measure>& measures);
+/// What a muscle's step of the method, or frame of a motion, measured, in the order the filters
+/// write it: `iterations` is the count to report, `stepShift` adds StepStaticShift.
+std::vector<Measure> StepMeasures(const md::MuscleStepMeasures& s, int iterations, bool stepShift);
+
+/// The time steps 0, 1, ..., `steps` of a filter whose time is its interpolation step.
+std::vector<double> StepTimes(int steps);
+/// Advertises `times` (TIME_STEPS and TIME_RANGE) on every output of `outputVector`, or none
+/// when `times` is empty.
+void AdvertiseTimes(vtkInformationVector* outputVector, const std::vector<double>& times);
+/// The interpolation step asked of output `outInfo` (its UPDATE_TIME_STEP rounded into
+/// [0, steps]), or `fallback` when none is asked.
+int StepAsked(vtkInformation* outInfo, int steps, int fallback);
+/// Asks the inputs of ports 0 .. `ports` - 1 for their default time (a filter whose time is its
+/// interpolation step, not one of its inputs').
+void InputsAtTheirOwnTime(vtkInformationVector** inputVector, int ports);
+/// Brings the inputs of `ports` up to date, for RequestInformation to read their data.
+void UpdateInputs(vtkAlgorithm* filter, const std::vector<int>& ports);
+/// Index of the entry of `times` (ascending, not empty) nearest `time`; the earlier one at a tie.
+int NearestTime(const std::vector<double>& times, double time);
+/// Stamps every output of `outputVector` with DATA_TIME_STEP `time`.
+void SetDataTime(vtkInformationVector* outputVector, double time);
 
 /// The output block of a muscle that could not be processed: no geometry (nothing silently
 /// wrong to show), the input block's field data, and DeformationFailed / FailureMessage.

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkActionLineGrouping.h"
 
-#include "Fnv1a.h"
+#include "Common/Fnv1a.h"
 #include "MDBlocks.h"
-#include "OpenSimAttachment.h"
+#include "OpenSim/OpenSimAttachment.h"
 
 #include <vtkAppendPolyData.h>
 #include <vtkCellData.h>
@@ -147,163 +147,193 @@ int vtkActionLineGrouping::RequestUpdateExtent(
   return this->Superclass::RequestUpdateExtent(request, inputVector, outputVector);
 }
 
+/// The inputs as read: the muscles (`meshes`, named `muscleNames`) and the paths at rest
+/// (`lines`, named `pathNames`), and the current pose's paths (`current`, the partner of path p
+/// is current[currentOf[p]]) when connected.
+struct vtkActionLineGrouping::Inputs
+{
+  std::vector<mdvtk::Leaf> muscles, paths, current;
+  std::vector<size_t> currentOf;
+  bool haveCurrent = false;
+  std::vector<md::TriangleMesh> meshes;
+  std::vector<md::Points> lines;
+  std::vector<std::string> muscleNames, pathNames;
+};
+
 int vtkActionLineGrouping::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   this->Decision.clear();
-  std::vector<mdvtk::Leaf> muscles, paths, current;
-  std::string error;
-  const bool haveCurrent = inputVector[2]->GetNumberOfInformationObjects() > 0;
-  if (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[0], 0), "Input", muscles, error, this->Checked[0]) ||
-    !mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[1], 0), "Paths", paths, error, this->Checked[1]) ||
-    (haveCurrent && !mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[2], 0), "PathsCurrent", current, error)))
+  Inputs in;
+  if (!this->ReadInputs(inputVector, in))
   {
-    vtkErrorMacro(<< error);
     return 0;
-  }
-  std::vector<size_t> currentOf;
-  if (haveCurrent && !mdvtk::PairLeaves(this, paths, "Paths", current, "PathsCurrent", currentOf, error))
-  {
-    vtkErrorMacro(<< error);
-    return 0;
-  }
-  std::vector<md::TriangleMesh> meshes(muscles.size());
-  std::vector<std::string> muscleNames, pathNames;
-  for (size_t m = 0; m < muscles.size(); ++m)
-  {
-    if (!muscles[m].data || mdvtk::ReadTriangles(muscles[m].data, meshes[m]) < 0 || meshes[m].triangles.rows() == 0)
-    {
-      vtkErrorMacro(<< muscles[m].label << " has no triangles: the muscles must be closed surfaces");
-      return 0;
-    }
-    muscleNames.push_back(muscles[m].name.empty() ? "muscle " + std::to_string(m) : muscles[m].name);
-  }
-  std::vector<md::Points> lines;
-  for (size_t p = 0; p < paths.size(); ++p)
-  {
-    const std::vector<md::Points> polylines =
-      paths[p].data ? mdvtk::ToPolylines(paths[p].data) : std::vector<md::Points>();
-    if (polylines.size() != 1 || polylines[0].rows() < 2)
-    {
-      vtkErrorMacro(<< paths[p].label << " must hold one polyline of at least 2 points (one path)");
-      return 0;
-    }
-    lines.push_back(polylines[0]);
-    pathNames.push_back(paths[p].name.empty() ? "path " + std::to_string(p) : paths[p].name);
   }
   const std::string assignments = this->PathsOfMuscle ? this->PathsOfMuscle : "";
-  if (this->LastGrouping && this->LastGrouping->DecidedOn(meshes, lines, muscleNames, pathNames, assignments))
+  if (this->LastGrouping &&
+    this->LastGrouping->DecidedOn(in.meshes, in.lines, in.muscleNames, in.pathNames, assignments))
   {
     this->Decision = this->LastGrouping->decision;
   }
   else
   {
     this->LastGrouping.reset();
-    md::osim::PathGrouping decided;
     int result = 1;
-    if (!mdvtk::CallCore(
-          this, "PathsOfMuscle: ",
-          [&] {
-            decided =
-              md::osim::GroupPaths(meshes, muscleNames, lines, pathNames, md::osim::ParseAssignments(assignments));
-          },
-          result))
+    if (!this->Group(in, assignments, result))
     {
       return result;
     }
-    std::ostringstream decision, unassigned;
-    for (size_t p = 0; p < paths.size(); ++p)
-    {
-      if (decided.muscleOfPath[p] < 0)
-      {
-        unassigned << (unassigned.tellp() > 0 ? ", " : "") << pathNames[p];
-        continue;
-      }
-      decision << pathNames[p] << " -> " << muscleNames[decided.muscleOfPath[p]] << " ("
-               << (decided.assignedByUser[p] ? "as given, " : "")
-               << static_cast<int>(100 * decided.insideFraction[p] + 0.5) << " % of its length inside)\n";
-    }
-    for (size_t m = 0; m < muscles.size(); ++m)
-    {
-      if (std::find(decided.muscleOfPath.begin(), decided.muscleOfPath.end(), static_cast<int>(m)) ==
-        decided.muscleOfPath.end())
-      {
-        vtkErrorMacro(<< muscles[m].label << ": no path runs inside this muscle; name its paths in PathsOfMuscle "
-                      << "(e.g. " << muscleNames[m] << "=" << pathNames.front() << ")");
-        return 0;
-      }
-    }
-    this->Decision = decision.str();
-    vtkOutputWindow::GetInstance()->DisplayText(("ActionLineGrouping:\n" + this->Decision).c_str());
-    if (unassigned.tellp() > 0)
-    {
-      vtkWarningMacro(<< "paths that run inside no muscle (less than 5 % of their length) are left out: "
-                      << unassigned.str());
-    }
-    this->LastGrouping.reset(
-      new Grouped{ std::move(meshes), lines, muscleNames, pathNames, assignments, decided, this->Decision });
   }
-  const md::osim::PathGrouping& grouping = this->LastGrouping->grouping;
-  // Its ExecuteAppend only, on paths that are never empty: no pipeline pass per muscle (at every
-  // frame of a motion, a third of this filter's time went on those passes).
-  vtkNew<vtkAppendPolyData> append;
-  auto build = [&](const std::vector<mdvtk::Leaf>& source, bool isCurrent, vtkMultiBlockDataSet* output) {
-    for (size_t m = 0; m < muscles.size(); ++m)
-    {
-      std::vector<vtkSmartPointer<vtkPolyData>> copies;
-      vtkNew<vtkStringArray> names;
-      names->SetName("ActionLinePaths");
-      vtkNew<vtkDoubleArray> shares;
-      shares->SetName("PathInsideFraction");
-      for (size_t p = 0; p < paths.size(); ++p)
-      {
-        if (grouping.muscleOfPath[p] != static_cast<int>(m))
-        {
-          continue;
-        }
-        vtkPolyData* line = source[isCurrent ? currentOf[p] : p].data;
-        auto copy = vtkSmartPointer<vtkPolyData>::New();
-        copy->ShallowCopy(line);
-        copy->GetFieldData()->Initialize();
-        if (!copy->GetCellData()->GetAbstractArray("ActionLineName"))
-        {
-          vtkNew<vtkStringArray> lineName;
-          lineName->SetName("ActionLineName");
-          lineName->InsertNextValue(pathNames[p]);
-          copy->GetCellData()->AddArray(lineName);
-        }
-        copies.push_back(copy);
-        names->InsertNextValue(pathNames[p]);
-        shares->InsertNextValue(grouping.insideFraction[p]);
-      }
-      std::vector<vtkPolyData*> inputs(copies.begin(), copies.end());
-      auto block = vtkSmartPointer<vtkPolyData>::New();
-      append->ExecuteAppend(block, inputs.data(), static_cast<int>(inputs.size()));
-      block->GetFieldData()->AddArray(names);
-      block->GetFieldData()->AddArray(shares);
-      mdvtk::AddBlock(output, muscleNames[m], block);
-    }
-  };
   vtkMultiBlockDataSet* grouped = vtkMultiBlockDataSet::GetData(outputVector, 0);
-  const std::uint64_t digest = PathsDigest(paths);
+  const std::uint64_t digest = PathsDigest(in.paths);
   if (this->LastGrouping->pathsOutput && this->LastGrouping->pathsDigest == digest)
   {
     grouped->ShallowCopy(this->LastGrouping->pathsOutput);
   }
   else
   {
-    build(paths, false, grouped);
+    this->BuildGrouped(in, false, grouped);
     mdvtk::MarkRoles(grouped, mdvtk::Role::ActionLine);
     this->LastGrouping->pathsOutput = vtkSmartPointer<vtkMultiBlockDataSet>::New();
     this->LastGrouping->pathsOutput->ShallowCopy(grouped);
     this->LastGrouping->pathsDigest = digest;
   }
-  if (haveCurrent)
+  if (in.haveCurrent)
   {
-    build(current, true, vtkMultiBlockDataSet::GetData(outputVector, 1));
+    this->BuildGrouped(in, true, vtkMultiBlockDataSet::GetData(outputVector, 1));
     mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, 1), mdvtk::Role::ActionLine);
   }
   return 1;
+}
+
+bool vtkActionLineGrouping::ReadInputs(vtkInformationVector** inputVector, Inputs& in)
+{
+  std::string error;
+  in.haveCurrent = inputVector[2]->GetNumberOfInformationObjects() > 0;
+  if (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[0], 0), "Input", in.muscles, error, this->Checked[0]) ||
+    !mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[1], 0), "Paths", in.paths, error, this->Checked[1]) ||
+    (in.haveCurrent &&
+      (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[2], 0), "PathsCurrent", in.current, error) ||
+        !mdvtk::PairLeaves(this, in.paths, "Paths", in.current, "PathsCurrent", in.currentOf, error))))
+  {
+    vtkErrorMacro(<< error);
+    return false;
+  }
+  in.meshes.resize(in.muscles.size());
+  for (size_t m = 0; m < in.muscles.size(); ++m)
+  {
+    const mdvtk::Leaf& muscle = in.muscles[m];
+    if (!muscle.data || mdvtk::ReadTriangles(muscle.data, in.meshes[m]) < 0 || in.meshes[m].triangles.rows() == 0)
+    {
+      vtkErrorMacro(<< muscle.label << " has no triangles: the muscles must be closed surfaces");
+      return false;
+    }
+    in.muscleNames.push_back(muscle.name.empty() ? "muscle " + std::to_string(m) : muscle.name);
+  }
+  for (size_t p = 0; p < in.paths.size(); ++p)
+  {
+    const mdvtk::Leaf& path = in.paths[p];
+    const std::vector<md::Points> polylines = path.data ? mdvtk::ToPolylines(path.data) : std::vector<md::Points>();
+    if (polylines.size() != 1 || polylines[0].rows() < 2)
+    {
+      vtkErrorMacro(<< path.label << " must hold one polyline of at least 2 points (one path)");
+      return false;
+    }
+    in.lines.push_back(polylines[0]);
+    in.pathNames.push_back(path.name.empty() ? "path " + std::to_string(p) : path.name);
+  }
+  return true;
+}
+
+bool vtkActionLineGrouping::Group(Inputs& in, const std::string& assignments, int& result)
+{
+  md::osim::PathGrouping decided;
+  if (!mdvtk::CallCore(
+        this, "PathsOfMuscle: ",
+        [&] {
+          decided = md::osim::GroupPaths(
+            in.meshes, in.muscleNames, in.lines, in.pathNames, md::osim::ParseAssignments(assignments));
+        },
+        result))
+  {
+    return false;
+  }
+  std::ostringstream decision, unassigned;
+  for (size_t p = 0; p < in.paths.size(); ++p)
+  {
+    if (decided.muscleOfPath[p] < 0)
+    {
+      unassigned << (unassigned.tellp() > 0 ? ", " : "") << in.pathNames[p];
+      continue;
+    }
+    decision << in.pathNames[p] << " -> " << in.muscleNames[decided.muscleOfPath[p]] << " ("
+             << (decided.assignedByUser[p] ? "as given, " : "")
+             << static_cast<int>(100 * decided.insideFraction[p] + 0.5) << " % of its length inside)\n";
+  }
+  for (size_t m = 0; m < in.muscles.size(); ++m)
+  {
+    if (std::find(decided.muscleOfPath.begin(), decided.muscleOfPath.end(), static_cast<int>(m)) ==
+      decided.muscleOfPath.end())
+    {
+      vtkErrorMacro(<< in.muscles[m].label << ": no path runs inside this muscle; name its paths in PathsOfMuscle "
+                    << "(e.g. " << in.muscleNames[m] << "=" << in.pathNames.front() << ")");
+      result = 0;
+      return false;
+    }
+  }
+  this->Decision = decision.str();
+  vtkOutputWindow::GetInstance()->DisplayText(("ActionLineGrouping:\n" + this->Decision).c_str());
+  if (unassigned.tellp() > 0)
+  {
+    vtkWarningMacro(<< "paths that run inside no muscle (less than 5 % of their length) are left out: "
+                    << unassigned.str());
+  }
+  this->LastGrouping.reset(
+    new Grouped{ std::move(in.meshes), in.lines, in.muscleNames, in.pathNames, assignments, decided, this->Decision });
+  return true;
+}
+
+void vtkActionLineGrouping::BuildGrouped(const Inputs& in, bool current, vtkMultiBlockDataSet* output)
+{
+  const md::osim::PathGrouping& grouping = this->LastGrouping->grouping;
+  // Its ExecuteAppend only, on paths that are never empty: no pipeline pass per muscle (at every
+  // frame of a motion, a third of this filter's time went on those passes).
+  vtkNew<vtkAppendPolyData> append;
+  for (size_t m = 0; m < in.muscles.size(); ++m)
+  {
+    std::vector<vtkSmartPointer<vtkPolyData>> copies;
+    vtkNew<vtkStringArray> names;
+    names->SetName("ActionLinePaths");
+    vtkNew<vtkDoubleArray> shares;
+    shares->SetName("PathInsideFraction");
+    for (size_t p = 0; p < in.paths.size(); ++p)
+    {
+      if (grouping.muscleOfPath[p] != static_cast<int>(m))
+      {
+        continue;
+      }
+      vtkPolyData* line = current ? in.current[in.currentOf[p]].data : in.paths[p].data;
+      auto copy = vtkSmartPointer<vtkPolyData>::New();
+      copy->ShallowCopy(line);
+      copy->GetFieldData()->Initialize();
+      if (!copy->GetCellData()->GetAbstractArray(mdvtk::array::ActionLineName))
+      {
+        vtkNew<vtkStringArray> lineName;
+        lineName->SetName(mdvtk::array::ActionLineName);
+        lineName->InsertNextValue(in.pathNames[p]);
+        copy->GetCellData()->AddArray(lineName);
+      }
+      copies.push_back(copy);
+      names->InsertNextValue(in.pathNames[p]);
+      shares->InsertNextValue(grouping.insideFraction[p]);
+    }
+    std::vector<vtkPolyData*> inputs(copies.begin(), copies.end());
+    auto block = vtkSmartPointer<vtkPolyData>::New();
+    append->ExecuteAppend(block, inputs.data(), static_cast<int>(inputs.size()));
+    block->GetFieldData()->AddArray(names);
+    block->GetFieldData()->AddArray(shares);
+    mdvtk::AddBlock(output, in.muscleNames[m], block);
+  }
 }
 
 void vtkActionLineGrouping::PrintSelf(ostream& os, vtkIndent indent)

@@ -68,4 +68,12 @@ protected:
 private:
   vtkActionLineGrouping(const vtkActionLineGrouping&) = delete;
   void operator=(const vtkActionLineGrouping&) = delete;
+  struct Inputs;
+  /// Reads the muscles and the paths in both poses; false when one cannot be read (reported).
+  bool ReadInputs(vtkInformationVector** inputVector, Inputs& in);
+  /// Decides which paths are whose (GroupPaths), says so, and keeps it in LastGrouping; false
+  /// (with RequestData's `result`) when a muscle gets none or the assignments are bad.
+  bool Group(Inputs& in, const std::string& assignments, int& result);
+  /// One block per muscle of `output`: its paths appended, at rest or in the current pose.
+  void BuildGrouped(const Inputs& in, bool current, vtkMultiBlockDataSet* output);
 };

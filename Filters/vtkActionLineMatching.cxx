@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkActionLineMatching.h"
 
-#include "ActionLineMatching.h"
 #include "MDBlocks.h"
+#include "Motion/ActionLineMatching.h"
 
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
@@ -72,6 +72,7 @@ vtkActionLineMatching::vtkActionLineMatching()
 {
   this->SetNumberOfInputPorts(2);
   this->SetNumberOfOutputPorts(2);
+  this->Tolerance = md::kDefaultMatchingTolerance;
 }
 
 int vtkActionLineMatching::FillInputPortInformation(int, vtkInformation* info)

@@ -49,7 +49,7 @@ protected:
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  double Tolerance = 0.01;
+  double Tolerance; // md::kDefaultMatchingTolerance, set by the constructor
 
 private:
   vtkActionLineMatching(const vtkActionLineMatching&) = delete;

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkBoneInterpolation.h"
 
-#include "BoneInterpolation.h"
 #include "MDBlocks.h"
+#include "Motion/BoneInterpolation.h"
 
 #include <vtkAlgorithmOutput.h>
 #include <vtkCellArray.h>
@@ -59,6 +59,9 @@ vtkBoneInterpolation::vtkBoneInterpolation()
 {
   this->SetNumberOfInputPorts(2);
   this->SetNumberOfOutputPorts(1);
+  this->NumberOfSteps = md::kDefaultNumberOfSteps;
+  this->MaximumStepDisplacement = md::kDefaultMaximumStepDisplacement;
+  this->InterpolationMode = static_cast<int>(md::kDefaultInterpolationMode);
 }
 
 int vtkBoneInterpolation::FillInputPortInformation(int port, vtkInformation* info)
@@ -153,13 +156,7 @@ int vtkBoneInterpolation::RequestInformation(
   {
     // The automatic count depends on the data, which the pipeline only
     // produces after this pass: bring the inputs up to date first.
-    for (int port = 0; port < 2; ++port)
-    {
-      if (this->GetNumberOfInputConnections(port) > 0)
-      {
-        this->GetInputAlgorithm(port, 0)->Update(this->GetInputConnection(port, 0)->GetIndex());
-      }
-    }
+    mdvtk::UpdateInputs(this, { 0, 1 });
     std::vector<Pose> poses;
     if (!this->ReadPoses(vtkDataObject::GetData(inputVector[0], 0),
           this->GetNumberOfInputConnections(1) ? vtkDataObject::GetData(inputVector[1], 0) : nullptr, poses))
@@ -179,16 +176,7 @@ int vtkBoneInterpolation::RequestInformation(
     }
   }
   this->ResolvedNumberOfSteps = steps;
-
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  std::vector<double> times(static_cast<size_t>(steps) + 1);
-  for (int j = 0; j <= steps; ++j)
-  {
-    times[j] = j;
-  }
-  outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), steps + 1);
-  const double range[2] = { 0.0, static_cast<double>(steps) };
-  outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+  mdvtk::AdvertiseTimes(outputVector, mdvtk::StepTimes(steps));
   return 1;
 }
 
@@ -196,15 +184,7 @@ int vtkBoneInterpolation::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   mdvtk::ClearOutputs(outputVector);
-  // Our time is the interpolation step, not a time of the inputs: ask them for
-  // their default.
-  for (int port = 0; port < 2; ++port)
-  {
-    for (int i = 0; i < inputVector[port]->GetNumberOfInformationObjects(); ++i)
-    {
-      inputVector[port]->GetInformationObject(i)->Remove(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
-    }
-  }
+  mdvtk::InputsAtTheirOwnTime(inputVector, 2); // our time is the interpolation step
   return 1;
 }
 
@@ -220,13 +200,7 @@ int vtkBoneInterpolation::RequestData(
     return 0;
   }
   const int steps = this->ResolvedNumberOfSteps;
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  int step = 0;
-  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
-  {
-    const double time = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
-    step = static_cast<int>(std::lround(std::clamp(time, 0.0, static_cast<double>(steps))));
-  }
+  const int step = mdvtk::StepAsked(outputVector->GetInformationObject(0), steps, 0);
   const auto mode = static_cast<md::InterpolationMode>(this->InterpolationMode);
 
   std::vector<vtkSmartPointer<vtkPolyData>> results(poses.size());
@@ -256,18 +230,9 @@ int vtkBoneInterpolation::RequestData(
               mdvtk::AddFieldValue(fieldData, "RigidFitMaxResidual", fit.maxResidual);
               mdvtk::AddFieldValue(
                 fieldData, "RotationAngleDegrees", vtkMath::DegreesFromRadians(interpolator.RotationAngle()));
-              double bounds[6];
-              pose.restData->GetBounds(bounds);
-              const double diagonal = std::sqrt(
-                vtkMath::Distance2BetweenPoints(std::array<double, 3>{ bounds[0], bounds[2], bounds[4] }.data(),
-                  std::array<double, 3>{ bounds[1], bounds[3], bounds[5] }.data()));
-              if (fit.maxResidual > 1e-3 * diagonal)
+              if (const std::string warning = interpolator.NonRigidWarning(pose.label); !warning.empty())
               {
-                vtkWarningMacro(<< "the motion of " << pose.label << " is not rigid: the best rigid fit "
-                                << "misses the current pose by up to " << fit.maxResidual << " ("
-                                << 100.0 * fit.maxResidual / diagonal
-                                << " % of its size); Rigid mode blends that residual in linearly, "
-                                   "Linear mode may suit this motion better");
+                vtkWarningMacro(<< warning);
               }
             }
           },
@@ -276,8 +241,8 @@ int vtkBoneInterpolation::RequestData(
       return result;
     }
     output->SetPoints(mdvtk::ToVtkPoints(positions));
-    mdvtk::AddFieldValue(fieldData, "InterpolationStep", step);
-    mdvtk::AddFieldValue(fieldData, "NumberOfSteps", steps);
+    mdvtk::AddFieldValue(fieldData, mdvtk::array::InterpolationStep, step);
+    mdvtk::AddFieldValue(fieldData, mdvtk::array::NumberOfSteps, steps);
     mdvtk::AddFieldValue(fieldData, "InterpolationFraction", static_cast<double>(step) / steps);
     results[b] = output;
   }

@@ -73,9 +73,10 @@ protected:
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  int NumberOfSteps = 4;
-  double MaximumStepDisplacement = 20.0;
-  int InterpolationMode = RIGID;
+  // The core's defaults (md::kDefault...), set by the constructor.
+  int NumberOfSteps;
+  double MaximumStepDisplacement;
+  int InterpolationMode;
   int ResolvedNumberOfSteps = 1;
 
 private:

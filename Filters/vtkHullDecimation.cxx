@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkHullDecimation.h"
 
+#include "Geometry/MeshChecks.h"
+#include "Hull/ProgressiveHull.h"
 #include "MDBlocks.h"
-#include "MeshChecks.h"
-#include "ProgressiveHull.h"
 
 #include <vtkFieldData.h>
 #include <vtkInformation.h>
@@ -20,6 +20,15 @@ int vtkHullDecimation::FillInputPortInformation(int, vtkInformation* info)
 {
   mdvtk::AcceptPolyDataOrMultiBlock(info);
   return 1;
+}
+
+vtkHullDecimation::vtkHullDecimation()
+{
+  const md::HullParameters hull;
+  this->TargetNumberOfPoints = hull.targetNumberOfPoints;
+  this->MinimumAngle = hull.minimumAngleDegrees;
+  this->MaximumNormalDeviation = hull.maximumNormalDeviationDegrees;
+  this->MaximumFoldAngle = hull.maximumFoldAngleDegrees;
 }
 
 int vtkHullDecimation::RequestUpdateExtent(
@@ -51,10 +60,9 @@ int vtkHullDecimation::RequestData(
   size_t muscleCount = 0, failedCount = 0;
   for (size_t b = 0; b < leaves.size(); ++b)
   {
-    this->UpdateProgress(static_cast<double>(b) / leaves.size());
-    if (this->CheckAbort())
+    if (mdvtk::ProgressOrStop(this, static_cast<double>(b) / leaves.size()))
     {
-      return 1; // stopped by the user: the executive empties the output
+      return 1;
     }
     const mdvtk::Leaf& leaf = leaves[b];
     if (!leaf.data)
@@ -89,51 +97,56 @@ int vtkHullDecimation::RequestData(
       continue;
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const md::RepairReport& report = built.report;
-    const md::HullResult& hull = built.result;
-    if (converted > 0 || report.Changed())
-    {
-      vtkWarningMacro(<< leaf.label << " was repaired before building its hull: "
-                      << (converted > 0 ? "triangulated " + std::to_string(converted) + " polygons or strips" : "")
-                      << (converted > 0 && report.Changed() ? ", " : "") << report.Describe());
-    }
-    if (!hull.reachedTarget)
-    {
-      vtkWarningMacro(<< "the hull of " << leaf.label << " has " << hull.hull.points.rows()
-                      << " points: no further collapse kept it enclosing, manifold and free of folds and "
-                         "self-intersections (target "
-                      << this->TargetNumberOfPoints << ")");
-    }
-
-    auto output = mdvtk::ToPolyData(hull.hull);
-    vtkFieldData* fieldData = output->GetFieldData();
-    mdvtk::AddFieldValue(fieldData, "HullVolume", built.hullVolume);
-    mdvtk::AddFieldValue(fieldData, "MuscleVolume", built.cleanVolume);
-    mdvtk::AddFieldValue(fieldData, "HullVolumeRatio", built.hullVolume / built.cleanVolume);
-    mdvtk::AddFieldValue(fieldData, "NumberOfCollapses", hull.collapses);
-    mdvtk::AddFieldValue(fieldData, "ElapsedSeconds", seconds);
-    if (report.Changed() || converted > 0)
-    {
-      vtkNew<vtkStringArray> repairs;
-      repairs->SetName("Repairs");
-      repairs->InsertNextValue(report.Describe());
-      fieldData->AddArray(repairs);
-    }
-    if (this->VerifyEnclosure)
-    {
-      // BuildMuscleHull has checked that every muscle point is inside: none is left outside.
-      const std::int64_t crossings = md::CountSelfIntersections(hull.hull);
-      mdvtk::AddFieldValue(fieldData, "PointsOutsideHull", std::int64_t{ 0 });
-      mdvtk::AddFieldValue(fieldData, "HullSelfIntersections", crossings);
-      if (crossings > 0)
-      {
-        vtkWarningMacro(<< "the hull of " << leaf.label << " has " << crossings << " self-intersecting triangle pairs");
-      }
-    }
-    results[b] = output;
+    results[b] = this->HullOutput(leaf, built, converted, seconds);
   }
   mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), results, mdvtk::Role::Hull);
   return muscleCount > 0 && failedCount == muscleCount ? 0 : 1; // each failure was reported
+}
+
+vtkSmartPointer<vtkPolyData> vtkHullDecimation::HullOutput(
+  const mdvtk::Leaf& leaf, const md::MuscleHull& built, vtkIdType converted, double seconds)
+{
+  const md::RepairReport& report = built.report;
+  const md::HullResult& hull = built.result;
+  if (converted > 0 || report.Changed())
+  {
+    vtkWarningMacro(<< leaf.label << " was repaired before building its hull: "
+                    << (converted > 0 ? "triangulated " + std::to_string(converted) + " polygons or strips" : "")
+                    << (converted > 0 && report.Changed() ? ", " : "") << report.Describe());
+  }
+  if (!hull.reachedTarget)
+  {
+    vtkWarningMacro(<< "the hull of " << leaf.label << " has " << hull.hull.points.rows()
+                    << " points: no further collapse kept it enclosing, manifold and free of folds and "
+                       "self-intersections (target "
+                    << this->TargetNumberOfPoints << ")");
+  }
+  auto output = mdvtk::ToPolyData(hull.hull);
+  vtkFieldData* fieldData = output->GetFieldData();
+  mdvtk::AddFieldValue(fieldData, "HullVolume", built.hullVolume);
+  mdvtk::AddFieldValue(fieldData, "MuscleVolume", built.cleanVolume);
+  mdvtk::AddFieldValue(fieldData, "HullVolumeRatio", built.hullVolume / built.cleanVolume);
+  mdvtk::AddFieldValue(fieldData, "NumberOfCollapses", hull.collapses);
+  mdvtk::AddFieldValue(fieldData, mdvtk::array::ElapsedSeconds, seconds);
+  if (report.Changed() || converted > 0)
+  {
+    vtkNew<vtkStringArray> repairs;
+    repairs->SetName("Repairs");
+    repairs->InsertNextValue(report.Describe());
+    fieldData->AddArray(repairs);
+  }
+  if (this->VerifyEnclosure)
+  {
+    // BuildMuscleHull has checked that every muscle point is inside: none is left outside.
+    const std::int64_t crossings = md::CountSelfIntersections(hull.hull);
+    mdvtk::AddFieldValue(fieldData, "PointsOutsideHull", std::int64_t{ 0 });
+    mdvtk::AddFieldValue(fieldData, "HullSelfIntersections", crossings);
+    if (crossings > 0)
+    {
+      vtkWarningMacro(<< "the hull of " << leaf.label << " has " << crossings << " self-intersecting triangle pairs");
+    }
+  }
+  return output;
 }
 
 void vtkHullDecimation::PrintSelf(ostream& os, vtkIndent indent)

@@ -30,6 +30,17 @@
 #include "MuscleDeformationFiltersModule.h"
 
 #include <vtkPassInputTypeAlgorithm.h>
+#include <vtkSmartPointer.h>
+
+class vtkPolyData;
+namespace md
+{
+struct MuscleHull;
+}
+namespace mdvtk
+{
+struct Leaf;
+}
 
 class MUSCLEDEFORMATIONFILTERS_EXPORT vtkHullDecimation : public vtkPassInputTypeAlgorithm
 {
@@ -64,20 +75,25 @@ public:
   vtkBooleanMacro(VerifyEnclosure, bool);
 
 protected:
-  vtkHullDecimation() = default;
+  vtkHullDecimation();
   ~vtkHullDecimation() override = default;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  int TargetNumberOfPoints = 250;
-  double MinimumAngle = 10.0;
-  double MaximumNormalDeviation = 90.0;
-  double MaximumFoldAngle = 150.0;
+  // The core's defaults (md::HullParameters), set by the constructor.
+  int TargetNumberOfPoints;
+  double MinimumAngle;
+  double MaximumNormalDeviation;
+  double MaximumFoldAngle;
   bool VerifyEnclosure = true;
 
 private:
   vtkHullDecimation(const vtkHullDecimation&) = delete;
   void operator=(const vtkHullDecimation&) = delete;
+  /// The output block of `leaf`'s hull `built` (`converted` polygons or strips triangulated, in
+  /// `seconds`), with its measures; what was repaired or not reached is said.
+  vtkSmartPointer<vtkPolyData> HullOutput(
+    const mdvtk::Leaf& leaf, const md::MuscleHull& built, vtkIdType converted, double seconds);
 };

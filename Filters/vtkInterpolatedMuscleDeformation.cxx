@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkInterpolatedMuscleDeformation.h"
 
-#include "ActionLineMatching.h"
-#include "InterpolatedDeformation.h"
-#include "LocalFrame.h"
+#include "Geometry/LocalFrame.h"
 #include "MDBlocks.h"
+#include "Method/InterpolatedDeformation.h"
+#include "Motion/ActionLineMatching.h"
 
 #include <vtkAlgorithmOutput.h>
 #include <vtkDoubleArray.h>
@@ -41,10 +41,70 @@ struct vtkInterpolatedMuscleDeformation::Cache
   std::vector<size_t> lineLeaf;                               // ActionLinesRest leaf of each muscle
 };
 
+/// The muscles' action lines as given: ActionLinesRest leaf restOf[b] of muscle block b, and
+/// ActionLinesCurrent leaf currentOf[r] of rest leaf r.
+struct vtkInterpolatedMuscleDeformation::Lines
+{
+  std::vector<mdvtk::Leaf> rest, current;
+  std::vector<size_t> restOf, currentOf;
+};
+
 namespace
 {
 const char* const PortNames[] = { "Input", "BonesRest", "BonesCurrent", "ActionLinesRest", "ActionLinesCurrent" };
 
+/// Output 3: a row per muscle, a column per measure (NaN in the rows of the muscles that failed),
+/// then DeformationFailed.
+class MeasuresTable
+{
+public:
+  void AddRow(const std::string& name, const std::vector<mdvtk::Measure>& measures)
+  {
+    this->Names.push_back(name);
+    this->Failed.push_back(0.0);
+    for (size_t k = 0; k < measures.size(); ++k)
+    {
+      if (this->Columns.size() <= k)
+      {
+        this->Columns.emplace_back(measures[k].name, std::vector<double>());
+      }
+      this->Columns[k].second.resize(this->Names.size() - 1, std::nan("")); // the failed rows before
+      this->Columns[k].second.push_back(measures[k].value);
+    }
+  }
+  void AddFailedRow(const std::string& name)
+  {
+    this->Names.push_back(name);
+    this->Failed.push_back(1.0);
+  }
+  void WriteTo(vtkTable* table)
+  {
+    vtkNew<vtkStringArray> muscleColumn;
+    muscleColumn->SetName("Muscle");
+    for (const std::string& name : this->Names)
+    {
+      muscleColumn->InsertNextValue(name);
+    }
+    table->AddColumn(muscleColumn);
+    this->Columns.emplace_back(mdvtk::FailedArrayName, this->Failed);
+    for (auto& [name, values] : this->Columns)
+    {
+      values.resize(this->Names.size(), std::nan("")); // the failed rows after the last deformed one
+      vtkNew<vtkDoubleArray> column;
+      column->SetName(name.c_str());
+      for (double value : values)
+      {
+        column->InsertNextValue(value);
+      }
+      table->AddColumn(column);
+    }
+  }
+
+private:
+  std::vector<std::string> Names;
+  std::vector<double> Failed;
+  std::vector<std::pair<std::string, std::vector<double>>> Columns;
+};
 }
 
 vtkInterpolatedMuscleDeformation::vtkInterpolatedMuscleDeformation()
@@ -53,6 +113,21 @@ vtkInterpolatedMuscleDeformation::vtkInterpolatedMuscleDeformation()
 {
   this->SetNumberOfInputPorts(5);
   this->SetNumberOfOutputPorts(4);
+  const md::InterpolationParameters method;
+  this->NumberOfSteps = method.numberOfSteps;
+  this->ResolvedNumberOfSteps = method.numberOfSteps;
+  this->MaximumStepDisplacement = method.maximumStepDisplacement;
+  this->BoneInterpolationMode = static_cast<int>(method.interpolationMode);
+  this->DeformationMesh = method.settleOnSurface ? MUSCLE_SURFACE : HULL;
+  this->HullMode = static_cast<int>(method.hullMode);
+  this->MatchingTolerance = md::kDefaultMatchingTolerance;
+  this->DeformableShare = method.staticResolve.deformableShare;
+  this->MaximumNumberOfIterations = method.deformation.maximumIterations;
+  this->ConvergenceTolerance = method.deformation.convergenceTolerance;
+  this->PreserveVolume = method.deformation.preserveVolume;
+  this->BoneContactWeight = method.deformation.contactWeight;
+  this->HullTargetNumberOfPoints = method.hull.targetNumberOfPoints;
+  this->RefitRegularisation = method.refitRegularisation;
 }
 
 int vtkInterpolatedMuscleDeformation::GetHullBuildCount() const
@@ -99,13 +174,7 @@ int vtkInterpolatedMuscleDeformation::RequestInformation(
   {
     // The automatic count depends on the bones, which the pipeline only
     // produces after this pass: bring those inputs up to date first.
-    for (int port = 1; port <= 2; ++port)
-    {
-      if (this->GetNumberOfInputConnections(port) > 0)
-      {
-        this->GetInputAlgorithm(port, 0)->Update(this->GetInputConnection(port, 0)->GetIndex());
-      }
-    }
+    mdvtk::UpdateInputs(this, { 1, 2 });
     std::vector<md::BoneMotion> bones;
     std::string error;
     if (!mdvtk::ReadBones(nullptr, vtkDataObject::GetData(inputVector[1], 0), PortNames[1],
@@ -125,18 +194,7 @@ int vtkInterpolatedMuscleDeformation::RequestInformation(
     }
   }
   this->ResolvedNumberOfSteps = steps;
-  std::vector<double> times(static_cast<size_t>(steps) + 1);
-  for (int j = 0; j <= steps; ++j)
-  {
-    times[j] = j;
-  }
-  const double range[2] = { 0.0, static_cast<double>(steps) };
-  for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
-  {
-    vtkInformation* outInfo = outputVector->GetInformationObject(port);
-    outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), steps + 1);
-    outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
-  }
+  mdvtk::AdvertiseTimes(outputVector, mdvtk::StepTimes(steps));
   return 1;
 }
 
@@ -144,21 +202,13 @@ int vtkInterpolatedMuscleDeformation::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   mdvtk::ClearOutputs(outputVector);
-  // Our time is the interpolation step, not a time of the inputs.
-  for (int port = 0; port < 5; ++port)
-  {
-    for (int i = 0; i < inputVector[port]->GetNumberOfInformationObjects(); ++i)
-    {
-      inputVector[port]->GetInformationObject(i)->Remove(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
-    }
-  }
+  mdvtk::InputsAtTheirOwnTime(inputVector, 5); // our time is the interpolation step
   return 1;
 }
 
 int vtkInterpolatedMuscleDeformation::RequestData(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkDataObject* input = vtkDataObject::GetData(inputVector[0], 0);
   vtkDataObject* inputs[5];
   vtkMTimeType inputsTime = 0;
   for (int port = 0; port < 5; ++port)
@@ -168,216 +218,234 @@ int vtkInterpolatedMuscleDeformation::RequestData(
   }
   std::vector<mdvtk::Leaf> muscles;
   std::string error;
-  if (!mdvtk::CollectLeaves(input, PortNames[0], muscles, error))
+  if (!mdvtk::CollectLeaves(inputs[0], PortNames[0], muscles, error))
   {
     vtkErrorMacro(<< error);
     return 0;
   }
-
-  Cache& cache = *this->Computed;
+  const Cache& cache = *this->Computed;
   if (cache.result.points.empty() || cache.inputsTime != inputsTime || cache.filterTime != this->GetMTime() ||
     cache.result.numberOfSteps != this->ResolvedNumberOfSteps)
   {
-    cache = Cache{};
-    // Everything is read and checked before any work.
-    std::vector<mdvtk::Leaf> restLines, currentLines;
-    std::vector<size_t> restLinesOf, currentLinesOf;
-    std::vector<md::BoneMotion> bones;
-    if (!mdvtk::CollectLeaves(inputs[3], PortNames[3], restLines, error) ||
-      !mdvtk::CollectLeaves(inputs[4], PortNames[4], currentLines, error) ||
-      !mdvtk::PairLeaves(this, muscles, PortNames[0], restLines, PortNames[3], restLinesOf, error) ||
-      !mdvtk::PairLeaves(this, restLines, PortNames[3], currentLines, PortNames[4], currentLinesOf, error) ||
-      !mdvtk::ReadBones(this, inputs[1], PortNames[1], inputs[2], PortNames[2], bones, error, &cache.boneLeaf))
+    if (const int result = this->Deform(inputs, muscles); !result || this->Computed->result.points.empty())
     {
-      vtkErrorMacro(<< error);
-      return 0;
+      return result;
     }
-    // One muscle's fault is reported and that muscle left out; the others go on.
-    auto fail = [&](size_t block, const std::string& message, bool reported = false) {
-      if (!reported)
-      {
-        vtkErrorMacro(<< message);
-      }
-      cache.failedBlocks[block] = message;
-    };
-    // Everything in the muscles' local frame from here on, the matching of the action lines
-    // too: the same answer wherever the data sits and whatever its units.
-    std::vector<md::MuscleMotion> motions;
-    for (size_t b = 0; b < muscles.size(); ++b)
+    this->Computed->inputsTime = inputsTime;
+    this->Computed->filterTime = this->GetMTime();
+  }
+  const int step = this->StepToShow(request, outputVector);
+  this->WriteMuscles(inputs[0], muscles, step, outputVector);
+  if (!this->WriteBonesAndLines(inputs, step, outputVector))
+  {
+    return 0;
+  }
+  mdvtk::SetDataTime(outputVector, step);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+int vtkInterpolatedMuscleDeformation::Deform(vtkDataObject* const inputs[5], const std::vector<mdvtk::Leaf>& muscles)
+{
+  Cache& cache = *this->Computed;
+  cache = Cache{};
+  // Everything is read and checked before any work.
+  Lines lines;
+  std::vector<md::BoneMotion> bones;
+  std::string error;
+  if (!mdvtk::CollectLeaves(inputs[3], PortNames[3], lines.rest, error) ||
+    !mdvtk::CollectLeaves(inputs[4], PortNames[4], lines.current, error) ||
+    !mdvtk::PairLeaves(this, muscles, PortNames[0], lines.rest, PortNames[3], lines.restOf, error) ||
+    !mdvtk::PairLeaves(this, lines.rest, PortNames[3], lines.current, PortNames[4], lines.currentOf, error) ||
+    !mdvtk::ReadBones(this, inputs[1], PortNames[1], inputs[2], PortNames[2], bones, error, &cache.boneLeaf))
+  {
+    vtkErrorMacro(<< error);
+    return 0;
+  }
+  // One muscle's fault is reported and that muscle left out; the others go on.
+  std::vector<md::MuscleMotion> motions;
+  for (size_t b = 0; b < muscles.size(); ++b)
+  {
+    md::MuscleMotion motion;
+    motion.name = mdvtk::NameOf(muscles[b]);
+    if (muscles[b].data && !mdvtk::ReadMuscleSurface(muscles[b], motion.muscle, error))
     {
-      const mdvtk::Leaf& leaf = muscles[b];
-      if (!leaf.data)
-      {
-        continue;
-      }
-      md::MuscleMotion motion;
-      motion.name = leaf.name.empty() ? leaf.label : leaf.name;
-      mdvtk::ReadTriangles(leaf.data, motion.muscle);
-      if (motion.muscle.triangles.rows() == 0)
-      {
-        fail(b, leaf.label + " has no surface (no polygons); a muscle must be a closed triangle surface");
-        continue;
-      }
+      mdvtk::FailBlock(this, cache.failedBlocks, b, error);
+    }
+    else if (muscles[b].data)
+    {
       motions.push_back(std::move(motion));
       cache.blockOf.push_back(b);
     }
-    std::vector<md::Points> worldMuscles; // the rest pose as given: step 0 shows it exactly
-    std::vector<const md::Points*> restPoints;
-    for (const md::MuscleMotion& motion : motions)
-    {
-      worldMuscles.push_back(motion.muscle.points);
-    }
-    for (const md::Points& points : worldMuscles)
-    {
-      restPoints.push_back(&points);
-    }
-    const md::LocalFrame frame = md::LocalFrame::Around(restPoints);
-    for (md::BoneMotion& bone : bones)
-    {
-      frame.ToLocal(bone.rest.points);
-      frame.ToLocal(bone.current);
-    }
-    std::vector<md::MuscleMotion> matched; // the muscles whose lines could be matched
-    std::vector<size_t> matchedBlocks;
-    std::vector<const md::Points*> matchedRest;
-    for (size_t m = 0; m < motions.size(); ++m)
-    {
-      md::MuscleMotion& motion = motions[m];
-      const size_t b = cache.blockOf[m];
-      const mdvtk::Leaf& leaf = muscles[b];
-      frame.ToLocal(motion.muscle.points);
-      const mdvtk::Leaf& restLeaf = restLines[restLinesOf[b]];
-      const mdvtk::Leaf& currentLeaf = currentLines[currentLinesOf[restLinesOf[b]]];
-      std::vector<md::Points> rest = restLeaf.data ? mdvtk::ToPolylines(restLeaf.data) : std::vector<md::Points>{};
-      std::vector<md::Points> current =
-        currentLeaf.data ? mdvtk::ToPolylines(currentLeaf.data) : std::vector<md::Points>{};
-      for (auto* lines : { &rest, &current })
-      {
-        for (md::Points& line : *lines)
-        {
-          frame.ToLocal(line);
-        }
-      }
-      if (rest.empty())
-      {
-        fail(b,
-          restLeaf.label + " has no polylines: muscle " + leaf.label +
-            " needs its action lines, or nothing says where it goes");
-        continue;
-      }
-      if (rest.size() != current.size())
-      {
-        fail(b,
-          restLeaf.label + " has " + std::to_string(rest.size()) + " action lines but " + currentLeaf.label + " has " +
-            std::to_string(current.size()) + ": the lines of a muscle pair by order");
-        continue;
-      }
-      int result = 1;
-      std::string failure;
-      if (!mdvtk::CallCore(
-            this, "an action line of " + restLeaf.label + " or " + currentLeaf.label + ": ",
-            [&] {
-              for (size_t l = 0; l < rest.size(); ++l)
-              {
-                const md::MatchedActionLines pair = md::MatchActionLines(rest[l], current[l], this->MatchingTolerance);
-                motion.lines.push_back({ pair.rest, pair.current });
-              }
-              for (const std::string& note : md::LimitActionLinePoints(motion.lines))
-              {
-                vtkWarningMacro(<< restLeaf.label << ": " << note);
-              }
-            },
-            result, &failure))
-      {
-        if (failure.empty())
-        {
-          return result; // stopped by the user
-        }
-        fail(b, failure, true);
-        continue;
-      }
-      cache.lineMotions.emplace_back();
-      for (const md::MatchedLine& line : motion.lines)
-      {
-        cache.lineMotions.back().emplace_back(
-          line.rest, line.current, static_cast<md::InterpolationMode>(this->BoneInterpolationMode));
-      }
-      cache.lineLeaf.push_back(restLinesOf[b]);
-      matched.push_back(std::move(motion));
-      matchedBlocks.push_back(b);
-      matchedRest.push_back(&worldMuscles[m]);
-    }
-
-    md::InterpolationParameters parameters;
-    parameters.numberOfSteps = this->ResolvedNumberOfSteps;
-    parameters.maximumStepDisplacement = frame.LengthToLocal(this->MaximumStepDisplacement);
-    parameters.interpolationMode = static_cast<md::InterpolationMode>(this->BoneInterpolationMode);
-    parameters.settleOnSurface = this->DeformationMesh == MUSCLE_SURFACE;
-    parameters.hullMode = static_cast<md::HullMode>(this->HullMode);
-    parameters.refitRegularisation = this->RefitRegularisation;
-    parameters.staticResolve.deformableShare = this->DeformableShare;
-    parameters.deformation.maximumIterations = this->MaximumNumberOfIterations;
-    parameters.deformation.convergenceTolerance = frame.LengthToLocal(this->ConvergenceTolerance);
-    parameters.deformation.preserveVolume = this->PreserveVolume;
-    parameters.deformation.contactWeight = this->BoneContactWeight;
-    parameters.hull.targetNumberOfPoints = this->HullTargetNumberOfPoints;
-    parameters.hull.cancelled = mdvtk::AbortRequested(this);
-    if (matched.empty() && !cache.failedBlocks.empty())
-    {
-      cache = Cache{};
-      return 0; // every muscle failed, each said why (no muscle at all is the core's error)
-    }
-    motions = std::move(matched);
-    cache.blockOf = std::move(matchedBlocks);
-    restPoints = std::move(matchedRest);
-    int result = 1;
-    if (!mdvtk::CallCore(
-          this, "",
-          [&] {
-            cache.result = md::DeformByInterpolation(
-              motions, bones, parameters, mdvtk::ProgressOrCancel(this), this->KeptRest.get());
-          },
-          result))
-    {
-      cache = Cache{};
-      return result;
-    }
-    md::ResultToWorld(frame, restPoints, cache.result);
-    for (size_t m = 0; m < motions.size(); ++m)
-    {
-      if (!cache.result.failures[m].empty())
-      {
-        fail(cache.blockOf[m], muscles[cache.blockOf[m]].label + ": " + cache.result.failures[m]);
-      }
-    }
-    cache.frame = frame;
-    for (const md::BoneMotion& bone : bones)
-    {
-      cache.boneMotions.emplace_back(
-        bone.rest.points, bone.current, static_cast<md::InterpolationMode>(this->BoneInterpolationMode));
-    }
-    for (const std::string& warning : cache.result.warnings)
-    {
-      vtkWarningMacro(<< warning);
-    }
-    cache.inputsTime = inputsTime;
-    cache.filterTime = this->GetMTime();
   }
+  // Everything in the muscles' local frame from here on, the matching of the action lines
+  // too: the same answer wherever the data sits and whatever its units.
+  std::vector<md::Points> worldMuscles; // the rest pose as given: step 0 shows it exactly
+  for (const md::MuscleMotion& motion : motions)
+  {
+    worldMuscles.push_back(motion.muscle.points);
+  }
+  std::vector<const md::Points*> restPoints;
+  for (const md::Points& points : worldMuscles)
+  {
+    restPoints.push_back(&points);
+  }
+  const md::LocalFrame frame = md::LocalFrame::Around(restPoints);
+  for (md::BoneMotion& bone : bones)
+  {
+    frame.ToLocal(bone.rest.points);
+    frame.ToLocal(bone.current);
+  }
+  int result = 1;
+  std::vector<size_t> kept;
+  if (!this->MatchLines(muscles, lines, frame, motions, kept, result))
+  {
+    return result; // stopped by the user
+  }
+  restPoints.clear();
+  for (size_t m : kept)
+  {
+    restPoints.push_back(&worldMuscles[m]);
+  }
+  if (motions.empty() && !cache.failedBlocks.empty())
+  {
+    cache = Cache{};
+    return 0; // every muscle failed, each said why (no muscle at all is the core's error)
+  }
+  const md::InterpolationParameters parameters = this->Parameters(frame);
+  if (!mdvtk::CallCore(
+        this, "",
+        [&] {
+          cache.result =
+            md::DeformByInterpolation(motions, bones, parameters, mdvtk::ProgressOrCancel(this), this->KeptRest.get());
+        },
+        result))
+  {
+    cache = Cache{};
+    return result;
+  }
+  md::ResultToWorld(frame, restPoints, cache.result);
+  for (size_t m = 0; m < motions.size(); ++m)
+  {
+    if (!cache.result.failures[m].empty())
+    {
+      mdvtk::FailBlock(
+        this, cache.failedBlocks, cache.blockOf[m], muscles[cache.blockOf[m]].label + ": " + cache.result.failures[m]);
+    }
+  }
+  cache.frame = frame;
+  for (const md::BoneMotion& bone : bones)
+  {
+    cache.boneMotions.emplace_back(bone.rest.points, bone.current, parameters.interpolationMode);
+  }
+  for (const std::string& warning : cache.result.warnings)
+  {
+    vtkWarningMacro(<< warning);
+  }
+  return 1;
+}
 
-  const md::InterpolationResult& r = cache.result;
-  const int steps = r.numberOfSteps;
+bool vtkInterpolatedMuscleDeformation::MatchLines(const std::vector<mdvtk::Leaf>& muscles, const Lines& lines,
+  const md::LocalFrame& frame, std::vector<md::MuscleMotion>& motions, std::vector<size_t>& kept, int& result)
+{
+  Cache& cache = *this->Computed;
+  std::vector<md::MuscleMotion> matched; // the muscles whose lines could be matched
+  std::vector<size_t> matchedBlocks;
+  for (size_t m = 0; m < motions.size(); ++m)
+  {
+    md::MuscleMotion& motion = motions[m];
+    const size_t b = cache.blockOf[m];
+    frame.ToLocal(motion.muscle.points);
+    const mdvtk::Leaf& restLeaf = lines.rest[lines.restOf[b]];
+    const mdvtk::Leaf& currentLeaf = lines.current[lines.currentOf[lines.restOf[b]]];
+    std::vector<md::Points> rest = restLeaf.data ? mdvtk::ToPolylines(restLeaf.data) : std::vector<md::Points>{};
+    std::vector<md::Points> current =
+      currentLeaf.data ? mdvtk::ToPolylines(currentLeaf.data) : std::vector<md::Points>{};
+    for (auto* poses : { &rest, &current })
+    {
+      for (md::Points& line : *poses)
+      {
+        frame.ToLocal(line);
+      }
+    }
+    if (rest.empty())
+    {
+      mdvtk::FailBlock(this, cache.failedBlocks, b,
+        restLeaf.label + " has no polylines: muscle " + muscles[b].label +
+          " needs its action lines, or nothing says where it goes");
+      continue;
+    }
+    if (rest.size() != current.size())
+    {
+      mdvtk::FailBlock(this, cache.failedBlocks, b,
+        restLeaf.label + " has " + std::to_string(rest.size()) + " action lines but " + currentLeaf.label + " has " +
+          std::to_string(current.size()) + ": the lines of a muscle pair by order");
+      continue;
+    }
+    std::string failure;
+    if (!mdvtk::CallCore(
+          this, "an action line of " + restLeaf.label + " or " + currentLeaf.label + ": ",
+          [&] {
+            std::vector<std::string> notes;
+            motion.lines = md::MatchMuscleLines(rest, current, this->MatchingTolerance, notes);
+            for (const std::string& note : notes)
+            {
+              vtkWarningMacro(<< restLeaf.label << ": " << note);
+            }
+          },
+          result, &failure))
+    {
+      if (failure.empty())
+      {
+        return false; // stopped by the user
+      }
+      mdvtk::FailBlock(this, cache.failedBlocks, b, failure, true);
+      continue;
+    }
+    cache.lineMotions.emplace_back();
+    for (const md::MatchedLine& line : motion.lines)
+    {
+      cache.lineMotions.back().emplace_back(
+        line.rest, line.current, static_cast<md::InterpolationMode>(this->BoneInterpolationMode));
+    }
+    cache.lineLeaf.push_back(lines.restOf[b]);
+    matched.push_back(std::move(motion));
+    matchedBlocks.push_back(b);
+    kept.push_back(m);
+  }
+  motions = std::move(matched);
+  cache.blockOf = std::move(matchedBlocks);
+  return true;
+}
+
+md::InterpolationParameters vtkInterpolatedMuscleDeformation::Parameters(const md::LocalFrame& frame)
+{
+  md::InterpolationParameters parameters;
+  parameters.numberOfSteps = this->ResolvedNumberOfSteps;
+  parameters.maximumStepDisplacement = frame.LengthToLocal(this->MaximumStepDisplacement);
+  parameters.interpolationMode = static_cast<md::InterpolationMode>(this->BoneInterpolationMode);
+  parameters.settleOnSurface = this->DeformationMesh == MUSCLE_SURFACE;
+  parameters.hullMode = static_cast<md::HullMode>(this->HullMode);
+  parameters.refitRegularisation = this->RefitRegularisation;
+  parameters.staticResolve.deformableShare = this->DeformableShare;
+  parameters.deformation.maximumIterations = this->MaximumNumberOfIterations;
+  parameters.deformation.convergenceTolerance = frame.LengthToLocal(this->ConvergenceTolerance);
+  parameters.deformation.preserveVolume = this->PreserveVolume;
+  parameters.deformation.contactWeight = this->BoneContactWeight;
+  parameters.hull.targetNumberOfPoints = this->HullTargetNumberOfPoints;
+  parameters.hull.cancelled = mdvtk::AbortRequested(this);
+  return parameters;
+}
+
+int vtkInterpolatedMuscleDeformation::StepToShow(vtkInformation* request, vtkInformationVector* outputVector)
+{
+  const int steps = this->Computed->result.numberOfSteps;
   // The time asked for on the port whose request this is: all three outputs show that step.
   int port = request->Has(vtkDemandDrivenPipeline::FROM_OUTPUT_PORT())
     ? request->Get(vtkDemandDrivenPipeline::FROM_OUTPUT_PORT())
     : 0;
   port = port < 0 || port >= this->GetNumberOfOutputPorts() ? 0 : port;
-  vtkInformation* outInfo = outputVector->GetInformationObject(port);
-  int step = steps;
-  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
-  {
-    const double time = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
-    step = static_cast<int>(std::lround(std::clamp(time, 0.0, static_cast<double>(steps))));
-  }
+  const int step = mdvtk::StepAsked(outputVector->GetInformationObject(port), steps, steps);
   // Time j is step j of N: after N changes the same time is another point of the motion. Said,
   // not silent, when the view stays on the time it showed before the change.
   if (this->ShownNumberOfSteps > 0 && steps != this->ShownNumberOfSteps && step == this->ShownStep && step != 0)
@@ -389,10 +457,16 @@ int vtkInterpolatedMuscleDeformation::RequestData(
   }
   this->ShownNumberOfSteps = steps;
   this->ShownStep = step;
+  return step;
+}
+
+void vtkInterpolatedMuscleDeformation::WriteMuscles(
+  vtkDataObject* input, const std::vector<mdvtk::Leaf>& muscles, int step, vtkInformationVector* outputVector)
+{
+  const Cache& cache = *this->Computed;
+  const md::InterpolationResult& r = cache.result;
   std::vector<vtkSmartPointer<vtkPolyData>> outputs(muscles.size());
-  std::vector<std::string> names;                                   // Measures rows
-  std::vector<std::pair<std::string, std::vector<double>>> columns; // Measures columns
-  std::vector<size_t> failedRows;                                   // muscles not deformed: NaN
+  MeasuresTable table;
   std::map<size_t, size_t> muscleOfBlock;
   for (size_t m = 0; m < cache.blockOf.size(); ++m)
   {
@@ -402,112 +476,65 @@ int vtkInterpolatedMuscleDeformation::RequestData(
   {
     const auto failed = cache.failedBlocks.find(b);
     const auto found = muscleOfBlock.find(b);
-    if (failed == cache.failedBlocks.end() && found == muscleOfBlock.end())
-    {
-      continue; // an empty block
-    }
-    names.push_back(muscles[b].name.empty() ? muscles[b].label : muscles[b].name);
     if (failed != cache.failedBlocks.end())
     {
       outputs[b] = mdvtk::FailedMuscle(muscles[b].data, failed->second);
-      failedRows.push_back(names.size() - 1);
+      table.AddFailedRow(mdvtk::NameOf(muscles[b]));
       continue;
+    }
+    if (found == muscleOfBlock.end())
+    {
+      continue; // an empty block
     }
     const size_t m = found->second;
     const md::Points& points = r.points[step][m];
-    const md::Points& rest = r.points[0][m];
     const md::MuscleStepMeasures& s = r.measures[step][m];
-    auto output = vtkSmartPointer<vtkPolyData>::New();
-    output->ShallowCopy(muscles[b].data);
-    output->SetPoints(mdvtk::ToVtkPoints(points));
-    output->GetPointData()->AddArray(mdvtk::ToVtkArray(mdvtk::DisplacementArrayName, points - rest));
+    outputs[b] = mdvtk::MovedMuscle(muscles[b].data, points, points - r.points[0][m]);
     // No static move at step 0: zeros.
-    output->GetPointData()->AddArray(mdvtk::ToVtkArray(mdvtk::StaticShiftArrayName,
+    outputs[b]->GetPointData()->AddArray(mdvtk::ToVtkArray(mdvtk::StaticShiftArrayName,
       s.staticShift.rows() ? s.staticShift : md::Points(md::Points::Zero(points.rows(), 3))));
     double hullSeconds = r.restHullSeconds[m];
     for (int j = 1; j <= step; ++j)
     {
       hullSeconds += r.measures[j][m].hullSeconds;
     }
-    vtkNew<vtkFieldData> fieldData;
-    fieldData->DeepCopy(muscles[b].data->GetFieldData());
     // Each measure goes to the muscle's field data and to its row of the Measures table.
-    size_t measureIndex = 0;
-    auto measure = [&](const char* name, auto value) {
-      mdvtk::AddFieldValue(fieldData, name, value);
-      if (columns.size() <= measureIndex)
-      {
-        columns.emplace_back(name, std::vector<double>());
-      }
-      columns[measureIndex].second.resize(names.size() - 1, std::nan("")); // the failed rows before
-      columns[measureIndex++].second.push_back(static_cast<double>(value));
-    };
-    measure(mdvtk::VolumeChangeArrayName, s.volumeChangePercent);
-    measure("NewPenetrationCount", s.newPenetrationCount);
-    measure("MaxNewPenetrationDepth", s.maxNewPenetrationDepth);
-    measure("NewBonePenetrationCount", s.newBonePenetrationCount);
-    measure("MaxNewBonePenetrationDepth", s.maxNewBonePenetrationDepth);
-    measure("MaxStaticShift", s.maxStaticShift);
-    measure("StepStaticShift", s.stepStaticShift);
-    measure("SharpEdgeCount", s.sharpEdgeCount);
-    measure("FlippedTriangleCount", s.flippedTriangleCount);
-    measure("NumberOfIterations", s.iterations);
-    measure("Converged", s.converged ? 1 : 0);
-    measure("PointsFrozenInObstacles", s.pointsFrozenInObstacles);
-    measure("InterpolationStep", step);
-    measure("NumberOfSteps", steps);
-    measure("HullSeconds", hullSeconds);
-    measure("StepSeconds", r.stepSeconds[step]);
-    measure("ElapsedSeconds", r.totalSeconds);
-    output->SetFieldData(fieldData);
-    outputs[b] = output;
+    std::vector<mdvtk::Measure> measures = mdvtk::StepMeasures(s, s.iterations, true);
+    measures.push_back({ mdvtk::array::PointsFrozenInObstacles, static_cast<double>(s.pointsFrozenInObstacles), true });
+    measures.push_back({ mdvtk::array::InterpolationStep, static_cast<double>(step), true });
+    measures.push_back({ mdvtk::array::NumberOfSteps, static_cast<double>(r.numberOfSteps), true });
+    measures.push_back({ mdvtk::array::HullSeconds, hullSeconds });
+    measures.push_back({ mdvtk::array::StepSeconds, r.stepSeconds[step] });
+    measures.push_back({ mdvtk::array::ElapsedSeconds, r.totalSeconds });
+    mdvtk::AddMeasures(outputs[b]->GetFieldData(), measures);
+    table.AddRow(mdvtk::NameOf(muscles[b]), measures);
   }
   mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), outputs, mdvtk::Role::Muscle);
-
   // Output 3: the same measures as a table, one row per muscle, for a spreadsheet view.
-  vtkTable* table = vtkTable::GetData(outputVector, 3);
-  vtkNew<vtkStringArray> muscleColumn;
-  muscleColumn->SetName("Muscle");
-  for (const std::string& name : names)
-  {
-    muscleColumn->InsertNextValue(name);
-  }
-  table->AddColumn(muscleColumn);
-  columns.emplace_back(mdvtk::FailedArrayName, std::vector<double>(names.size(), 0.0));
-  for (size_t row : failedRows)
-  {
-    columns.back().second[row] = 1;
-  }
-  for (auto& [name, values] : columns)
-  {
-    values.resize(names.size(), std::nan("")); // the failed rows after the last deformed one
-    vtkNew<vtkDoubleArray> column;
-    column->SetName(name.c_str());
-    for (double value : values)
-    {
-      column->InsertNextValue(value);
-    }
-    table->AddColumn(column);
-  }
+  table.WriteTo(vtkTable::GetData(outputVector, 3));
+}
 
+bool vtkInterpolatedMuscleDeformation::WriteBonesAndLines(
+  vtkDataObject* const inputs[5], int step, vtkInformationVector* outputVector)
+{
   // Outputs 1 and 2: the bones and the matched action lines at the same step, as the method
   // moved them, so that the muscles are never shown against bones of another step.
+  const Cache& cache = *this->Computed;
+  const int steps = cache.result.numberOfSteps;
   std::vector<mdvtk::Leaf> boneLeaves, lineLeaves;
+  std::string error;
   if (!mdvtk::CollectLeaves(inputs[1], PortNames[1], boneLeaves, error) ||
     !mdvtk::CollectLeaves(inputs[3], PortNames[3], lineLeaves, error))
   {
     vtkErrorMacro(<< error);
-    return 0;
+    return false;
   }
   std::vector<vtkSmartPointer<vtkPolyData>> boneOutputs(boneLeaves.size());
   for (size_t k = 0; k < cache.boneMotions.size(); ++k)
   {
     md::Points points = cache.boneMotions[k].AtStep(step, steps);
     cache.frame.ToWorld(points);
-    auto bone = vtkSmartPointer<vtkPolyData>::New();
-    bone->ShallowCopy(boneLeaves[cache.boneLeaf[k]].data);
-    bone->SetPoints(mdvtk::ToVtkPoints(points));
-    boneOutputs[cache.boneLeaf[k]] = bone;
+    boneOutputs[cache.boneLeaf[k]] = mdvtk::MovedCopy(boneLeaves[cache.boneLeaf[k]].data, points);
   }
   mdvtk::AssignLeaves(inputs[1], vtkDataObject::GetData(outputVector, 1), boneOutputs, mdvtk::Role::Bone);
   std::vector<vtkSmartPointer<vtkPolyData>> lineOutputs(lineLeaves.size());
@@ -522,14 +549,7 @@ int vtkInterpolatedMuscleDeformation::RequestData(
     lineOutputs[cache.lineLeaf[m]] = mdvtk::ToPolyLines(lines);
   }
   mdvtk::AssignLeaves(inputs[3], vtkDataObject::GetData(outputVector, 2), lineOutputs, mdvtk::Role::ActionLine);
-  for (int p = 0; p < this->GetNumberOfOutputPorts(); ++p)
-  {
-    vtkDataObject::GetData(outputVector, p)
-      ->GetInformation()
-      ->Set(vtkDataObject::DATA_TIME_STEP(), static_cast<double>(step));
-  }
-  this->UpdateProgress(1.0);
-  return 1;
+  return true;
 }
 
 void vtkInterpolatedMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)

@@ -52,10 +52,19 @@
 #include <vtkPassInputTypeAlgorithm.h>
 
 #include <memory>
+#include <string>
+#include <vector>
 
 namespace md
 {
 struct RestMappingCache;
+struct MuscleMotion;
+struct LocalFrame;
+struct InterpolationParameters;
+}
+namespace mdvtk
+{
+struct Leaf;
 }
 
 class MUSCLEDEFORMATIONFILTERS_EXPORT vtkInterpolatedMuscleDeformation : public vtkPassInputTypeAlgorithm
@@ -156,20 +165,21 @@ protected:
   int FillOutputPortInformation(int port, vtkInformation* info) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  int NumberOfSteps = 4;
-  double MaximumStepDisplacement = 20.0;
-  int BoneInterpolationMode = RIGID;
-  int DeformationMesh = MUSCLE_SURFACE;
-  int HullMode = REFIT;
-  double MatchingTolerance = 0.01;
-  double DeformableShare = 0.6;
-  int MaximumNumberOfIterations = 200;
-  double ConvergenceTolerance = 0.01;
-  bool PreserveVolume = true;
-  double BoneContactWeight = 0.5;
-  int HullTargetNumberOfPoints = 250;
-  double RefitRegularisation = 1e-3;
-  int ResolvedNumberOfSteps = 4;
+  // The core's defaults (md::InterpolationParameters), set by the constructor.
+  int NumberOfSteps;
+  double MaximumStepDisplacement;
+  int BoneInterpolationMode;
+  int DeformationMesh;
+  int HullMode;
+  double MatchingTolerance;
+  double DeformableShare;
+  int MaximumNumberOfIterations;
+  double ConvergenceTolerance;
+  bool PreserveVolume;
+  double BoneContactWeight;
+  int HullTargetNumberOfPoints;
+  double RefitRegularisation;
+  int ResolvedNumberOfSteps;
   int ShownNumberOfSteps = 0; // N and step of the last output, to say when N changes under a time
   int ShownStep = 0;
 
@@ -177,6 +187,22 @@ private:
   vtkInterpolatedMuscleDeformation(const vtkInterpolatedMuscleDeformation&) = delete;
   void operator=(const vtkInterpolatedMuscleDeformation&) = delete;
   struct Cache;
+  struct Lines;
+  /// Reads the inputs and runs the method, into Computed: RequestData's result.
+  int Deform(vtkDataObject* const inputs[5], const std::vector<mdvtk::Leaf>& muscles);
+  /// Brings `motions` (the muscles read, at their blocks Computed->blockOf) into `frame` and
+  /// matches their action lines; a muscle whose lines fail is left out, `kept` the indices of the
+  /// others. False (with RequestData's `result`) when the user stopped the run.
+  bool MatchLines(const std::vector<mdvtk::Leaf>& muscles, const Lines& lines, const md::LocalFrame& frame,
+    std::vector<md::MuscleMotion>& motions, std::vector<size_t>& kept, int& result);
+  md::InterpolationParameters Parameters(const md::LocalFrame& frame);
+  /// The step the request asks for (said when NumberOfSteps changed under the same time).
+  int StepToShow(vtkInformation* request, vtkInformationVector* outputVector);
+  /// Output 0, the muscles at `step`, and output 3, their measures.
+  void WriteMuscles(
+    vtkDataObject* input, const std::vector<mdvtk::Leaf>& muscles, int step, vtkInformationVector* outputVector);
+  /// Outputs 1 and 2: the bones and action lines at `step`.
+  bool WriteBonesAndLines(vtkDataObject* const inputs[5], int step, vtkInformationVector* outputVector);
   std::unique_ptr<Cache> Computed;
   std::unique_ptr<md::RestMappingCache> KeptRest;
 };

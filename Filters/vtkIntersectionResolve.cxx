@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkIntersectionResolve.h"
 
-#include "LocalFrame.h"
+#include "Deformation/MuscleDeformer.h"
+#include "Geometry/LocalFrame.h"
+#include "Geometry/MeshChecks.h"
+#include "Intersections/StaticIntersections.h"
 #include "MDBlocks.h"
-#include "MeshChecks.h"
-#include "MuscleDeformer.h"
-#include "StaticIntersections.h"
 
 #include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
@@ -23,6 +23,7 @@ vtkStandardNewMacro(vtkIntersectionResolve);
 vtkIntersectionResolve::vtkIntersectionResolve()
 {
   this->SetNumberOfInputPorts(4);
+  this->DeformableShare = md::StaticResolveParameters().deformableShare;
 }
 
 int vtkIntersectionResolve::FillInputPortInformation(int port, vtkInformation* info)
@@ -75,190 +76,184 @@ int vtkIntersectionResolve::RequestUpdateExtent(
   return this->Superclass::RequestUpdateExtent(request, inputVector, outputVector);
 }
 
+/// What RequestData read: the meshes to resolve (`deformable`, at blocks `used`; `deformableRest`
+/// their rest pose when InputRest is given), the obstacles in both poses, what failed.
+struct vtkIntersectionResolve::Read
+{
+  std::vector<mdvtk::Leaf> leaves;
+  std::vector<md::TriangleMesh> deformable, deformableRest;
+  std::vector<size_t> used;
+  bool restGiven = false;
+  std::vector<std::string> obstacleNames, restObstacleNames;
+  std::vector<md::TriangleMesh> obstacles, restObstacles;
+  std::map<size_t, std::string> failedBlocks; // one muscle's fault leaves the others to be resolved
+};
+
 int vtkIntersectionResolve::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkDataObject* input = vtkDataObject::GetData(inputVector[0], 0);
-  std::vector<mdvtk::Leaf> leaves;
-  std::vector<md::TriangleMesh> meshes;
-  std::vector<std::string> obstacleNames, restObstacleNames;
-  std::vector<md::TriangleMesh> obstacles, restObstacles;
-  std::string error;
-  std::map<size_t, std::string> failedBlocks; // one muscle's fault leaves the others to be resolved
-  if (!mdvtk::CollectLeaves(input, "Input", leaves, error) || !ReadLeafMeshes(leaves, meshes, error, &failedBlocks) ||
-    !mdvtk::ReadMeshes(inputVector[1], "Obstacles", obstacleNames, obstacles, error) ||
-    !mdvtk::ReadMeshes(inputVector[3], "ObstaclesRest", restObstacleNames, restObstacles, error))
+  Read read;
+  if (!this->ReadInputs(inputVector, read))
   {
-    vtkErrorMacro(<< error);
     return 0;
   }
-  if (inputVector[1]->GetNumberOfInformationObjects() == 0)
-  {
-    vtkWarningMacro(<< "no Obstacles are connected: only the Input's meshes are kept out of one another, "
-                       "nothing keeps them out of the bones; connect the bones in the current pose as Obstacles");
-  }
-  const bool restGiven = inputVector[2]->GetNumberOfInformationObjects() > 0;
-  if (!restGiven && !restObstacles.empty())
-  {
-    vtkWarningMacro(<< "ObstaclesRest is connected but InputRest is not: all penetration is resolved");
-  }
-  if (restGiven && !restObstacles.empty())
-  {
-    if (restObstacles.size() != obstacles.size())
-    {
-      vtkErrorMacro(<< "ObstaclesRest has " << restObstacles.size() << " meshes but Obstacles has " << obstacles.size()
-                    << ": connect the same obstacles in both poses, in the same order");
-      return 0;
-    }
-    for (size_t o = 0; o < obstacles.size(); ++o)
-    {
-      if (restObstacles[o].points.rows() != obstacles[o].points.rows())
-      {
-        vtkErrorMacro(<< "obstacle '" << obstacleNames[o] << "' has " << obstacles[o].points.rows()
-                      << " points but its rest pose '" << restObstacleNames[o] << "' has "
-                      << restObstacles[o].points.rows() << ": both poses must have the same points");
-        return 0;
-      }
-    }
-  }
-
-  // Only the leaves with data take part; `used[k]` is the leaf of mesh k.
-  std::vector<md::TriangleMesh> deformable, deformableRest;
-  std::vector<size_t> used;
-  std::vector<mdvtk::Leaf> restLeaves;
-  std::vector<size_t> restOf;
-  std::vector<md::TriangleMesh> restMeshes;
-  if (restGiven &&
-    (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[2], 0), "InputRest", restLeaves, error) ||
-      !mdvtk::PairLeaves(this, leaves, "Input", restLeaves, "InputRest", restOf, error) ||
-      !ReadLeafMeshes(restLeaves, restMeshes, error)))
-  {
-    vtkErrorMacro(<< error);
-    return 0;
-  }
-  for (size_t b = 0; b < leaves.size(); ++b)
-  {
-    if (!leaves[b].data || failedBlocks.count(b))
-    {
-      continue;
-    }
-    if (restGiven)
-    {
-      const md::TriangleMesh& rest = restMeshes[restOf[b]];
-      if (rest.points.rows() != meshes[b].points.rows())
-      {
-        failedBlocks[b] = restLeaves[restOf[b]].label + " has " + std::to_string(rest.points.rows()) + " points but " +
-          leaves[b].label + " has " + std::to_string(meshes[b].points.rows()) +
-          ": InputRest must be the Input in the rest pose, with the same points";
-        continue;
-      }
-      deformableRest.push_back({ rest.points, meshes[b].triangles });
-    }
-    deformable.push_back(meshes[b]);
-    used.push_back(b);
-  }
-  for (const auto& [b, message] : failedBlocks)
+  for (const auto& [b, message] : read.failedBlocks)
   {
     vtkErrorMacro(<< message);
   }
-  if (used.empty() && !failedBlocks.empty())
+  if (read.used.empty() && !read.failedBlocks.empty())
   {
     return 0; // nothing left to resolve, each failure said
   }
-
   // In the local frame of the meshes to resolve: the same answer wherever they sit, whatever
   // their units.
   std::vector<const md::Points*> parts;
-  for (const md::TriangleMesh& mesh : deformable)
+  for (const md::TriangleMesh& mesh : read.deformable)
   {
     parts.push_back(&mesh.points);
   }
   const md::LocalFrame frame = md::LocalFrame::Around(parts);
-  for (auto* list : { &deformable, &deformableRest, &obstacles, &restObstacles })
+  for (auto* list : { &read.deformable, &read.deformableRest, &read.obstacles, &read.restObstacles })
   {
     for (md::TriangleMesh& mesh : *list)
     {
       frame.ToLocal(mesh.points);
     }
   }
-
-  md::OverlapMasks existing;
-  std::vector<md::Obstacle> trees, restTrees;
-  auto fixedOf = [](const std::vector<md::Obstacle>& list) {
-    std::vector<md::FixedObstacle> fixed;
-    for (const md::Obstacle& o : list)
-    {
-      fixed.push_back({ o.name, o.tree.get() });
-    }
-    return fixed;
-  };
-  md::StaticResolveResult resolved;
-  std::vector<md::Penetration> left;
+  md::StaticStep step;
   int result = 1;
   if (!mdvtk::CallCore(
         this, "",
         [&] {
-          trees = md::BuildObstacles(obstacleNames, obstacles);
-          this->UpdateProgress(0.2);
-          if (restGiven)
-          {
-            restTrees = restObstacles.empty() ? trees : md::BuildObstacles(restObstacleNames, restObstacles);
-            existing = md::FindOverlaps(deformableRest, fixedOf(restTrees));
-          }
-          this->UpdateProgress(0.4);
           md::StaticResolveParameters parameters;
           parameters.deformableShare = this->DeformableShare;
-          const std::vector<md::FixedObstacle> fixed = fixedOf(trees);
-          resolved = md::ResolveStaticIntersections(deformable, fixed, restGiven ? &existing : nullptr, parameters);
-          this->UpdateProgress(0.8);
-          std::vector<md::TriangleMesh> after = deformable;
-          for (size_t k = 0; k < after.size(); ++k)
-          {
-            after[k].points = resolved.points[k];
-          }
-          left = md::MeasureNewPenetration(after, fixed, restGiven ? &existing : nullptr);
+          step =
+            md::ResolveStatically(read.deformable, read.restGiven ? &read.deformableRest : nullptr, read.obstacleNames,
+              read.obstacles, read.restObstacleNames, read.restObstacles, parameters, mdvtk::ProgressOrCancel(this));
         },
         result))
   {
     return result;
   }
-
-  std::vector<vtkSmartPointer<vtkPolyData>> outputs(leaves.size());
-  for (size_t k = 0; k < used.size(); ++k)
+  std::vector<vtkSmartPointer<vtkPolyData>> outputs(read.leaves.size());
+  for (size_t k = 0; k < read.used.size(); ++k)
   {
-    const size_t b = used[k];
-    md::Points points = resolved.points[k];
+    const size_t b = read.used[k];
+    md::Points points = step.resolved.points[k];
     frame.ToWorld(points);
-    md::Points shifts = resolved.shift[k];
+    md::Points shifts = step.resolved.shift[k];
     frame.VectorsToWorld(shifts);
-    auto output = vtkSmartPointer<vtkPolyData>::New();
-    output->ShallowCopy(leaves[b].data);
-    output->SetPoints(mdvtk::ToVtkPoints(points));
-    output->GetPointData()->AddArray(mdvtk::ToVtkArray(mdvtk::StaticShiftArrayName, shifts));
+    outputs[b] = mdvtk::MovedCopy(read.leaves[b].data, points);
+    outputs[b]->GetPointData()->AddArray(mdvtk::ToVtkArray(mdvtk::StaticShiftArrayName, shifts));
     // Field data describes this output only: the upstream measures (a deformation's volume
     // change, iterations, ...) no longer hold once points have moved.
     vtkNew<vtkFieldData> fieldData;
-    const md::StaticResolveReport& r = resolved.reports[k];
-    const md::TriangleMesh& reference = restGiven ? deformableRest[k] : deformable[k];
-    const double referenceVolume = md::SignedVolume(reference.points, reference.triangles);
-    const double volume = md::SignedVolume(resolved.points[k], deformable[k].triangles);
-    mdvtk::AddFieldValue(fieldData, mdvtk::VolumeChangeArrayName, 100.0 * (volume - referenceVolume) / referenceVolume);
-    mdvtk::AddFieldValue(fieldData, "PenetratingPointCount", r.penetratingPoints);
-    mdvtk::AddFieldValue(fieldData, "PenetratingGroupCount", r.groups);
-    mdvtk::AddFieldValue(fieldData, "MaxPenetrationDepth", frame.LengthToWorld(r.maxDepth));
-    mdvtk::AddFieldValue(fieldData, "MaxStaticShift", frame.LengthToWorld(r.maxShift));
-    mdvtk::AddFieldValue(fieldData, "NewPenetrationCount", left[k].count);
-    mdvtk::AddFieldValue(fieldData, "MaxNewPenetrationDepth", frame.LengthToWorld(left[k].maxDepth));
-    output->SetFieldData(fieldData);
-    outputs[b] = output;
+    const md::StaticResolveReport& r = step.resolved.reports[k];
+    mdvtk::AddMeasures(fieldData,
+      { { mdvtk::VolumeChangeArrayName, step.volumeChangePercent[k] },
+        { "PenetratingPointCount", static_cast<double>(r.penetratingPoints), true },
+        { "PenetratingGroupCount", static_cast<double>(r.groups), true },
+        { "MaxPenetrationDepth", frame.LengthToWorld(r.maxDepth) },
+        { mdvtk::array::MaxStaticShift, frame.LengthToWorld(r.maxShift) },
+        { mdvtk::array::NewPenetrationCount, static_cast<double>(step.left[k].count), true },
+        { mdvtk::array::MaxNewPenetrationDepth, frame.LengthToWorld(step.left[k].maxDepth) } });
+    outputs[b]->SetFieldData(fieldData);
   }
-  for (const auto& [b, message] : failedBlocks)
+  for (const auto& [b, message] : read.failedBlocks)
   {
-    outputs[b] = mdvtk::FailedMuscle(leaves[b].data, message);
+    outputs[b] = mdvtk::FailedMuscle(read.leaves[b].data, message);
   }
-  mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), outputs, mdvtk::Role::Muscle);
+  mdvtk::AssignLeaves(
+    vtkDataObject::GetData(inputVector[0], 0), vtkDataObject::GetData(outputVector, 0), outputs, mdvtk::Role::Muscle);
   this->UpdateProgress(1.0);
   return 1;
+}
+
+bool vtkIntersectionResolve::ReadInputs(vtkInformationVector** inputVector, Read& read)
+{
+  std::vector<md::TriangleMesh> meshes;
+  std::string error;
+  if (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[0], 0), "Input", read.leaves, error) ||
+    !ReadLeafMeshes(read.leaves, meshes, error, &read.failedBlocks) ||
+    !mdvtk::ReadMeshes(inputVector[1], "Obstacles", read.obstacleNames, read.obstacles, error) ||
+    !mdvtk::ReadMeshes(inputVector[3], "ObstaclesRest", read.restObstacleNames, read.restObstacles, error))
+  {
+    vtkErrorMacro(<< error);
+    return false;
+  }
+  if (inputVector[1]->GetNumberOfInformationObjects() == 0)
+  {
+    vtkWarningMacro(<< "no Obstacles are connected: only the Input's meshes are kept out of one another, "
+                       "nothing keeps them out of the bones; connect the bones in the current pose as Obstacles");
+  }
+  read.restGiven = inputVector[2]->GetNumberOfInformationObjects() > 0;
+  if (!read.restGiven && !read.restObstacles.empty())
+  {
+    vtkWarningMacro(<< "ObstaclesRest is connected but InputRest is not: all penetration is resolved");
+  }
+  if (read.restGiven && !this->ObstaclesPair(read))
+  {
+    return false;
+  }
+  // Only the leaves with data take part; `used[k]` is the leaf of mesh k.
+  std::vector<mdvtk::Leaf> restLeaves;
+  std::vector<size_t> restOf;
+  std::vector<md::TriangleMesh> restMeshes;
+  if (read.restGiven &&
+    (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[2], 0), "InputRest", restLeaves, error) ||
+      !mdvtk::PairLeaves(this, read.leaves, "Input", restLeaves, "InputRest", restOf, error) ||
+      !ReadLeafMeshes(restLeaves, restMeshes, error)))
+  {
+    vtkErrorMacro(<< error);
+    return false;
+  }
+  for (size_t b = 0; b < read.leaves.size(); ++b)
+  {
+    if (!read.leaves[b].data || read.failedBlocks.count(b))
+    {
+      continue;
+    }
+    if (read.restGiven)
+    {
+      const md::TriangleMesh& rest = restMeshes[restOf[b]];
+      if (rest.points.rows() != meshes[b].points.rows())
+      {
+        read.failedBlocks[b] = restLeaves[restOf[b]].label + " has " + std::to_string(rest.points.rows()) +
+          " points but " + read.leaves[b].label + " has " + std::to_string(meshes[b].points.rows()) +
+          ": InputRest must be the Input in the rest pose, with the same points";
+        continue;
+      }
+      read.deformableRest.push_back({ rest.points, meshes[b].triangles });
+    }
+    read.deformable.push_back(meshes[b]);
+    read.used.push_back(b);
+  }
+  return true;
+}
+
+bool vtkIntersectionResolve::ObstaclesPair(const Read& read)
+{
+  if (read.restObstacles.empty())
+  {
+    return true;
+  }
+  if (read.restObstacles.size() != read.obstacles.size())
+  {
+    vtkErrorMacro(<< "ObstaclesRest has " << read.restObstacles.size() << " meshes but Obstacles has "
+                  << read.obstacles.size() << ": connect the same obstacles in both poses, in the same order");
+    return false;
+  }
+  for (size_t o = 0; o < read.obstacles.size(); ++o)
+  {
+    if (read.restObstacles[o].points.rows() != read.obstacles[o].points.rows())
+    {
+      vtkErrorMacro(<< "obstacle '" << read.obstacleNames[o] << "' has " << read.obstacles[o].points.rows()
+                    << " points but its rest pose '" << read.restObstacleNames[o] << "' has "
+                    << read.restObstacles[o].points.rows() << ": both poses must have the same points");
+      return false;
+    }
+  }
+  return true;
 }
 
 void vtkIntersectionResolve::PrintSelf(ostream& os, vtkIndent indent)

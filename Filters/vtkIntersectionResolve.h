@@ -61,9 +61,15 @@ protected:
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  double DeformableShare = 0.6;
+  double DeformableShare; // the core's default (md::StaticResolveParameters), set by the constructor
 
 private:
   vtkIntersectionResolve(const vtkIntersectionResolve&) = delete;
   void operator=(const vtkIntersectionResolve&) = delete;
+  struct Read;
+  /// Reads the meshes to resolve and the obstacles in both poses; false when an input cannot be
+  /// read (reported). A mesh that cannot be used is left out, in read.failedBlocks.
+  bool ReadInputs(vtkInformationVector** inputVector, Read& read);
+  /// Whether the rest-pose obstacles (when given) pair with the obstacles, one for one.
+  bool ObstaclesPair(const Read& read);
 };

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkMotionMuscleDeformation.h"
 
-#include "InterpolatedDeformation.h"
 #include "MDBlocks.h"
-#include "MotionDeformation.h"
+#include "Method/InterpolatedDeformation.h"
+#include "Method/MotionDeformation.h"
 
 #include <vtkDemandDrivenPipeline.h>
 #include <vtkDoubleArray.h>
@@ -28,9 +28,10 @@ namespace
 using SDDP = vtkStreamingDemandDrivenPipeline;
 const char* const PortNames[] = { "Input", "BonesRest", "BonesMotion", "ActionLinesRest", "ActionLinesMotion" };
 constexpr int kMotionPorts[] = { 2, 4 };
+}
 
 /// What the frames were computed from: when any of it changes, the motion starts again.
-struct Signature
+struct vtkMotionMuscleDeformation::Signature
 {
   vtkMTimeType restInputs = 0;     ///< the rest-pose inputs' data
   vtkMTimeType motionPipeline = 0; ///< the time-varying inputs' pipelines (their sources' settings)
@@ -49,6 +50,8 @@ struct Signature
   }
 };
 
+namespace
+{
 /// The time steps advertised on an input (none: empty).
 std::vector<double> TimesOf(vtkInformation* info)
 {
@@ -58,18 +61,6 @@ std::vector<double> TimesOf(vtkInformation* info)
   }
   const double* values = info->Get(SDDP::TIME_STEPS());
   return std::vector<double>(values, values + info->Length(SDDP::TIME_STEPS()));
-}
-
-/// Index of the time nearest `time`.
-int NearestFrame(const std::vector<double>& times, double time)
-{
-  const auto after = std::lower_bound(times.begin(), times.end(), time);
-  size_t k = static_cast<size_t>(after - times.begin());
-  if (k == times.size() || (k > 0 && time - times[k - 1] < times[k] - time))
-  {
-    k = k == 0 ? 0 : k - 1;
-  }
-  return static_cast<int>(k);
 }
 
 double Bytes(const md::Points& p)
@@ -95,6 +86,27 @@ struct FrameMeasures
   std::vector<double> smoothnessRatio;
   int steps = 0;
   double seconds = 0;
+
+  /// Muscle `m`'s measures, as written to its field data.
+  std::vector<mdvtk::Measure> Of(size_t m) const
+  {
+    std::vector<mdvtk::Measure> all = mdvtk::StepMeasures(this->measures[m], this->measures[m].stepIterations, false);
+    all.push_back({ mdvtk::array::SecondDifference, this->secondDifference[m] });
+    all.push_back({ mdvtk::array::SmoothnessRatio, this->smoothnessRatio[m] });
+    return all;
+  }
+  /// The measure of muscle `m` called `name`.
+  double Value(size_t m, const std::string& name) const
+  {
+    for (const mdvtk::Measure& measure : this->Of(m))
+    {
+      if (name == measure.name)
+      {
+        return measure.value;
+      }
+    }
+    return std::nan("");
+  }
 };
 
 struct vtkMotionMuscleDeformation::Internals
@@ -162,6 +174,61 @@ struct vtkMotionMuscleDeformation::Internals
       this->frames.erase(farthest);
     }
   }
+  /// The muscles not failed, by their block.
+  std::map<size_t, size_t> MuscleOfBlock() const
+  {
+    std::map<size_t, size_t> muscleOfBlock;
+    for (size_t m = 0; m < this->blockOf.size(); ++m)
+    {
+      if (this->deformation->Failures()[m].empty())
+      {
+        muscleOfBlock[this->blockOf[m]] = m;
+      }
+    }
+    return muscleOfBlock;
+  }
+  /// Keeps frame `k`: the muscles where `advanced` left them, the pose that drove them, where the
+  /// motion stands, and the frame's measures, with how smoothly the muscles follow what drives
+  /// them over the last three frames.
+  void Keep(int k, md::MotionPose pose, const md::MotionFrameResult& advanced)
+  {
+    FrameKept kept;
+    kept.state = this->deformation->Save();
+    kept.points.resize(this->blockOf.size());
+    FrameMeasures measures;
+    measures.steps = advanced.steps;
+    measures.seconds = advanced.seconds;
+    const auto before = this->frames.find(k - 1);
+    const auto older = this->frames.find(k - 2);
+    const bool threeFrames = k >= 2 && before != this->frames.end() && older != this->frames.end();
+    // What drives the muscles (the bones' points and the lines), once for all muscles.
+    const double driven =
+      threeFrames ? md::LargestSecondDifference(older->second.pose, before->second.pose, pose) : 0.0;
+    for (size_t m = 0; m < this->blockOf.size(); ++m)
+    {
+      kept.points[m] = advanced.points[m];
+      md::MuscleStepMeasures s = advanced.measures[m];
+      s.staticShift = md::Points(0, 3);
+      measures.measures.push_back(s);
+      double second = std::nan(""), ratio = std::nan("");
+      if (threeFrames && kept.points[m].rows() > 0)
+      {
+        second = md::LargestSecondDifference(older->second.points[m], before->second.points[m], kept.points[m]);
+        ratio = driven > 0 ? second / driven : std::nan("");
+      }
+      measures.secondDifference.push_back(second);
+      measures.smoothnessRatio.push_back(ratio);
+      kept.bytes += Bytes(kept.points[m]);
+    }
+    for (const md::Points& p : pose.bones)
+    {
+      kept.bytes += Bytes(p);
+    }
+    kept.bytes += static_cast<double>(md::MotionDeformation::StateBytes(*kept.state));
+    kept.pose = std::move(pose);
+    this->frames[k] = std::move(kept);
+    this->measures[k] = std::move(measures);
+  }
   /// The frame to compute first for `target`: after the last one kept before it.
   int FirstMissing(int target) const
   {
@@ -179,6 +246,11 @@ vtkMotionMuscleDeformation::vtkMotionMuscleDeformation()
 {
   this->SetNumberOfInputPorts(5);
   this->SetNumberOfOutputPorts(4);
+  const md::InterpolationParameters method;
+  this->MaximumStepDisplacement = method.maximumStepDisplacement;
+  this->BoneInterpolationMode = static_cast<int>(method.interpolationMode);
+  this->DeformableShare = method.staticResolve.deformableShare;
+  this->PreserveVolume = method.deformation.preserveVolume;
 }
 
 vtkMotionMuscleDeformation::~vtkMotionMuscleDeformation() = default;
@@ -232,11 +304,7 @@ int vtkMotionMuscleDeformation::RequestInformation(
 {
   const std::vector<double> bones = TimesOf(inputVector[2]->GetInformationObject(0));
   const std::vector<double> lines = TimesOf(inputVector[4]->GetInformationObject(0));
-  for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
-  {
-    outputVector->GetInformationObject(port)->Remove(SDDP::TIME_STEPS());
-    outputVector->GetInformationObject(port)->Remove(SDDP::TIME_RANGE());
-  }
+  mdvtk::AdvertiseTimes(outputVector, {});
   if (bones.empty() || lines.empty())
   {
     vtkErrorMacro(<< (bones.empty() ? PortNames[2] : PortNames[4])
@@ -265,13 +333,7 @@ int vtkMotionMuscleDeformation::RequestInformation(
                   << "): a motion needs two frames or more; for one pose use InterpolatedMuscleDeformation");
     return 0;
   }
-  for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
-  {
-    vtkInformation* info = outputVector->GetInformationObject(port);
-    info->Set(SDDP::TIME_STEPS(), bones.data(), static_cast<int>(bones.size()));
-    const double range[2] = { bones.front(), bones.back() };
-    info->Set(SDDP::TIME_RANGE(), range, 2);
-  }
+  mdvtk::AdvertiseTimes(outputVector, bones);
   return 1;
 }
 
@@ -284,8 +346,9 @@ int vtkMotionMuscleDeformation::RequestUpdateExtent(
   {
     mdvtk::ClearOutputs(outputVector);
     vtkInformation* outInfo = outputVector->GetInformationObject(0);
-    in.target = outInfo->Has(SDDP::UPDATE_TIME_STEP()) ? NearestFrame(times, outInfo->Get(SDDP::UPDATE_TIME_STEP()))
-                                                       : static_cast<int>(times.size()) - 1;
+    in.target = outInfo->Has(SDDP::UPDATE_TIME_STEP())
+      ? mdvtk::NearestTime(times, outInfo->Get(SDDP::UPDATE_TIME_STEP()))
+      : static_cast<int>(times.size()) - 1;
     in.gather = in.signature.times == times ? in.FirstMissing(in.target) : 0;
   }
   // The time-varying inputs at the frame to compute; when none is to be computed, at the time
@@ -319,17 +382,18 @@ int vtkMotionMuscleDeformation::RequestUpdateExtent(
   return 1;
 }
 
-namespace
-{
 /// The leaves of the inputs, read and paired the same way at every frame.
-struct Leaves
+struct vtkMotionMuscleDeformation::Leaves
 {
-  std::vector<mdvtk::Leaf> muscles, restLines, motionLines, restBones, motionBones;
+  std::vector<mdvtk::Leaf> muscles, restLines, motionLines, restBones;
   std::vector<size_t> restLinesOf, motionLinesOf;
 };
 
+namespace
+{
 /// The rest-pose inputs are checked only where they were modified since they last passed
 /// (`checked`, per port): a frame checks the time-varying inputs.
+template<class Leaves>
 bool CollectInputs(vtkMotionMuscleDeformation* self, vtkDataObject* const inputs[5], mdvtk::InputCheck checked[5],
   Leaves& leaves, std::string& error)
 {
@@ -341,19 +405,79 @@ bool CollectInputs(vtkMotionMuscleDeformation* self, vtkDataObject* const inputs
     mdvtk::PairLeaves(
       self, leaves.restLines, PortNames[3], leaves.motionLines, PortNames[4], leaves.motionLinesOf, error);
 }
+
+/// The columns of output 3 for each muscle, of the measures each frame keeps.
+const char* const TableMeasures[] = { mdvtk::VolumeChangeArrayName, mdvtk::array::NewPenetrationCount,
+  mdvtk::array::MaxNewBonePenetrationDepth, mdvtk::array::MaxStaticShift, mdvtk::array::SharpEdgeCount,
+  mdvtk::array::FlippedTriangleCount, mdvtk::array::NumberOfIterations, mdvtk::array::Converged,
+  mdvtk::array::SecondDifference, mdvtk::array::SmoothnessRatio };
 }
 
 int vtkMotionMuscleDeformation::RequestData(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   Internals& in = *this->In;
-  auto stop = [&](int result) {
-    in.gather = -1;
-    in.looping = false;
-    request->Remove(SDDP::CONTINUE_EXECUTING());
-    return result;
-  };
   vtkDataObject* inputs[5];
+  const Signature signature = this->SignatureOf(inputVector, inputs);
+  if (signature.times.size() < 2)
+  {
+    return this->Stop(request, 0); // RequestInformation said why
+  }
+  Leaves leaves;
+  std::string error;
+  if (!CollectInputs(this, inputs, in.checked, leaves, error))
+  {
+    vtkErrorMacro(<< error);
+    return this->Stop(request, 0);
+  }
+  if (!(signature == in.signature))
+  {
+    in.Restart();
+    in.signature = signature;
+    if (in.gather != 0)
+    {
+      in.gather = 0; // the inputs of this pass may be of another time: start from the first frame
+      return this->GoOn(request);
+    }
+  }
+  int result = 1;
+  if (!in.deformation && !this->Start(leaves, result))
+  {
+    in.Restart();
+    return this->Stop(request, result);
+  }
+  if (in.gather < 0 && in.FirstMissing(in.target) >= 0)
+  {
+    in.gather = in.FirstMissing(in.target); // dropped from the cache since the request was made
+    return this->GoOn(request);
+  }
+  if (in.gather >= 0)
+  {
+    // This pass's time-varying inputs hold frame `gather`: read its pose and deform to it.
+    if (!this->ComputeFrame(inputs[2], leaves, result))
+    {
+      return this->Stop(request, result);
+    }
+    if (in.gather < in.target)
+    {
+      ++in.gather;
+      return this->GoOn(request);
+    }
+    this->Stop(request, 1);
+  }
+  // The frame asked for, from the cache (kept within a limit that may have been lowered).
+  in.Evict(this->CacheMemoryLimit, in.target);
+  this->WriteMuscles(inputs[0], leaves, vtkDataObject::GetData(outputVector, 0));
+  this->WriteBonesAndLines(inputs, leaves, outputVector);
+  this->WriteTable(leaves, vtkTable::GetData(outputVector, 3));
+  mdvtk::SetDataTime(outputVector, in.signature.times[in.target]);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+vtkMotionMuscleDeformation::Signature vtkMotionMuscleDeformation::SignatureOf(
+  vtkInformationVector** inputVector, vtkDataObject* inputs[5])
+{
   Signature signature;
   for (int port = 0; port < 5; ++port)
   {
@@ -373,329 +497,247 @@ int vtkMotionMuscleDeformation::RequestData(
   signature.interpolationMode = this->BoneInterpolationMode;
   signature.deformableShare = this->DeformableShare;
   signature.preserveVolume = this->PreserveVolume;
-  const std::vector<double>& times = signature.times;
-  if (times.size() < 2)
-  {
-    return stop(0); // RequestInformation said why
-  }
-  Leaves leaves;
+  return signature;
+}
+
+int vtkMotionMuscleDeformation::Stop(vtkInformation* request, int result)
+{
+  this->In->gather = -1;
+  this->In->looping = false;
+  request->Remove(SDDP::CONTINUE_EXECUTING());
+  return result;
+}
+
+int vtkMotionMuscleDeformation::GoOn(vtkInformation* request)
+{
+  request->Set(SDDP::CONTINUE_EXECUTING(), 1);
+  this->In->looping = true;
+  return 1;
+}
+
+bool vtkMotionMuscleDeformation::Start(const Leaves& leaves, int& result)
+{
+  // The rest pose: muscles, their action lines, bones. One muscle's fault leaves it out.
+  Internals& in = *this->In;
+  std::vector<md::MotionDeformation::Muscle> muscles;
   std::string error;
-  if (!CollectInputs(this, inputs, in.checked, leaves, error))
+  for (size_t b = 0; b < leaves.muscles.size(); ++b)
   {
-    vtkErrorMacro(<< error);
-    return stop(0);
-  }
-  if (!(signature == in.signature))
-  {
-    in.Restart();
-    in.signature = signature;
-    if (in.gather != 0)
+    const mdvtk::Leaf& leaf = leaves.muscles[b];
+    if (!leaf.data)
     {
-      // The inputs of this pass may be of another time: start the motion from its first frame.
-      in.gather = 0;
-      request->Set(SDDP::CONTINUE_EXECUTING(), 1);
-      in.looping = true;
-      return 1;
+      continue;
+    }
+    md::MotionDeformation::Muscle muscle;
+    muscle.name = mdvtk::NameOf(leaf);
+    const mdvtk::Leaf& lines = leaves.restLines[leaves.restLinesOf[b]];
+    if (!mdvtk::ReadMuscleSurface(leaf, muscle.rest, error))
+    {
+      mdvtk::FailBlock(this, in.failedBlocks, b, error);
+      continue;
+    }
+    muscle.restLines = lines.data ? mdvtk::ToPolylines(lines.data) : std::vector<md::Points>{};
+    if (muscle.restLines.empty())
+    {
+      mdvtk::FailBlock(this, in.failedBlocks, b,
+        lines.label + " has no polylines: muscle " + leaf.label +
+          " needs its action lines, or nothing says where it goes");
+      continue;
+    }
+    in.blockOf.push_back(b);
+    in.restPoints.push_back(muscle.rest.points);
+    in.restLines.push_back(muscle.restLines);
+    muscles.push_back(std::move(muscle));
+  }
+  std::vector<md::MotionDeformation::Bone> bones;
+  for (size_t b = 0; b < leaves.restBones.size(); ++b)
+  {
+    const mdvtk::Leaf& leaf = leaves.restBones[b];
+    if (!leaf.data)
+    {
+      continue;
+    }
+    md::MotionDeformation::Bone bone;
+    bone.name = mdvtk::NameOf(leaf);
+    mdvtk::ReadTriangles(leaf.data, bone.rest);
+    if (bone.rest.triangles.rows() == 0)
+    {
+      vtkErrorMacro(<< leaf.label << " has no surface (no polygons)");
+      result = 0;
+      return false;
+    }
+    bones.push_back(std::move(bone));
+    in.boneLeaf.push_back(b);
+  }
+  if (muscles.empty())
+  {
+    if (in.failedBlocks.empty())
+    {
+      vtkErrorMacro(<< PortNames[0] << " has no muscle");
+    }
+    result = 0;
+    return false;
+  }
+  md::InterpolationParameters parameters;
+  parameters.numberOfSteps = this->NumberOfSteps;
+  parameters.maximumStepDisplacement = this->MaximumStepDisplacement;
+  parameters.interpolationMode = static_cast<md::InterpolationMode>(this->BoneInterpolationMode);
+  parameters.staticResolve.deformableShare = this->DeformableShare;
+  parameters.deformation.preserveVolume = this->PreserveVolume;
+  if (!mdvtk::CallCore(
+        this, "",
+        [&] { in.deformation = std::make_unique<md::MotionDeformation>(muscles, bones, parameters, &in.kept); },
+        result))
+  {
+    return false;
+  }
+  for (size_t m = 0; m < muscles.size(); ++m)
+  {
+    if (const std::string& failure = in.deformation->Failures()[m]; !failure.empty())
+    {
+      mdvtk::FailBlock(this, in.failedBlocks, in.blockOf[m], leaves.muscles[in.blockOf[m]].label + ": " + failure);
     }
   }
+  for (const std::string& warning : in.deformation->Warnings())
+  {
+    vtkWarningMacro(<< warning);
+  }
+  return true;
+}
 
-  if (!in.deformation)
+bool vtkMotionMuscleDeformation::ReadPose(
+  vtkDataObject* motionBones, const Leaves& leaves, md::MotionPose& pose, int& result)
+{
+  Internals& in = *this->In;
+  const double time = in.signature.times[in.gather];
+  std::vector<mdvtk::Leaf> bonesNow;
+  std::vector<size_t> partner;
+  std::string error;
+  if (!mdvtk::CollectLeaves(motionBones, PortNames[2], bonesNow, error) ||
+    !mdvtk::PairLeaves(this, leaves.restBones, PortNames[1], bonesNow, PortNames[2], partner, error))
   {
-    // The rest pose: muscles, their action lines, bones. One muscle's fault leaves it out.
-    auto fail = [&](size_t block, const std::string& message, bool reported = false) {
-      if (!reported)
-      {
-        vtkErrorMacro(<< message);
-      }
-      in.failedBlocks[block] = message;
-    };
-    std::vector<md::MotionDeformation::Muscle> muscles;
-    for (size_t b = 0; b < leaves.muscles.size(); ++b)
+    vtkErrorMacro(<< "at time " << time << ": " << error);
+    result = 0;
+    return false;
+  }
+  for (size_t leaf : in.boneLeaf)
+  {
+    const mdvtk::Leaf& moving = bonesNow[partner[leaf]];
+    pose.bones.push_back(moving.data ? mdvtk::ToPoints(moving.data->GetPoints()) : md::Points(0, 3));
+    if (pose.bones.back().rows() != leaves.restBones[leaf].data->GetNumberOfPoints())
     {
-      const mdvtk::Leaf& leaf = leaves.muscles[b];
-      if (!leaf.data)
-      {
-        continue;
-      }
-      md::MotionDeformation::Muscle muscle;
-      muscle.name = leaf.name.empty() ? leaf.label : leaf.name;
-      mdvtk::ReadTriangles(leaf.data, muscle.rest);
-      const mdvtk::Leaf& lines = leaves.restLines[leaves.restLinesOf[b]];
-      if (muscle.rest.triangles.rows() == 0)
-      {
-        fail(b, leaf.label + " has no surface (no polygons); a muscle must be a closed triangle surface");
-        continue;
-      }
-      muscle.restLines = lines.data ? mdvtk::ToPolylines(lines.data) : std::vector<md::Points>{};
-      if (muscle.restLines.empty())
-      {
-        fail(b,
-          lines.label + " has no polylines: muscle " + leaf.label +
-            " needs its action lines, or nothing says where it goes");
-        continue;
-      }
-      in.blockOf.push_back(b);
-      in.restPoints.push_back(muscle.rest.points);
-      in.restLines.push_back(muscle.restLines);
-      muscles.push_back(std::move(muscle));
-    }
-    std::vector<md::MotionDeformation::Bone> bones;
-    for (size_t b = 0; b < leaves.restBones.size(); ++b)
-    {
-      const mdvtk::Leaf& leaf = leaves.restBones[b];
-      if (!leaf.data)
-      {
-        continue;
-      }
-      md::MotionDeformation::Bone bone;
-      bone.name = leaf.name.empty() ? leaf.label : leaf.name;
-      mdvtk::ReadTriangles(leaf.data, bone.rest);
-      if (bone.rest.triangles.rows() == 0)
-      {
-        vtkErrorMacro(<< leaf.label << " has no surface (no polygons)");
-        in.Restart();
-        return stop(0);
-      }
-      bones.push_back(std::move(bone));
-      in.boneLeaf.push_back(b);
-    }
-    if (muscles.empty())
-    {
-      if (in.failedBlocks.empty())
-      {
-        vtkErrorMacro(<< PortNames[0] << " has no muscle");
-      }
-      in.Restart();
-      return stop(0);
-    }
-    md::InterpolationParameters parameters;
-    parameters.numberOfSteps = this->NumberOfSteps;
-    parameters.maximumStepDisplacement = this->MaximumStepDisplacement;
-    parameters.interpolationMode = static_cast<md::InterpolationMode>(this->BoneInterpolationMode);
-    parameters.staticResolve.deformableShare = this->DeformableShare;
-    parameters.deformation.preserveVolume = this->PreserveVolume;
-    int result = 1;
-    if (!mdvtk::CallCore(
-          this, "",
-          [&] { in.deformation = std::make_unique<md::MotionDeformation>(muscles, bones, parameters, &in.kept); },
-          result))
-    {
-      in.Restart();
-      return stop(result);
-    }
-    for (size_t m = 0; m < muscles.size(); ++m)
-    {
-      const std::string& failure = in.deformation->Failures()[m];
-      if (!failure.empty())
-      {
-        fail(in.blockOf[m], leaves.muscles[in.blockOf[m]].label + ": " + failure);
-      }
-    }
-    for (const std::string& warning : in.deformation->Warnings())
-    {
-      vtkWarningMacro(<< warning);
+      vtkErrorMacro(<< moving.label << " has " << pose.bones.back().rows() << " points at time " << time << " but "
+                    << leaves.restBones[leaf].label << " has " << leaves.restBones[leaf].data->GetNumberOfPoints()
+                    << ": a bone must keep its points through the motion");
+      result = 0;
+      return false;
     }
   }
-
-  if (in.gather < 0 && in.FirstMissing(in.target) >= 0)
+  pose.lines.resize(in.blockOf.size());
+  for (size_t m = 0; m < in.blockOf.size(); ++m)
   {
-    in.gather = in.FirstMissing(in.target); // dropped from the cache since the request was made
-    request->Set(SDDP::CONTINUE_EXECUTING(), 1);
-    in.looping = true;
-    return 1;
-  }
-  if (in.gather >= 0)
-  {
-    // This pass's time-varying inputs hold frame `gather`: read its pose and deform to it.
-    const int k = in.gather;
-    std::vector<mdvtk::Leaf> motionBones;
-    std::vector<size_t> partner;
-    if (!mdvtk::CollectLeaves(inputs[2], PortNames[2], motionBones, error) ||
-      !mdvtk::PairLeaves(this, leaves.restBones, PortNames[1], motionBones, PortNames[2], partner, error))
+    if (!in.deformation->Failures()[m].empty())
     {
-      vtkErrorMacro(<< "at time " << times[k] << ": " << error);
-      return stop(0);
+      continue;
     }
-    md::MotionPose pose;
-    for (size_t leaf : in.boneLeaf)
+    const size_t restLeaf = leaves.restLinesOf[in.blockOf[m]];
+    const mdvtk::Leaf& moving = leaves.motionLines[leaves.motionLinesOf[restLeaf]];
+    const std::vector<md::Points> lines = moving.data ? mdvtk::ToPolylines(moving.data) : std::vector<md::Points>{};
+    if (lines.size() != in.restLines[m].size())
     {
-      const mdvtk::Leaf& moving = motionBones[partner[leaf]];
-      pose.bones.push_back(moving.data ? mdvtk::ToPoints(moving.data->GetPoints()) : md::Points(0, 3));
-      if (pose.bones.back().rows() != leaves.restBones[leaf].data->GetNumberOfPoints())
-      {
-        vtkErrorMacro(<< moving.label << " has " << pose.bones.back().rows() << " points at time " << times[k]
-                      << " but " << leaves.restBones[leaf].label << " has "
-                      << leaves.restBones[leaf].data->GetNumberOfPoints()
-                      << ": a bone must keep its points through the motion");
-        return stop(0);
-      }
+      vtkErrorMacro(<< moving.label << " has " << lines.size() << " action lines at time " << time << " but "
+                    << leaves.restLines[restLeaf].label << " has " << in.restLines[m].size()
+                    << ": the lines of a muscle pair by order through the motion");
+      result = 0;
+      return false;
     }
-    pose.lines.resize(in.blockOf.size());
-    for (size_t m = 0; m < in.blockOf.size(); ++m)
-    {
-      if (!in.deformation->Failures()[m].empty())
-      {
-        continue;
-      }
-      const size_t restLeaf = leaves.restLinesOf[in.blockOf[m]];
-      const mdvtk::Leaf& moving = leaves.motionLines[leaves.motionLinesOf[restLeaf]];
-      const std::vector<md::Points> lines = moving.data ? mdvtk::ToPolylines(moving.data) : std::vector<md::Points>{};
-      if (lines.size() != in.restLines[m].size())
-      {
-        vtkErrorMacro(<< moving.label << " has " << lines.size() << " action lines at time " << times[k] << " but "
-                      << leaves.restLines[restLeaf].label << " has " << in.restLines[m].size()
-                      << ": the lines of a muscle pair by order through the motion");
-        return stop(0);
-      }
-      int result = 1;
-      if (!mdvtk::CallCore(
-            this, moving.label + " at time " + std::to_string(times[k]) + ": ",
-            [&] {
-              for (size_t l = 0; l < lines.size(); ++l)
-              {
-                pose.lines[m].push_back(md::AtRestParameters(in.restLines[m][l], lines[l]));
-              }
-            },
-            result))
-      {
-        return stop(result);
-      }
-    }
-    // From the frame before (the rest pose before the first), wherever the motion stands now.
-    const auto before = in.frames.find(k - 1);
-    md::MotionFrameResult advanced;
-    int result = 1;
-    const int first = in.FirstMissing(in.target) < 0 ? k : std::min(k, in.FirstMissing(in.target));
-    const double share = 1.0 / std::max(1, in.target - first + 1);
     if (!mdvtk::CallCore(
-          this, "at time " + std::to_string(times[k]) + ": ",
+          this, moving.label + " at time " + std::to_string(time) + ": ",
           [&] {
-            if (k > 0 && before == in.frames.end())
+            for (size_t l = 0; l < lines.size(); ++l)
             {
-              throw md::ComputationError("frame " + std::to_string(k - 1) + " is not kept"); // not reached
+              pose.lines[m].push_back(md::AtRestParameters(in.restLines[m][l], lines[l]));
             }
-            in.deformation->Resume(k > 0 ? before->second.state : nullptr);
-            advanced = in.deformation->Advance(pose, mdvtk::ProgressOrCancel(this, (k - first) * share, share));
           },
           result))
     {
-      return stop(result);
+      return false;
     }
-    ++in.framesComputed;
-    for (const std::string& warning : advanced.warnings)
-    {
-      vtkWarningMacro(<< "at time " << times[k] << ": " << warning);
-    }
-    FrameKept kept;
-    kept.pose = pose;
-    kept.state = in.deformation->Save();
-    kept.points.resize(in.blockOf.size());
-    FrameMeasures measures;
-    measures.steps = advanced.steps;
-    measures.seconds = advanced.seconds;
-    const auto older = in.frames.find(k - 2);
-    const bool threeFrames = k >= 2 && before != in.frames.end() && older != in.frames.end();
-    // What drives the muscles (the bones' points and the lines), once for all muscles.
-    const double driven =
-      threeFrames ? md::LargestSecondDifference(older->second.pose, before->second.pose, pose) : 0.0;
-    for (size_t m = 0; m < in.blockOf.size(); ++m)
-    {
-      kept.points[m] = advanced.points[m];
-      md::MuscleStepMeasures s = advanced.measures[m];
-      s.staticShift = md::Points(0, 3);
-      measures.measures.push_back(s);
-      double second = std::nan(""), ratio = std::nan("");
-      if (threeFrames && kept.points[m].rows() > 0)
-      {
-        second = md::LargestSecondDifference(older->second.points[m], before->second.points[m], kept.points[m]);
-        ratio = driven > 0 ? second / driven : std::nan("");
-      }
-      measures.secondDifference.push_back(second);
-      measures.smoothnessRatio.push_back(ratio);
-      kept.bytes += Bytes(kept.points[m]);
-    }
-    for (const md::Points& p : pose.bones)
-    {
-      kept.bytes += Bytes(p);
-    }
-    kept.bytes += static_cast<double>(md::MotionDeformation::StateBytes(*kept.state));
-    in.frames[k] = std::move(kept);
-    in.measures[k] = std::move(measures);
-    in.Evict(this->CacheMemoryLimit, k);
-    if (k < in.target)
-    {
-      in.gather = k + 1;
-      request->Set(SDDP::CONTINUE_EXECUTING(), 1);
-      in.looping = true;
-      return 1;
-    }
-    stop(1);
   }
+  return true;
+}
 
-  // The frame asked for, from the cache (kept within a limit that may have been lowered).
-  const int k = in.target;
+bool vtkMotionMuscleDeformation::ComputeFrame(vtkDataObject* motionBones, const Leaves& leaves, int& result)
+{
+  Internals& in = *this->In;
+  const int k = in.gather;
+  md::MotionPose pose;
+  if (!this->ReadPose(motionBones, leaves, pose, result))
+  {
+    return false;
+  }
+  // From the frame before (the rest pose before the first), wherever the motion stands now.
+  const auto before = in.frames.find(k - 1);
+  md::MotionFrameResult advanced;
+  const int first = in.FirstMissing(in.target) < 0 ? k : std::min(k, in.FirstMissing(in.target));
+  const double share = 1.0 / std::max(1, in.target - first + 1);
+  if (!mdvtk::CallCore(
+        this, "at time " + std::to_string(in.signature.times[k]) + ": ",
+        [&] {
+          if (k > 0 && before == in.frames.end())
+          {
+            throw md::ComputationError("frame " + std::to_string(k - 1) + " is not kept"); // not reached
+          }
+          in.deformation->Resume(k > 0 ? before->second.state : nullptr);
+          advanced = in.deformation->Advance(pose, mdvtk::ProgressOrCancel(this, (k - first) * share, share));
+        },
+        result))
+  {
+    return false;
+  }
+  ++in.framesComputed;
+  for (const std::string& warning : advanced.warnings)
+  {
+    vtkWarningMacro(<< "at time " << in.signature.times[k] << ": " << warning);
+  }
+  in.Keep(k, std::move(pose), advanced);
   in.Evict(this->CacheMemoryLimit, k);
+  return true;
+}
+
+void vtkMotionMuscleDeformation::WriteMuscles(vtkDataObject* input, const Leaves& leaves, vtkDataObject* output)
+{
+  const Internals& in = *this->In;
+  const int k = in.target;
   const FrameKept& frame = in.frames.at(k);
   const FrameMeasures& measures = in.measures.at(k);
   std::vector<vtkSmartPointer<vtkPolyData>> outputs(leaves.muscles.size());
-  std::map<size_t, size_t> muscleOfBlock;
-  for (size_t m = 0; m < in.blockOf.size(); ++m)
+  for (const auto& [b, message] : in.failedBlocks)
   {
-    if (in.deformation->Failures()[m].empty())
-    {
-      muscleOfBlock[in.blockOf[m]] = m;
-    }
+    outputs[b] = mdvtk::FailedMuscle(leaves.muscles[b].data, message);
   }
-  for (size_t b = 0; b < leaves.muscles.size(); ++b)
+  for (const auto& [b, m] : in.MuscleOfBlock())
   {
-    const auto failed = in.failedBlocks.find(b);
-    if (failed != in.failedBlocks.end())
-    {
-      outputs[b] = mdvtk::FailedMuscle(leaves.muscles[b].data, failed->second);
-      continue;
-    }
-    const auto found = muscleOfBlock.find(b);
-    if (found == muscleOfBlock.end())
-    {
-      continue; // an empty block
-    }
-    const size_t m = found->second;
-    const md::MuscleStepMeasures& s = measures.measures[m];
-    auto output = vtkSmartPointer<vtkPolyData>::New();
-    output->ShallowCopy(leaves.muscles[b].data);
-    output->SetPoints(mdvtk::ToVtkPoints(frame.points[m]));
-    output->GetPointData()->AddArray(
-      mdvtk::ToVtkArray(mdvtk::DisplacementArrayName, frame.points[m] - in.restPoints[m]));
-    vtkNew<vtkFieldData> fieldData;
-    fieldData->DeepCopy(leaves.muscles[b].data->GetFieldData());
-    mdvtk::AddFieldValue(fieldData, mdvtk::VolumeChangeArrayName, s.volumeChangePercent);
-    mdvtk::AddFieldValue(fieldData, "NewPenetrationCount", s.newPenetrationCount);
-    mdvtk::AddFieldValue(fieldData, "MaxNewPenetrationDepth", s.maxNewPenetrationDepth);
-    mdvtk::AddFieldValue(fieldData, "NewBonePenetrationCount", s.newBonePenetrationCount);
-    mdvtk::AddFieldValue(fieldData, "MaxNewBonePenetrationDepth", s.maxNewBonePenetrationDepth);
-    mdvtk::AddFieldValue(fieldData, "MaxStaticShift", s.maxStaticShift);
-    mdvtk::AddFieldValue(fieldData, "SharpEdgeCount", s.sharpEdgeCount);
-    mdvtk::AddFieldValue(fieldData, "FlippedTriangleCount", s.flippedTriangleCount);
-    mdvtk::AddFieldValue(fieldData, "NumberOfIterations", s.stepIterations);
-    mdvtk::AddFieldValue(fieldData, "Converged", s.converged ? 1 : 0);
-    mdvtk::AddFieldValue(fieldData, "SecondDifference", measures.secondDifference[m]);
-    mdvtk::AddFieldValue(fieldData, "SmoothnessRatio", measures.smoothnessRatio[m]);
-    mdvtk::AddFieldValue(fieldData, "FrameSeconds", measures.seconds);
-    mdvtk::AddFieldValue(fieldData, "Frame", k);
-    mdvtk::AddFieldValue(fieldData, "Time", times[k]);
-    output->SetFieldData(fieldData);
-    outputs[b] = output;
+    outputs[b] = mdvtk::MovedMuscle(leaves.muscles[b].data, frame.points[m], frame.points[m] - in.restPoints[m]);
+    std::vector<mdvtk::Measure> written = measures.Of(m);
+    written.push_back({ mdvtk::array::FrameSeconds, measures.seconds });
+    written.push_back({ mdvtk::array::Frame, static_cast<double>(k), true });
+    written.push_back({ mdvtk::array::Time, in.signature.times[k] });
+    mdvtk::AddMeasures(outputs[b]->GetFieldData(), written);
   }
-  mdvtk::AssignLeaves(inputs[0], vtkDataObject::GetData(outputVector, 0), outputs, mdvtk::Role::Muscle);
+  mdvtk::AssignLeaves(input, output, outputs, mdvtk::Role::Muscle);
+}
 
+void vtkMotionMuscleDeformation::WriteBonesAndLines(
+  vtkDataObject* const inputs[5], const Leaves& leaves, vtkInformationVector* outputVector)
+{
   // Outputs 1 and 2: the bones and the action lines of this frame, as the method used them.
+  const Internals& in = *this->In;
+  const FrameKept& frame = in.frames.at(in.target);
   std::vector<vtkSmartPointer<vtkPolyData>> boneOutputs(leaves.restBones.size());
   for (size_t b = 0; b < in.boneLeaf.size(); ++b)
   {
-    auto bone = vtkSmartPointer<vtkPolyData>::New();
-    bone->ShallowCopy(leaves.restBones[in.boneLeaf[b]].data);
-    bone->SetPoints(mdvtk::ToVtkPoints(frame.pose.bones[b]));
-    boneOutputs[in.boneLeaf[b]] = bone;
+    boneOutputs[in.boneLeaf[b]] = mdvtk::MovedCopy(leaves.restBones[in.boneLeaf[b]].data, frame.pose.bones[b]);
   }
   mdvtk::AssignLeaves(inputs[1], vtkDataObject::GetData(outputVector, 1), boneOutputs, mdvtk::Role::Bone);
   std::vector<vtkSmartPointer<vtkPolyData>> lineOutputs(leaves.restLines.size());
@@ -707,51 +749,13 @@ int vtkMotionMuscleDeformation::RequestData(
     }
   }
   mdvtk::AssignLeaves(inputs[3], vtkDataObject::GetData(outputVector, 2), lineOutputs, mdvtk::Role::ActionLine);
+}
 
+void vtkMotionMuscleDeformation::WriteTable(const Leaves& leaves, vtkTable* table)
+{
   // Output 3: the measures of every frame computed so far, one row per frame.
-  vtkTable* table = vtkTable::GetData(outputVector, 3);
-  std::vector<std::pair<std::string, std::function<double(const FrameMeasures&, size_t)>>> perMuscle = {
-    { mdvtk::VolumeChangeArrayName,
-      [](const FrameMeasures& f, size_t m) {
-        return f.measures[m].volumeChangePercent;
-      } },
-    { "NewPenetrationCount",
-      [](const FrameMeasures& f, size_t m) {
-        return static_cast<double>(f.measures[m].newPenetrationCount);
-      } },
-    { "MaxNewBonePenetrationDepth",
-      [](const FrameMeasures& f, size_t m) {
-        return f.measures[m].maxNewBonePenetrationDepth;
-      } },
-    { "MaxStaticShift",
-      [](const FrameMeasures& f, size_t m) {
-        return f.measures[m].maxStaticShift;
-      } },
-    { "SharpEdgeCount",
-      [](const FrameMeasures& f, size_t m) {
-        return static_cast<double>(f.measures[m].sharpEdgeCount);
-      } },
-    { "FlippedTriangleCount",
-      [](const FrameMeasures& f, size_t m) {
-        return static_cast<double>(f.measures[m].flippedTriangleCount);
-      } },
-    { "NumberOfIterations",
-      [](const FrameMeasures& f, size_t m) {
-        return static_cast<double>(f.measures[m].stepIterations);
-      } },
-    { "Converged",
-      [](const FrameMeasures& f, size_t m) {
-        return f.measures[m].converged ? 1.0 : 0.0;
-      } },
-    { "SecondDifference",
-      [](const FrameMeasures& f, size_t m) {
-        return f.secondDifference[m];
-      } },
-    { "SmoothnessRatio",
-      [](const FrameMeasures& f, size_t m) {
-        return f.smoothnessRatio[m];
-      } },
-  };
+  const Internals& in = *this->In;
+  const std::vector<double>& times = in.signature.times;
   auto column = [&](const std::string& name, auto value) {
     vtkNew<vtkDoubleArray> array;
     array->SetName(name.c_str());
@@ -761,24 +765,18 @@ int vtkMotionMuscleDeformation::RequestData(
     }
     table->AddColumn(array);
   };
-  column("Time", [&](int f, const FrameMeasures&) { return times[f]; });
-  column("Frame", [](int f, const FrameMeasures&) { return static_cast<double>(f); });
+  column(mdvtk::array::Time, [&](int f, const FrameMeasures&) { return times[f]; });
+  column(mdvtk::array::Frame, [](int f, const FrameMeasures&) { return static_cast<double>(f); });
   column("Steps", [](int, const FrameMeasures& f) { return static_cast<double>(f.steps); });
-  column("FrameSeconds", [](int, const FrameMeasures& f) { return f.seconds; });
-  for (const auto& [b, m] : muscleOfBlock)
+  column(mdvtk::array::FrameSeconds, [](int, const FrameMeasures& f) { return f.seconds; });
+  for (const auto& [b, m] : in.MuscleOfBlock())
   {
-    const std::string name = leaves.muscles[b].name.empty() ? leaves.muscles[b].label : leaves.muscles[b].name;
-    for (const auto& [measure, value] : perMuscle)
+    for (const char* measure : TableMeasures)
     {
-      column(measure + " (" + name + ")", [&, m = m](int, const FrameMeasures& f) { return value(f, m); });
+      column(std::string(measure) + " (" + mdvtk::NameOf(leaves.muscles[b]) + ")",
+        [&, m = m](int, const FrameMeasures& f) { return f.Value(m, measure); });
     }
   }
-  for (int p = 0; p < this->GetNumberOfOutputPorts(); ++p)
-  {
-    vtkDataObject::GetData(outputVector, p)->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), times[k]);
-  }
-  this->UpdateProgress(1.0);
-  return 1;
 }
 
 void vtkMotionMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)

@@ -39,6 +39,12 @@
 
 #include <memory>
 
+class vtkTable;
+namespace md
+{
+struct MotionPose;
+}
+
 class MUSCLEDEFORMATIONFILTERS_EXPORT vtkMotionMuscleDeformation : public vtkPassInputTypeAlgorithm
 {
 public:
@@ -98,16 +104,34 @@ protected:
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  int NumberOfSteps = 0;
-  double MaximumStepDisplacement = 20.0;
-  int BoneInterpolationMode = RIGID;
-  double DeformableShare = 0.6;
-  bool PreserveVolume = true;
+  int NumberOfSteps = 0; // automatic: frames far apart get more steps
+  // The core's defaults (md::InterpolationParameters), set by the constructor.
+  double MaximumStepDisplacement;
+  int BoneInterpolationMode;
+  double DeformableShare;
+  bool PreserveVolume;
   double CacheMemoryLimit = 2048.0;
 
 private:
   vtkMotionMuscleDeformation(const vtkMotionMuscleDeformation&) = delete;
   void operator=(const vtkMotionMuscleDeformation&) = delete;
   struct Internals;
+  struct Signature;
+  struct Leaves;
+  /// What the frames depend on, and the inputs of this pass.
+  Signature SignatureOf(vtkInformationVector** inputVector, vtkDataObject* inputs[5]);
+  /// Ends the passes over the motion with `result`, or asks the executive for one more.
+  int Stop(vtkInformation* request, int result);
+  int GoOn(vtkInformation* request);
+  /// Reads the rest pose and makes the motion's deformation; false with RequestData's `result`.
+  bool Start(const Leaves& leaves, int& result);
+  /// Reads the pose of frame In->gather (`motionBones`, the lines of `leaves`).
+  bool ReadPose(vtkDataObject* motionBones, const Leaves& leaves, md::MotionPose& pose, int& result);
+  /// Deforms the muscles to frame In->gather and keeps it.
+  bool ComputeFrame(vtkDataObject* motionBones, const Leaves& leaves, int& result);
+  /// The outputs at the frame asked for: the muscles, the bones and lines, the measures table.
+  void WriteMuscles(vtkDataObject* input, const Leaves& leaves, vtkDataObject* output);
+  void WriteBonesAndLines(vtkDataObject* const inputs[5], const Leaves& leaves, vtkInformationVector* outputVector);
+  void WriteTable(const Leaves& leaves, vtkTable* table);
   std::unique_ptr<Internals> In;
 };

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkMoveWithBodies.h"
 
+#include "Geometry/RigidMotion.h"
 #include "MDBlocks.h"
-#include "OpenSimAttachment.h"
-#include "RigidMotion.h"
+#include "OpenSim/OpenSimAttachment.h"
 
 #include <vtkAbstractArray.h>
 #include <vtkDataArray.h>

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkMuscleDeformation.h"
 
-#include "LocalFrame.h"
+#include "Deformation/MuscleDeformer.h"
+#include "Geometry/LocalFrame.h"
+#include "Geometry/MeanValueCoordinates.h"
+#include "Geometry/MeshChecks.h"
+#include "Hull/ProgressiveHull.h"
+#include "Intersections/SurfacePass.h"
 #include "MDBlocks.h"
-#include "MeanValueCoordinates.h"
-#include "MeshChecks.h"
-#include "MuscleDeformer.h"
-#include "ProgressiveHull.h"
-#include "SurfacePass.h"
 
 #include <vtkCellArray.h>
 #include <vtkDataArray.h>
@@ -128,6 +128,23 @@ struct vtkMuscleDeformation::PassInput
   const md::LocalFrame& frame;
 };
 
+/// What RequestData read, per muscle block (muscles, lines, hulls) or per muscle to deform
+/// (`toDeform`, at blocks `blockOf`), what failed, the obstacles, and the outputs.
+struct vtkMuscleDeformation::Read
+{
+  std::vector<mdvtk::Leaf> muscles, lineLeaves, hullLeaves;
+  std::vector<size_t> lineOf, hullOf;
+  bool hullGiven = false;
+  std::vector<md::TriangleMesh> surfaces, hulls;
+  std::vector<md::MuscleToDeform> toDeform;
+  std::vector<size_t> blockOf;
+  std::map<size_t, std::string> failedBlocks;
+  std::vector<std::string> failures; ///< per muscle to deform
+  std::vector<std::string> obstacleNames;
+  std::vector<md::TriangleMesh> obstacleMeshes;
+  std::vector<vtkSmartPointer<vtkPolyData>> outputs;
+};
+
 struct vtkMuscleDeformation::RestPoseCache
 {
   std::map<size_t, KeptMuscle> hulls;
@@ -144,10 +161,9 @@ bool vtkMuscleDeformation::PassOnSurface(const PassInput& in, std::vector<std::s
   for (size_t m = 0; m < in.toDeform.size(); ++m)
   {
     const size_t b = in.blockOf[m];
-    this->UpdateProgress(0.3 * m / in.toDeform.size());
-    if (this->CheckAbort())
+    if (mdvtk::ProgressOrStop(this, 0.3 * m / in.toDeform.size()))
     {
-      result = 1; // stopped by the user: the executive empties the output
+      result = 1;
       return false;
     }
     toSettle[m] = { in.toDeform[m].name, &in.surfaces[b], in.toDeform[m].lines, nullptr };
@@ -183,10 +199,9 @@ bool vtkMuscleDeformation::PassOnSurface(const PassInput& in, std::vector<std::s
         continue;
       }
     }
-    if (entry.energy->PointsNoLineDrives() > 0)
+    if (const std::string warning = entry.energy->UndrivenWarning(in.toDeform[m].name); !warning.empty())
     {
-      vtkWarningMacro(<< md::PartApartWarning(in.toDeform[m].name, entry.energy->PointsNoLineDrives(),
-                        entry.energy->PointsUsed(), "its surface"));
+      vtkWarningMacro(<< warning);
     }
     toSettle[m].energy = entry.energy.get();
     outcomes[m].restSeconds = SecondsSince(energyStart);
@@ -232,24 +247,70 @@ bool vtkMuscleDeformation::PassOnSurface(const PassInput& in, std::vector<std::s
   return true;
 }
 
+vtkMuscleDeformation::HullReady vtkMuscleDeformation::KeepHull(const PassInput& in, size_t m,
+  const md::TriangleMesh* givenHull, const std::string& hullLabel, std::string& failure, int& result)
+{
+  const size_t b = in.blockOf[m];
+  const mdvtk::Leaf& leaf = in.muscles[b];
+  KeptMuscle& entry = this->Kept->hulls[b];
+  if (entry.Holds(in.surfaces[b], in.frame, givenHull != nullptr, givenHull, this->HullTargetNumberOfPoints))
+  {
+    return HullReady::Yes;
+  }
+  entry = KeptMuscle{};
+  if (givenHull &&
+    !mdvtk::CallCore(
+      this, "", [&] { md::CheckGivenHull(*givenHull, hullLabel, in.surfaces[b], leaf.label, in.frame.rounding); },
+      result, &failure))
+  {
+    return failure.empty() ? HullReady::Stopped : HullReady::No;
+  }
+  md::HullParameters parameters;
+  parameters.targetNumberOfPoints = this->HullTargetNumberOfPoints;
+  parameters.cancelled = mdvtk::AbortRequested(this);
+  if (!mdvtk::CallCore(
+        this, leaf.label + ": ",
+        [&] {
+          if (givenHull)
+          {
+            entry.hull = *givenHull;
+          }
+          else
+          {
+            const md::MuscleHull built = md::BuildMuscleHull(in.surfaces[b], parameters);
+            ++this->HullBuildCount;
+            entry.hull = built.result.hull;
+            if (built.report.Changed())
+            {
+              entry.repairs = built.report.Describe();
+            }
+          }
+          entry.weights = md::MeanValueCoordinates(entry.hull, in.surfaces[b].points);
+        },
+        result, &failure))
+  {
+    entry = KeptMuscle{}; // a hull without its weights is not kept
+    return failure.empty() ? HullReady::Stopped : HullReady::No;
+  }
+  entry.surface = in.surfaces[b];
+  entry.frame = in.frame;
+  entry.hullGiven = givenHull != nullptr;
+  entry.target = this->HullTargetNumberOfPoints;
+  return HullReady::Yes;
+}
+
 bool vtkMuscleDeformation::PassOnHull(const PassInput& in, bool hullGiven, std::vector<md::TriangleMesh>& hulls,
   const std::vector<mdvtk::Leaf>& hullLeaves, const std::vector<size_t>& hullOf, std::vector<std::string>& failures,
   std::vector<std::string>& reportedBefore, std::vector<PassOutcome>& outcomes, int& result)
 {
-  auto failMuscle = [&](size_t m, const std::string& message) {
-    vtkErrorMacro(<< message);
-    failures[m] = message;
-  };
   // Hulls and their mean value coordinates: kept from an earlier run when the muscle (and its
   // given hull, or the hull size) are the same, else checked (given) or built.
   for (size_t m = 0; m < in.toDeform.size(); ++m)
   {
     const size_t b = in.blockOf[m];
-    const mdvtk::Leaf& leaf = in.muscles[b];
-    this->UpdateProgress(0.3 * m / in.toDeform.size());
-    if (this->CheckAbort())
+    if (mdvtk::ProgressOrStop(this, 0.3 * m / in.toDeform.size()))
     {
-      result = 1; // stopped by the user: the executive empties the output
+      result = 1;
       return false;
     }
     if (!failures[m].empty())
@@ -257,70 +318,20 @@ bool vtkMuscleDeformation::PassOnHull(const PassInput& in, bool hullGiven, std::
       continue;
     }
     const auto hullStart = Clock::now();
-    KeptMuscle& entry = this->Kept->hulls[b];
-    if (!entry.Holds(
-          in.surfaces[b], in.frame, hullGiven, hullGiven ? &hulls[b] : nullptr, this->HullTargetNumberOfPoints))
+    const HullReady ready = this->KeepHull(
+      in, m, hullGiven ? &hulls[b] : nullptr, hullGiven ? hullLeaves[hullOf[b]].label : "", failures[m], result);
+    if (ready == HullReady::Stopped)
     {
-      entry = KeptMuscle{};
-      if (hullGiven)
-      {
-        const mdvtk::Leaf& hullLeaf = hullLeaves[hullOf[b]];
-        if (!md::CheckEdges(hulls[b].triangles).IsClosedOrientedManifold() ||
-          md::SignedVolume(hulls[b].points, hulls[b].triangles) <= 0)
-        {
-          failMuscle(
-            m, hullLeaf.label + " is not a closed, outward-oriented manifold surface: build it with HullDecimation");
-          continue;
-        }
-        const std::int64_t outside = md::CountPointsOutsideHull(hulls[b], in.surfaces[b], in.frame.rounding);
-        if (outside > 0)
-        {
-          failMuscle(m,
-            hullLeaf.label + " does not enclose " + leaf.label + ": " + std::to_string(outside) + " of " +
-              std::to_string(md::UsedPoints(in.surfaces[b]).rows()) +
-              " muscle points are outside it, where mean value coordinates extrapolate; build the "
-              "hull with HullDecimation or leave Hull empty");
-          continue;
-        }
-        entry.hull = hulls[b];
-      }
-      md::HullParameters parameters;
-      parameters.targetNumberOfPoints = this->HullTargetNumberOfPoints;
-      parameters.cancelled = mdvtk::AbortRequested(this);
-      std::string failure;
-      if (!mdvtk::CallCore(
-            this, leaf.label + ": ",
-            [&] {
-              if (!hullGiven)
-              {
-                const md::MuscleHull built = md::BuildMuscleHull(in.surfaces[b], parameters);
-                ++this->HullBuildCount;
-                entry.hull = built.result.hull;
-                if (built.report.Changed())
-                {
-                  entry.repairs = built.report.Describe();
-                }
-              }
-              entry.weights = md::MeanValueCoordinates(entry.hull, in.surfaces[b].points);
-            },
-            result, &failure))
-      {
-        if (failure.empty())
-        {
-          return false; // stopped by the user
-        }
-        failures[m] = failure; // reported
-        entry = KeptMuscle{};  // a hull without its weights is not kept
-        continue;
-      }
-      entry.surface = in.surfaces[b];
-      entry.frame = in.frame;
-      entry.hullGiven = hullGiven;
-      entry.target = this->HullTargetNumberOfPoints;
+      return false;
     }
+    if (ready == HullReady::No)
+    {
+      continue; // failures[m] says why, reported
+    }
+    const KeptMuscle& entry = this->Kept->hulls[b];
     if (!entry.repairs.empty())
     {
-      vtkWarningMacro(<< leaf.label << " was repaired to build its hull: " << entry.repairs
+      vtkWarningMacro(<< in.muscles[b].label << " was repaired to build its hull: " << entry.repairs
                       << " (the muscle itself is deformed as given)");
     }
     in.toDeform[m].hull = &entry.hull;
@@ -368,7 +379,7 @@ bool vtkMuscleDeformation::PassOnHull(const PassInput& in, bool hullGiven, std::
     out.warnings = r.warnings;
     out.addOwnMeasures = [r](vtkFieldData* fieldData) {
       mdvtk::AddFieldValue(fieldData, "CoarseIterations", r.coarseIterations);
-      mdvtk::AddFieldValue(fieldData, "PointsFrozenInObstacles", r.verticesFrozen);
+      mdvtk::AddFieldValue(fieldData, mdvtk::array::PointsFrozenInObstacles, r.verticesFrozen);
       mdvtk::AddFieldValue(fieldData, "PointsStoppedAtObstacles", r.verticesStopped);
       mdvtk::AddFieldValue(fieldData, "RestActionLineSamplesInside", r.restSamplesInside);
       mdvtk::AddFieldValue(fieldData, "CurrentActionLineSamplesInside", r.currentSamplesInside);
@@ -381,6 +392,15 @@ vtkMuscleDeformation::vtkMuscleDeformation()
   : Kept(std::make_unique<RestPoseCache>())
 {
   this->SetNumberOfInputPorts(4);
+  const md::DeformationParameters deformation;
+  this->MaximumNumberOfIterations = deformation.maximumIterations;
+  this->MaximumCoarseIterations = deformation.maximumCoarseIterations;
+  this->ConvergenceTolerance = deformation.convergenceTolerance;
+  this->StepLength = deformation.stepLength;
+  this->SamplesPerSegment = deformation.samplesPerSegment;
+  this->PreserveVolume = deformation.preserveVolume;
+  this->DynamicIntersections = deformation.dynamicIntersections;
+  this->HullTargetNumberOfPoints = md::HullParameters().targetNumberOfPoints;
 }
 
 vtkMuscleDeformation::~vtkMuscleDeformation() = default;
@@ -411,161 +431,161 @@ int vtkMuscleDeformation::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   const auto start = Clock::now();
-  vtkDataObject* input = vtkDataObject::GetData(inputVector[0], 0);
-  std::vector<mdvtk::Leaf> muscles, lineLeaves, hullLeaves;
-  std::vector<size_t> lineOf, hullOf;
-  std::string error;
-  if (!mdvtk::CollectLeaves(input, "Input", muscles, error) ||
-    !mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[1], 0), "ActionLines", lineLeaves, error) ||
-    !mdvtk::PairLeaves(this, muscles, "Input", lineLeaves, "ActionLines", lineOf, error))
-  {
-    vtkErrorMacro(<< error);
-    return 0;
-  }
-  const bool hullGiven = inputVector[3]->GetNumberOfInformationObjects() > 0;
-  if (hullGiven &&
-    (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[3], 0), "Hull", hullLeaves, error) ||
-      !mdvtk::PairLeaves(this, muscles, "Input", hullLeaves, "Hull", hullOf, error)))
-  {
-    vtkErrorMacro(<< error);
-    return 0;
-  }
-
   // Everything is read first, so that bad input is reported before any work.
-  const size_t count = muscles.size();
-  std::vector<md::TriangleMesh> surfaces(count), hulls(count);
-  std::vector<md::MuscleToDeform> toDeform;
-  std::vector<size_t> blockOf;
+  Read read;
+  if (!this->ReadMuscles(inputVector, read))
+  {
+    return 0;
+  }
+  if (read.toDeform.empty() && !read.failedBlocks.empty())
+  {
+    return 0; // every muscle failed, each said why
+  }
+  std::string error;
+  if (!mdvtk::ReadMeshes(inputVector[2], "Obstacles", read.obstacleNames, read.obstacleMeshes, error))
+  {
+    vtkErrorMacro(<< error);
+    return 0;
+  }
+  const md::LocalFrame frame = ToLocalFrame(read);
+  // Only the muscles that are still in keep what their rest pose made.
+  EraseOthers(this->Kept->hulls, read.blockOf);
+  EraseOthers(this->Kept->energies, read.blockOf);
+
+  const PassInput in{ read.toDeform, read.blockOf, read.surfaces, read.muscles, read.obstacleNames, read.obstacleMeshes,
+    frame };
+  std::vector<PassOutcome> outcomes(read.toDeform.size());
+  std::vector<std::string> reportedBefore; // the failures said before the deformation
+  int result = 1;
+  if (this->DeformationMesh == MUSCLE_SURFACE)
+  {
+    if (read.hullGiven)
+    {
+      vtkWarningMacro(<< "the Hull input is not used with DeformationMesh Muscle surface (only with Hull (paper))");
+    }
+    if (!this->PassOnSurface(in, read.failures, reportedBefore, outcomes, result))
+    {
+      return result;
+    }
+  }
+  else if (!this->PassOnHull(in, read.hullGiven, read.hulls, read.hullLeaves, read.hullOf, read.failures,
+             reportedBefore, outcomes, result))
+  {
+    return result;
+  }
+  this->WriteMuscles(read, reportedBefore, frame, outcomes, SecondsSince(start));
+  mdvtk::AssignLeaves(vtkDataObject::GetData(inputVector[0], 0), vtkDataObject::GetData(outputVector, 0), read.outputs,
+    mdvtk::Role::Muscle);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+bool vtkMuscleDeformation::ReadMuscles(vtkInformationVector** inputVector, Read& read)
+{
+  std::string error;
+  if (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[0], 0), "Input", read.muscles, error) ||
+    !mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[1], 0), "ActionLines", read.lineLeaves, error) ||
+    !mdvtk::PairLeaves(this, read.muscles, "Input", read.lineLeaves, "ActionLines", read.lineOf, error))
+  {
+    vtkErrorMacro(<< error);
+    return false;
+  }
+  read.hullGiven = inputVector[3]->GetNumberOfInformationObjects() > 0;
+  if (read.hullGiven &&
+    (!mdvtk::CollectLeaves(vtkDataObject::GetData(inputVector[3], 0), "Hull", read.hullLeaves, error) ||
+      !mdvtk::PairLeaves(this, read.muscles, "Input", read.hullLeaves, "Hull", read.hullOf, error)))
+  {
+    vtkErrorMacro(<< error);
+    return false;
+  }
+  const size_t count = read.muscles.size();
+  read.surfaces.resize(count);
+  read.hulls.resize(count);
+  read.outputs.resize(count);
   // One muscle's fault is reported and that muscle left out; the others go on.
-  std::map<size_t, std::string> failedBlocks;
-  auto fail = [&](size_t block, const std::string& message) {
-    vtkErrorMacro(<< message);
-    failedBlocks[block] = message;
-  };
   for (size_t b = 0; b < count; ++b)
   {
-    const mdvtk::Leaf& leaf = muscles[b];
+    const mdvtk::Leaf& leaf = read.muscles[b];
     if (!leaf.data)
     {
       continue;
     }
-    if (leaf.data->GetNumberOfPolys() + leaf.data->GetNumberOfStrips() == 0)
+    if (!mdvtk::ReadMuscleSurface(leaf, read.surfaces[b], error)) // coordinates checked by CollectLeaves
     {
-      fail(b, leaf.label + " has no surface (no polygons); a muscle must be a closed triangle surface");
+      mdvtk::FailBlock(this, read.failedBlocks, b, error);
       continue;
     }
-    mdvtk::ReadTriangles(leaf.data, surfaces[b]); // coordinates checked finite by CollectLeaves
     md::MuscleToDeform muscle;
-    muscle.name = leaf.name.empty() ? leaf.label : leaf.name;
-    muscle.muscle = &surfaces[b];
+    muscle.name = mdvtk::NameOf(leaf);
+    muscle.muscle = &read.surfaces[b];
     std::vector<std::string> notes;
-    if (!ReadMatchedLines(lineLeaves[lineOf[b]], muscle.lines, notes, error))
+    if (!ReadMatchedLines(read.lineLeaves[read.lineOf[b]], muscle.lines, notes, error))
     {
-      fail(b, error + " (for " + leaf.label + ")");
+      mdvtk::FailBlock(this, read.failedBlocks, b, error + " (for " + leaf.label + ")");
       continue;
     }
     for (const std::string& note : notes)
     {
-      vtkWarningMacro(<< lineLeaves[lineOf[b]].label << ": " << note);
+      vtkWarningMacro(<< read.lineLeaves[read.lineOf[b]].label << ": " << note);
     }
-    toDeform.push_back(std::move(muscle));
-    blockOf.push_back(b);
-  }
-  if (toDeform.empty() && !failedBlocks.empty())
-  {
-    return 0; // every muscle failed, each said why
+    read.toDeform.push_back(std::move(muscle));
+    read.blockOf.push_back(b);
   }
   // Failures from here on are per muscle to deform, reported as found.
-  std::vector<std::string> failures(toDeform.size());
-  auto failMuscle = [&](size_t m, const std::string& message) {
-    vtkErrorMacro(<< message);
-    failures[m] = message;
-  };
-  if (hullGiven)
+  read.failures.resize(read.toDeform.size());
+  for (size_t m = 0; read.hullGiven && m < read.toDeform.size(); ++m)
   {
-    for (size_t m = 0; m < toDeform.size(); ++m)
+    const mdvtk::Leaf& hullLeaf = read.hullLeaves[read.hullOf[read.blockOf[m]]];
+    if (!hullLeaf.data || hullLeaf.data->GetNumberOfPolys() == 0)
     {
-      const mdvtk::Leaf& hullLeaf = hullLeaves[hullOf[blockOf[m]]];
-      if (!hullLeaf.data || hullLeaf.data->GetNumberOfPolys() == 0)
-      {
-        failMuscle(m, hullLeaf.label + " has no surface");
-        continue;
-      }
-      mdvtk::ReadTriangles(hullLeaf.data, hulls[blockOf[m]]);
+      read.failures[m] = hullLeaf.label + " has no surface";
+      vtkErrorMacro(<< read.failures[m]);
+      continue;
     }
+    mdvtk::ReadTriangles(hullLeaf.data, read.hulls[read.blockOf[m]]);
   }
+  return true;
+}
 
-  // Obstacles: every block of every connection of port 2.
-  std::vector<std::string> obstacleNames;
-  std::vector<md::TriangleMesh> obstacleMeshes;
-  if (!mdvtk::ReadMeshes(inputVector[2], "Obstacles", obstacleNames, obstacleMeshes, error))
-  {
-    vtkErrorMacro(<< error);
-    return 0;
-  }
-
+md::LocalFrame vtkMuscleDeformation::ToLocalFrame(Read& read)
+{
   // The computation runs in the muscles' local frame: the same answer wherever they sit and
   // whatever their units.
   std::vector<const md::Points*> muscleParts;
-  for (size_t b : blockOf)
+  for (size_t b : read.blockOf)
   {
-    muscleParts.push_back(&surfaces[b].points);
+    muscleParts.push_back(&read.surfaces[b].points);
   }
   const md::LocalFrame frame = md::LocalFrame::Around(muscleParts);
-  for (size_t m = 0; m < toDeform.size(); ++m)
+  for (size_t m = 0; m < read.toDeform.size(); ++m)
   {
-    frame.ToLocal(surfaces[blockOf[m]].points);
-    frame.ToLocal(hulls[blockOf[m]].points);
-    for (md::MatchedLine& line : toDeform[m].lines)
+    frame.ToLocal(read.surfaces[read.blockOf[m]].points);
+    frame.ToLocal(read.hulls[read.blockOf[m]].points);
+    for (md::MatchedLine& line : read.toDeform[m].lines)
     {
       frame.ToLocal(line.rest);
       frame.ToLocal(line.current);
     }
   }
-  for (md::TriangleMesh& obstacle : obstacleMeshes)
+  for (md::TriangleMesh& obstacle : read.obstacleMeshes)
   {
     frame.ToLocal(obstacle.points);
   }
+  return frame;
+}
 
-  // Only the muscles that are still in keep what their rest pose made.
-  EraseOthers(this->Kept->hulls, blockOf);
-  EraseOthers(this->Kept->energies, blockOf);
-
-  const PassInput in{ toDeform, blockOf, surfaces, muscles, obstacleNames, obstacleMeshes, frame };
-  std::vector<PassOutcome> outcomes(toDeform.size());
-  std::vector<std::string> reportedBefore; // the failures said before the deformation
-  int result = 1;
-  if (this->DeformationMesh == MUSCLE_SURFACE)
-  {
-    if (hullGiven)
-    {
-      vtkWarningMacro(<< "the Hull input is not used with DeformationMesh Muscle surface (only with Hull (paper))");
-    }
-    if (!this->PassOnSurface(in, failures, reportedBefore, outcomes, result))
-    {
-      return result;
-    }
-  }
-  else if (!this->PassOnHull(in, hullGiven, hulls, hullLeaves, hullOf, failures, reportedBefore, outcomes, result))
-  {
-    return result;
-  }
-  const double seconds = SecondsSince(start);
-
-  std::vector<vtkSmartPointer<vtkPolyData>> outputs(count);
+void vtkMuscleDeformation::WriteMuscles(Read& read, const std::vector<std::string>& reportedBefore,
+  const md::LocalFrame& frame, std::vector<PassOutcome>& outcomes, double seconds)
+{
   for (size_t m = 0; m < outcomes.size(); ++m)
   {
-    const size_t b = blockOf[m];
-    if (!failures[m].empty())
+    const size_t b = read.blockOf[m];
+    if (!read.failures[m].empty())
     {
-      if (reportedBefore[m].empty()) // the deformation's own failure, not said yet
-      {
-        fail(b, muscles[b].label + ": " + failures[m]);
-      }
-      else
-      {
-        failedBlocks[b] = failures[m];
-      }
+      // The deformation's own failure is said here; the earlier ones were said as found.
+      mdvtk::FailBlock(this, read.failedBlocks, b,
+        reportedBefore[m].empty() ? read.muscles[b].label + ": " + read.failures[m] : read.failures[m],
+        !reportedBefore[m].empty());
       continue;
     }
     PassOutcome& r = outcomes[m];
@@ -573,33 +593,24 @@ int vtkMuscleDeformation::RequestData(
     {
       vtkWarningMacro(<< warning);
     }
-    md::Points displacement = r.points - surfaces[b].points;
+    md::Points displacement = r.points - read.surfaces[b].points;
     frame.VectorsToWorld(displacement);
     frame.ToWorld(r.points);
-    auto output = vtkSmartPointer<vtkPolyData>::New();
-    output->ShallowCopy(muscles[b].data);
-    output->SetPoints(mdvtk::ToVtkPoints(r.points));
-    output->GetPointData()->AddArray(mdvtk::ToVtkArray(mdvtk::DisplacementArrayName, displacement));
-    vtkNew<vtkFieldData> fieldData;
-    fieldData->DeepCopy(muscles[b].data->GetFieldData());
+    read.outputs[b] = mdvtk::MovedMuscle(read.muscles[b].data, r.points, displacement);
+    vtkFieldData* fieldData = read.outputs[b]->GetFieldData();
     mdvtk::AddFieldValue(fieldData, mdvtk::VolumeChangeArrayName, r.volumeChangePercent);
-    mdvtk::AddFieldValue(fieldData, "NumberOfIterations", r.iterations);
-    mdvtk::AddFieldValue(fieldData, "Converged", r.converged ? 1 : 0);
-    mdvtk::AddFieldValue(fieldData, "FlippedTriangleCount", r.flippedTriangles);
+    mdvtk::AddFieldValue(fieldData, mdvtk::array::NumberOfIterations, r.iterations);
+    mdvtk::AddFieldValue(fieldData, mdvtk::array::Converged, r.converged ? 1 : 0);
+    mdvtk::AddFieldValue(fieldData, mdvtk::array::FlippedTriangleCount, r.flippedTriangles);
     r.addOwnMeasures(fieldData);
-    mdvtk::AddFieldValue(fieldData, "HullSeconds", r.restSeconds);
+    mdvtk::AddFieldValue(fieldData, mdvtk::array::HullSeconds, r.restSeconds);
     mdvtk::AddFieldValue(fieldData, "DeformationSeconds", r.deformationSeconds);
-    mdvtk::AddFieldValue(fieldData, "ElapsedSeconds", seconds);
-    output->SetFieldData(fieldData);
-    outputs[b] = output;
+    mdvtk::AddFieldValue(fieldData, mdvtk::array::ElapsedSeconds, seconds);
   }
-  for (const auto& [b, message] : failedBlocks)
+  for (const auto& [b, message] : read.failedBlocks)
   {
-    outputs[b] = mdvtk::FailedMuscle(muscles[b].data, message);
+    read.outputs[b] = mdvtk::FailedMuscle(read.muscles[b].data, message);
   }
-  mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), outputs, mdvtk::Role::Muscle);
-  this->UpdateProgress(1.0);
-  return 1;
 }
 
 void vtkMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)

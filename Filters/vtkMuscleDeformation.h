@@ -52,6 +52,7 @@
 namespace md
 {
 struct TriangleMesh;
+struct LocalFrame;
 }
 namespace mdvtk
 {
@@ -135,14 +136,15 @@ protected:
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   int DeformationMesh = HULL;
-  int MaximumNumberOfIterations = 200;
-  int MaximumCoarseIterations = 100;
-  double ConvergenceTolerance = 0.01;
-  double StepLength = 1.0;
-  int SamplesPerSegment = 10;
-  bool PreserveVolume = true;
-  bool DynamicIntersections = true;
-  int HullTargetNumberOfPoints = 250;
+  // The core's defaults (md::DeformationParameters, md::HullParameters), set by the constructor.
+  int MaximumNumberOfIterations;
+  int MaximumCoarseIterations;
+  double ConvergenceTolerance;
+  double StepLength;
+  int SamplesPerSegment;
+  bool PreserveVolume;
+  bool DynamicIntersections;
+  int HullTargetNumberOfPoints;
 
 private:
   vtkMuscleDeformation(const vtkMuscleDeformation&) = delete;
@@ -152,6 +154,24 @@ private:
   struct RestPoseCache;
   struct PassInput;
   struct PassOutcome;
+  struct Read;
+  /// Reads the muscles, their action lines and given hulls; false when an input cannot be read
+  /// (reported). A muscle that cannot be read is left out, in read.failedBlocks.
+  bool ReadMuscles(vtkInformationVector** inputVector, Read& read);
+  /// Brings what was read into the muscles' local frame.
+  static md::LocalFrame ToLocalFrame(Read& read);
+  /// The output block of every muscle: deformed (in the data's coordinates) or failed.
+  void WriteMuscles(Read& read, const std::vector<std::string>& reportedBefore, const md::LocalFrame& frame,
+    std::vector<PassOutcome>& outcomes, double seconds);
+  enum class HullReady
+  {
+    Yes,
+    No,     ///< failed: `failure` says why, reported
+    Stopped ///< by the user
+  };
+  /// Muscle m's hull (given: checked; else built) and its mean value coordinates, kept in Kept.
+  HullReady KeepHull(const PassInput& in, size_t m, const md::TriangleMesh* givenHull, const std::string& hullLabel,
+    std::string& failure, int& result);
   /// The pass on the muscles' surfaces or on their hulls: each muscle's outcome, or its failure
   /// in `failures` (`reportedBefore`: the failures already reported when the deformation
   /// started); false (with RequestData's `result`) when the run stops.

@@ -2,7 +2,7 @@
 #include "vtkMusculoskeletalPhantom.h"
 
 #include "MDBlocks.h"
-#include "Phantom.h"
+#include "Phantom/Phantom.h"
 
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
@@ -23,7 +23,7 @@ vtkSmartPointer<vtkPolyData> Polylines(const std::vector<md::Points>& lines, con
 {
   vtkSmartPointer<vtkPolyData> polyData = mdvtk::ToPolyLines(lines);
   vtkNew<vtkStringArray> lineNames;
-  lineNames->SetName("ActionLineName");
+  lineNames->SetName(mdvtk::array::ActionLineName);
   for (const std::string& name : names)
   {
     lineNames->InsertNextValue(name);

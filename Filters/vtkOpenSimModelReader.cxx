@@ -2,8 +2,8 @@
 #include "vtkOpenSimModelReader.h"
 
 #include "MDBlocks.h"
-#include "OpenSimKinematics.h"
-#include "OpenSimMotion.h"
+#include "OpenSim/OpenSimKinematics.h"
+#include "OpenSim/OpenSimMotion.h"
 
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
@@ -87,6 +87,78 @@ vtkSmartPointer<vtkPolyData> ReadMeshFile(const std::string& path)
   return mesh;
 }
 
+/// A body's meshes (the files of its geometry, found in `folders`) as one mesh in the body's
+/// frame; the files not found are added to `missing`.
+BodyMesh ReadBodyMesh(const osim::Body& body, const std::vector<std::string>& folders, std::string& missing)
+{
+  std::vector<md::Points> parts;
+  vtkNew<vtkCellArray> polys;
+  vtkIdType offset = 0;
+  for (const osim::Geometry& g : body.geometry)
+  {
+    // Models made on Windows name files with backslashes (".\\geometry\\x.vtp"): try the
+    // name as given and its last part, in every folder.
+    std::string relative = g.file;
+    std::replace(relative.begin(), relative.end(), '\\', '/');
+    const std::string bare = vtksys::SystemTools::GetFilenameName(relative);
+    vtkSmartPointer<vtkPolyData> mesh;
+    for (const std::string& f : folders)
+    {
+      for (const std::string& name : { relative, bare })
+      {
+        const std::string path = vtksys::SystemTools::FileIsFullPath(name) ? name : f + "/" + name;
+        if (!mesh && vtksys::SystemTools::FileExists(path, true))
+        {
+          mesh = ReadMeshFile(path);
+        }
+      }
+    }
+    if (!mesh)
+    {
+      missing += (missing.empty() ? "" : ", ") + g.file + " (" + body.name + ")";
+      continue;
+    }
+    md::Points local = mdvtk::ToPoints(mesh->GetPoints());
+    local = local * g.scale.asDiagonal();
+    parts.push_back(g.placement.Apply(local));
+    vtkCellArray* cells = mesh->GetPolys();
+    const vtkIdType* ids = nullptr;
+    vtkIdType count = 0;
+    std::vector<vtkIdType> shifted;
+    for (cells->InitTraversal(); cells->GetNextCell(count, ids);)
+    {
+      shifted.assign(ids, ids + count);
+      for (vtkIdType& id : shifted)
+      {
+        id += offset;
+      }
+      polys->InsertNextCell(count, shifted.data());
+    }
+    offset += local.rows();
+  }
+  BodyMesh target;
+  target.points.resize(offset, 3);
+  vtkIdType row = 0;
+  for (const md::Points& p : parts)
+  {
+    target.points.middleRows(row, p.rows()) = p;
+    row += p.rows();
+  }
+  target.polys = polys;
+  return target;
+}
+
+/// How the reader's motions are read (AngleUnit, IgnoreUnknownColumns).
+osim::MotionOptions OptionsOf(int angleUnit, bool ignoreUnknownColumns)
+{
+  osim::MotionOptions options;
+  options.angles = angleUnit == vtkOpenSimModelReader::ANGLES_IN_DEGREES ? osim::AngleUnit::Degrees
+    : angleUnit == vtkOpenSimModelReader::ANGLES_IN_RADIANS              ? osim::AngleUnit::Radians
+                                                                         : osim::AngleUnit::FromFile;
+  options.ignoreUnknownColumns = ignoreUnknownColumns;
+  return options;
+}
+
 vtkSmartPointer<vtkStringArray> Strings(const char* name)
 {
   auto array = vtkSmartPointer<vtkStringArray>::New();
@@ -144,178 +216,23 @@ double vtkOpenSimModelReader::GetTimeStep(int index)
 
 bool vtkOpenSimModelReader::Load()
 {
-  Internals& in = *this->Internal;
   const std::string fileName = Text(this->FileName);
   if (fileName.empty())
   {
     vtkErrorMacro(<< "no FileName: give the OpenSim model (.osim) to read");
     return false;
   }
-  const std::string modelKey =
-    fileName + "|" + Text(this->GeometrySearchPath) + "|" + std::to_string(this->LoadGeometry);
   std::vector<std::string> warnings;
-  try
+  int result = 1;
+  if (!mdvtk::CallCore(
+        this, "",
+        [&] {
+          this->LoadModel(fileName, warnings);
+          this->LoadMotion(warnings);
+          this->LoadRestPose();
+        },
+        result))
   {
-    if (!in.haveModel || modelKey != in.modelKey)
-    {
-      in.haveModel = false;
-      in.motionKey.clear();
-      in.poseKey.clear();
-      in.model = osim::ReadModel(fileName);
-      ++this->ModelReadCount;
-      warnings = in.model.warnings;
-      // Meshes: beside the model, in its Geometry/ and geometry/ folders, then the search path.
-      const std::string folder = vtksys::SystemTools::GetFilenamePath(fileName);
-      std::vector<std::string> folders = { folder, folder + "/Geometry", folder + "/geometry" };
-      std::stringstream search(Text(this->GeometrySearchPath));
-      std::string entry;
-      while (std::getline(search, entry, ';'))
-      {
-        if (!entry.empty())
-        {
-          folders.push_back(entry);
-        }
-      }
-      in.meshes.assign(in.model.bodies.size(), BodyMesh());
-      std::string missing;
-      for (size_t b = 0; b < in.model.bodies.size() && this->LoadGeometry; ++b)
-      {
-        std::vector<md::Points> parts;
-        vtkNew<vtkCellArray> polys;
-        vtkIdType offset = 0;
-        for (const osim::Geometry& g : in.model.bodies[b].geometry)
-        {
-          // Models made on Windows name files with backslashes (".\\geometry\\x.vtp"): try the
-          // name as given and its last part, in every folder.
-          std::string relative = g.file;
-          std::replace(relative.begin(), relative.end(), '\\', '/');
-          const std::string bare = vtksys::SystemTools::GetFilenameName(relative);
-          vtkSmartPointer<vtkPolyData> mesh;
-          for (const std::string& f : folders)
-          {
-            for (const std::string& name : { relative, bare })
-            {
-              const std::string path = vtksys::SystemTools::FileIsFullPath(name) ? name : f + "/" + name;
-              if (!mesh && vtksys::SystemTools::FileExists(path, true))
-              {
-                mesh = ReadMeshFile(path);
-              }
-            }
-          }
-          if (!mesh)
-          {
-            missing += (missing.empty() ? "" : ", ") + g.file + " (" + in.model.bodies[b].name + ")";
-            continue;
-          }
-          md::Points local = mdvtk::ToPoints(mesh->GetPoints());
-          local = local * g.scale.asDiagonal();
-          parts.push_back(g.placement.Apply(local));
-          vtkCellArray* cells = mesh->GetPolys();
-          const vtkIdType* ids = nullptr;
-          vtkIdType count = 0;
-          std::vector<vtkIdType> shifted;
-          for (cells->InitTraversal(); cells->GetNextCell(count, ids);)
-          {
-            shifted.assign(ids, ids + count);
-            for (vtkIdType& id : shifted)
-            {
-              id += offset;
-            }
-            polys->InsertNextCell(count, shifted.data());
-          }
-          offset += local.rows();
-        }
-        BodyMesh& target = in.meshes[b];
-        target.points.resize(offset, 3);
-        vtkIdType row = 0;
-        for (const md::Points& p : parts)
-        {
-          target.points.middleRows(row, p.rows()) = p;
-          row += p.rows();
-        }
-        target.polys = polys;
-      }
-      if (!missing.empty())
-      {
-        warnings.push_back("mesh files not found (the bodies still move): " + missing);
-      }
-      in.wraps.clear();
-      for (const osim::WrapObject& w : in.model.wrapObjects)
-      {
-        in.wraps.push_back(osim::WrapSurface(w));
-      }
-      std::string wrapped;
-      for (const osim::Path& p : in.model.paths)
-      {
-        if (!p.wrapObjects.empty())
-        {
-          wrapped += (wrapped.empty() ? "" : ", ") + p.name;
-        }
-      }
-      if (!wrapped.empty())
-      {
-        warnings.push_back("paths are not wrapped yet: these muscles have wrap objects and are drawn as "
-                           "straight polylines through their path points: " +
-          wrapped);
-      }
-      in.modelKey = modelKey;
-      in.haveModel = true;
-    }
-    osim::MotionOptions options;
-    options.angles = this->AngleUnit == ANGLES_IN_DEGREES ? osim::AngleUnit::Degrees
-      : this->AngleUnit == ANGLES_IN_RADIANS              ? osim::AngleUnit::Radians
-                                                          : osim::AngleUnit::FromFile;
-    options.ignoreUnknownColumns = this->IgnoreUnknownColumns;
-    const std::string motionKey = Text(this->MotionFileName) + "|" + std::to_string(this->AngleUnit) + "|" +
-      std::to_string(this->IgnoreUnknownColumns);
-    if (motionKey != in.motionKey)
-    {
-      in.trajectory = osim::CoordinateTrajectory();
-      in.motionKey.clear();
-      if (!Text(this->MotionFileName).empty())
-      {
-        in.trajectory = osim::MapMotion(in.model, osim::ReadMotion(this->MotionFileName), options);
-        warnings.insert(warnings.end(), in.trajectory.warnings.begin(), in.trajectory.warnings.end());
-      }
-      in.motionKey = motionKey;
-    }
-    const std::string poseKey = Text(this->RestPoseFileName) + "|" + Text(this->RestPoseCoordinates) + "|" +
-      Text(this->ReferenceBody) + "|" + motionKey;
-    if (poseKey != in.poseKey)
-    {
-      in.poseKey.clear();
-      in.rest = osim::DefaultCoordinates(in.model);
-      if (!Text(this->RestPoseFileName).empty())
-      {
-        // The first row of a motion file (a static trial in the scan pose), read as the motion is.
-        const osim::CoordinateTrajectory pose =
-          osim::MapMotion(in.model, osim::ReadMotion(this->RestPoseFileName), options);
-        in.rest = pose.frames.front();
-      }
-      osim::SetCoordinates(in.model, Text(this->RestPoseCoordinates), true, in.rest);
-      in.restPoses = osim::BodyPoses(in.model, in.rest);
-      in.toOutput = RigidTransform();
-      const std::string reference = Text(this->ReferenceBody);
-      if (!reference.empty())
-      {
-        const int body = in.model.FindBody(reference);
-        if (body < 0)
-        {
-          throw md::InputError("ReferenceBody '" + reference + "' is not a body of the model");
-        }
-        in.toOutput = Inverse(in.restPoses[body]);
-      }
-      in.poseKey = poseKey;
-    }
-  }
-  catch (const md::InputError& e)
-  {
-    vtkErrorMacro(<< e.what());
-    return false;
-  }
-  catch (const std::exception& e)
-  {
-    vtkErrorMacro(<< "reading '" << fileName << "' failed: " << e.what());
     return false;
   }
   for (const std::string& w : warnings)
@@ -325,6 +242,120 @@ bool vtkOpenSimModelReader::Load()
   return true;
 }
 
+void vtkOpenSimModelReader::LoadModel(const std::string& fileName, std::vector<std::string>& warnings)
+{
+  Internals& in = *this->Internal;
+  const std::string modelKey =
+    fileName + "|" + Text(this->GeometrySearchPath) + "|" + std::to_string(this->LoadGeometry);
+  if (in.haveModel && modelKey == in.modelKey)
+  {
+    return;
+  }
+  in.haveModel = false;
+  in.motionKey.clear();
+  in.poseKey.clear();
+  in.model = osim::ReadModel(fileName);
+  ++this->ModelReadCount;
+  warnings = in.model.warnings;
+  // Meshes: beside the model, in its Geometry/ and geometry/ folders, then the search path.
+  const std::string folder = vtksys::SystemTools::GetFilenamePath(fileName);
+  std::vector<std::string> folders = { folder, folder + "/Geometry", folder + "/geometry" };
+  std::stringstream search(Text(this->GeometrySearchPath));
+  std::string entry;
+  while (std::getline(search, entry, ';'))
+  {
+    if (!entry.empty())
+    {
+      folders.push_back(entry);
+    }
+  }
+  in.meshes.assign(in.model.bodies.size(), BodyMesh());
+  std::string missing;
+  for (size_t b = 0; b < in.model.bodies.size() && this->LoadGeometry; ++b)
+  {
+    in.meshes[b] = ReadBodyMesh(in.model.bodies[b], folders, missing);
+  }
+  if (!missing.empty())
+  {
+    warnings.push_back("mesh files not found (the bodies still move): " + missing);
+  }
+  in.wraps.clear();
+  for (const osim::WrapObject& w : in.model.wrapObjects)
+  {
+    in.wraps.push_back(osim::WrapSurface(w));
+  }
+  std::string wrapped;
+  for (const osim::Path& p : in.model.paths)
+  {
+    if (!p.wrapObjects.empty())
+    {
+      wrapped += (wrapped.empty() ? "" : ", ") + p.name;
+    }
+  }
+  if (!wrapped.empty())
+  {
+    warnings.push_back("paths are not wrapped yet: these muscles have wrap objects and are drawn as "
+                       "straight polylines through their path points: " +
+      wrapped);
+  }
+  in.modelKey = modelKey;
+  in.haveModel = true;
+}
+
+void vtkOpenSimModelReader::LoadMotion(std::vector<std::string>& warnings)
+{
+  Internals& in = *this->Internal;
+  const std::string motionKey = Text(this->MotionFileName) + "|" + std::to_string(this->AngleUnit) + "|" +
+    std::to_string(this->IgnoreUnknownColumns);
+  if (motionKey == in.motionKey)
+  {
+    return;
+  }
+  in.trajectory = osim::CoordinateTrajectory();
+  in.motionKey.clear();
+  if (!Text(this->MotionFileName).empty())
+  {
+    in.trajectory = osim::MapMotion(
+      in.model, osim::ReadMotion(this->MotionFileName), OptionsOf(this->AngleUnit, this->IgnoreUnknownColumns));
+    warnings.insert(warnings.end(), in.trajectory.warnings.begin(), in.trajectory.warnings.end());
+  }
+  in.motionKey = motionKey;
+}
+
+void vtkOpenSimModelReader::LoadRestPose()
+{
+  Internals& in = *this->Internal;
+  const std::string poseKey = Text(this->RestPoseFileName) + "|" + Text(this->RestPoseCoordinates) + "|" +
+    Text(this->ReferenceBody) + "|" + in.motionKey;
+  if (poseKey == in.poseKey)
+  {
+    return;
+  }
+  in.poseKey.clear();
+  in.rest = osim::DefaultCoordinates(in.model);
+  if (!Text(this->RestPoseFileName).empty())
+  {
+    // The first row of a motion file (a static trial in the scan pose), read as the motion is.
+    const osim::CoordinateTrajectory pose = osim::MapMotion(
+      in.model, osim::ReadMotion(this->RestPoseFileName), OptionsOf(this->AngleUnit, this->IgnoreUnknownColumns));
+    in.rest = pose.frames.front();
+  }
+  osim::SetCoordinates(in.model, Text(this->RestPoseCoordinates), true, in.rest);
+  in.restPoses = osim::BodyPoses(in.model, in.rest);
+  in.toOutput = RigidTransform();
+  const std::string reference = Text(this->ReferenceBody);
+  if (!reference.empty())
+  {
+    const int body = in.model.FindBody(reference);
+    if (body < 0)
+    {
+      throw md::InputError("ReferenceBody '" + reference + "' is not a body of the model");
+    }
+    in.toOutput = Inverse(in.restPoses[body]);
+  }
+  in.poseKey = poseKey;
+}
+
 int vtkOpenSimModelReader::RequestInformation(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
@@ -332,20 +363,7 @@ int vtkOpenSimModelReader::RequestInformation(
   {
     return 0;
   }
-  static const std::vector<double> none;
-  const std::vector<double>& times = this->PlayMotion ? this->Internal->trajectory.times : none;
-  for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
-  {
-    vtkInformation* info = outputVector->GetInformationObject(port);
-    info->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-    info->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-    if (!times.empty())
-    {
-      info->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
-      const double range[2] = { times.front(), times.back() };
-      info->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
-    }
-  }
+  mdvtk::AdvertiseTimes(outputVector, this->PlayMotion ? this->Internal->trajectory.times : std::vector<double>{});
   return 1;
 }
 
@@ -357,13 +375,11 @@ int vtkOpenSimModelReader::RequestData(
     return 0;
   }
   const Internals& in = *this->Internal;
-  const osim::Model& model = in.model;
   // The frame nearest the requested time.
   std::vector<double> q = in.rest;
   double time = 0.0;
   if (!in.trajectory.times.empty())
   {
-    const std::vector<double>& times = in.trajectory.times;
     // The time asked for on the port whose request this is (the other ports keep older times).
     int port = request->Has(vtkDemandDrivenPipeline::FROM_OUTPUT_PORT())
       ? request->Get(vtkDemandDrivenPipeline::FROM_OUTPUT_PORT())
@@ -375,95 +391,15 @@ int vtkOpenSimModelReader::RequestData(
     {
       requested = info->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
     }
-    size_t k = static_cast<size_t>(std::lower_bound(times.begin(), times.end(), requested) - times.begin());
-    if (k == times.size() || (k > 0 && requested - times[k - 1] < times[k] - requested))
-    {
-      k = k == 0 ? 0 : k - 1;
-    }
+    const int k = mdvtk::NearestTime(in.trajectory.times, requested);
     q = in.trajectory.frames[k];
-    time = times[k];
+    time = in.trajectory.times[k];
   }
-  const std::vector<RigidTransform> poses = osim::BodyPoses(model, q);
-  const double scale = this->Scale;
-  // Body frame -> output frame (scaled separately).
-  auto placed = [&](const std::vector<RigidTransform>& p, size_t body) {
-    return Compose(in.toOutput, p[body]);
-  };
-  auto toOutput = [&](const RigidTransform& t, const md::Points& local) {
-    md::Points out = t.Apply(local);
-    out *= scale;
-    return out;
-  };
-
-  auto bodies = [&](const std::vector<RigidTransform>& p, vtkMultiBlockDataSet* tree) {
-    for (size_t b = 0; b < model.bodies.size(); ++b)
-    {
-      if (b == 0 && model.bodies[0].geometry.empty())
-      {
-        continue;
-      }
-      auto block = vtkSmartPointer<vtkPolyData>::New();
-      const BodyMesh& mesh = in.meshes[b];
-      if (mesh.points.rows() > 0)
-      {
-        block->SetPoints(mdvtk::ToVtkPoints(toOutput(placed(p, b), mesh.points)));
-        block->SetPolys(mesh.polys);
-      }
-      // Rest to this pose, in the output frame and units.
-      const RigidTransform motion = Motion(placed(p, b), placed(in.restPoses, b));
-      vtkNew<vtkDoubleArray> transform;
-      transform->SetName("RestToCurrentTransform");
-      transform->SetNumberOfComponents(12);
-      double values[12];
-      for (int i = 0; i < 9; ++i)
-      {
-        values[i] = motion.rotation(i / 3, i % 3);
-      }
-      for (int i = 0; i < 3; ++i)
-      {
-        values[9 + i] = scale * motion.translation[i];
-      }
-      transform->InsertNextTuple(values);
-      block->GetFieldData()->AddArray(transform);
-      mdvtk::AddBlock(tree, model.bodies[b].name, block);
-    }
-  };
-  auto paths = [&](const std::vector<double>& coordinates, const std::vector<RigidTransform>& p,
-                 vtkMultiBlockDataSet* tree) {
-    for (const osim::Path& path : model.paths)
-    {
-      const osim::PathGeometry g = osim::PathAt(model, path, coordinates, p);
-      md::Points points = g.points;
-      for (Eigen::Index i = 0; i < points.rows(); ++i)
-      {
-        points.row(i) = scale * in.toOutput.Apply(Eigen::Vector3d(points.row(i).transpose())).transpose();
-      }
-      auto block = vtkSmartPointer<vtkPolyData>::New();
-      block->SetPoints(mdvtk::ToVtkPoints(points));
-      vtkNew<vtkCellArray> line;
-      line->InsertNextCell(static_cast<vtkIdType>(points.rows()));
-      auto names = Strings("PathPointName"), onBody = Strings("PathPointBody"), lineName = Strings("ActionLineName");
-      for (Eigen::Index i = 0; i < points.rows(); ++i)
-      {
-        line->InsertCellPoint(i);
-        const osim::PathPoint& point = path.points[g.pointIndex[i]];
-        names->InsertNextValue(point.name);
-        onBody->InsertNextValue(model.bodies[point.body].name);
-      }
-      lineName->InsertNextValue(path.name);
-      block->SetLines(line);
-      block->GetPointData()->AddArray(names);
-      block->GetPointData()->AddArray(onBody);
-      block->GetCellData()->AddArray(lineName);
-      mdvtk::AddFieldValue(block->GetFieldData(), "PathLength", scale * osim::PolylineLength(g.points));
-      mdvtk::AddBlock(tree, path.name, block);
-    }
-  };
-
-  bodies(poses, vtkMultiBlockDataSet::GetData(outputVector, BODIES));
-  bodies(in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, BODIES_REST));
-  paths(q, poses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS));
-  paths(in.rest, in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS_REST));
+  const std::vector<RigidTransform> poses = osim::BodyPoses(in.model, q);
+  this->WriteBodies(poses, vtkMultiBlockDataSet::GetData(outputVector, BODIES));
+  this->WriteBodies(in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, BODIES_REST));
+  this->WritePaths(q, poses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS));
+  this->WritePaths(in.rest, in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS_REST));
   for (int port : { BODIES, BODIES_REST })
   {
     mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, port), mdvtk::Role::Bone);
@@ -472,16 +408,104 @@ int vtkOpenSimModelReader::RequestData(
   {
     mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, port), mdvtk::Role::ActionLine);
   }
-
   vtkMultiBlockDataSet* wraps = vtkMultiBlockDataSet::GetData(outputVector, WRAP_OBJECTS);
-  for (size_t w = 0; w < model.wrapObjects.size(); ++w)
+  for (size_t w = 0; w < in.model.wrapObjects.size(); ++w)
   {
     md::TriangleMesh mesh = in.wraps[w];
-    mesh.points = toOutput(placed(poses, model.wrapObjects[w].body), mesh.points);
-    mdvtk::AddBlock(wraps, model.wrapObjects[w].name, mdvtk::ToPolyData(mesh));
+    mesh.points = this->Scale * this->Placed(poses, in.model.wrapObjects[w].body).Apply(mesh.points);
+    mdvtk::AddBlock(wraps, in.model.wrapObjects[w].name, mdvtk::ToPolyData(mesh));
   }
+  this->WriteTransforms(poses, q, time, vtkTable::GetData(outputVector, BODY_TRANSFORMS));
+  if (this->PlayMotion && !in.trajectory.times.empty())
+  {
+    mdvtk::SetDataTime(outputVector, time);
+  }
+  return 1;
+}
 
-  vtkTable* table = vtkTable::GetData(outputVector, BODY_TRANSFORMS);
+md::RigidTransform vtkOpenSimModelReader::Placed(const std::vector<md::RigidTransform>& poses, size_t body) const
+{
+  return Compose(this->Internal->toOutput, poses[body]); // body frame -> output frame (scaled apart)
+}
+
+void vtkOpenSimModelReader::WriteBodies(const std::vector<md::RigidTransform>& poses, vtkMultiBlockDataSet* tree) const
+{
+  const Internals& in = *this->Internal;
+  const osim::Model& model = in.model;
+  for (size_t b = 0; b < model.bodies.size(); ++b)
+  {
+    if (b == 0 && model.bodies[0].geometry.empty())
+    {
+      continue;
+    }
+    auto block = vtkSmartPointer<vtkPolyData>::New();
+    const BodyMesh& mesh = in.meshes[b];
+    if (mesh.points.rows() > 0)
+    {
+      block->SetPoints(mdvtk::ToVtkPoints(this->Scale * this->Placed(poses, b).Apply(mesh.points)));
+      block->SetPolys(mesh.polys);
+    }
+    // Rest to this pose, in the output frame and units.
+    const RigidTransform motion = Motion(this->Placed(poses, b), this->Placed(in.restPoses, b));
+    vtkNew<vtkDoubleArray> transform;
+    transform->SetName("RestToCurrentTransform");
+    transform->SetNumberOfComponents(12);
+    double values[12];
+    for (int i = 0; i < 9; ++i)
+    {
+      values[i] = motion.rotation(i / 3, i % 3);
+    }
+    for (int i = 0; i < 3; ++i)
+    {
+      values[9 + i] = this->Scale * motion.translation[i];
+    }
+    transform->InsertNextTuple(values);
+    block->GetFieldData()->AddArray(transform);
+    mdvtk::AddBlock(tree, model.bodies[b].name, block);
+  }
+}
+
+void vtkOpenSimModelReader::WritePaths(const std::vector<double>& coordinates,
+  const std::vector<md::RigidTransform>& poses, vtkMultiBlockDataSet* tree) const
+{
+  const Internals& in = *this->Internal;
+  const osim::Model& model = in.model;
+  for (const osim::Path& path : model.paths)
+  {
+    const osim::PathGeometry g = osim::PathAt(model, path, coordinates, poses);
+    md::Points points = g.points;
+    for (Eigen::Index i = 0; i < points.rows(); ++i)
+    {
+      points.row(i) = this->Scale * in.toOutput.Apply(Eigen::Vector3d(points.row(i).transpose())).transpose();
+    }
+    auto block = vtkSmartPointer<vtkPolyData>::New();
+    block->SetPoints(mdvtk::ToVtkPoints(points));
+    vtkNew<vtkCellArray> line;
+    line->InsertNextCell(static_cast<vtkIdType>(points.rows()));
+    auto names = Strings("PathPointName"), onBody = Strings("PathPointBody"),
+         lineName = Strings(mdvtk::array::ActionLineName);
+    for (Eigen::Index i = 0; i < points.rows(); ++i)
+    {
+      line->InsertCellPoint(i);
+      const osim::PathPoint& point = path.points[g.pointIndex[i]];
+      names->InsertNextValue(point.name);
+      onBody->InsertNextValue(model.bodies[point.body].name);
+    }
+    lineName->InsertNextValue(path.name);
+    block->SetLines(line);
+    block->GetPointData()->AddArray(names);
+    block->GetPointData()->AddArray(onBody);
+    block->GetCellData()->AddArray(lineName);
+    mdvtk::AddFieldValue(block->GetFieldData(), "PathLength", this->Scale * osim::PolylineLength(g.points));
+    mdvtk::AddBlock(tree, path.name, block);
+  }
+}
+
+void vtkOpenSimModelReader::WriteTransforms(const std::vector<md::RigidTransform>& poses,
+  const std::vector<double>& coordinates, double time, vtkTable* table) const
+{
+  const Internals& in = *this->Internal;
+  const osim::Model& model = in.model;
   auto bodyNames = Strings("Body");
   table->AddColumn(bodyNames);
   std::vector<vtkSmartPointer<vtkDoubleArray>> columns;
@@ -495,7 +519,7 @@ int vtkOpenSimModelReader::RequestData(
   }
   for (size_t b = 0; b < model.bodies.size(); ++b)
   {
-    const RigidTransform motion = Motion(placed(poses, b), placed(in.restPoses, b));
+    const RigidTransform motion = Motion(this->Placed(poses, b), this->Placed(in.restPoses, b));
     bodyNames->InsertNextValue(model.bodies[b].name);
     for (int i = 0; i < 9; ++i)
     {
@@ -503,26 +527,16 @@ int vtkOpenSimModelReader::RequestData(
     }
     for (int i = 0; i < 3; ++i)
     {
-      columns[9 + i]->InsertNextValue(scale * motion.translation[i]);
+      columns[9 + i]->InsertNextValue(this->Scale * motion.translation[i]);
     }
   }
-
-  mdvtk::AddFieldValue(table->GetFieldData(), "Time", time);
+  mdvtk::AddFieldValue(table->GetFieldData(), mdvtk::array::Time, time);
   for (size_t c = 0; c < model.coordinates.size(); ++c)
   {
     const bool rotational = model.coordinates[c].motionType == osim::MotionType::Rotational;
-    mdvtk::AddFieldValue(
-      table->GetFieldData(), model.coordinates[c].name.c_str(), rotational ? q[c] * 180.0 / M_PI : q[c]);
+    mdvtk::AddFieldValue(table->GetFieldData(), model.coordinates[c].name.c_str(),
+      rotational ? coordinates[c] * 180.0 / M_PI : coordinates[c]);
   }
-  if (this->PlayMotion && !in.trajectory.times.empty())
-  {
-    for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
-    {
-      vtkDataObject* output = outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT());
-      output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), time);
-    }
-  }
-  return 1;
 }
 
 void vtkOpenSimModelReader::PrintSelf(ostream& os, vtkIndent indent)

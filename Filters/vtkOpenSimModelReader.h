@@ -27,6 +27,13 @@
 
 #include <memory>
 #include <string>
+#include <vector>
+
+class vtkTable;
+namespace md
+{
+struct RigidTransform;
+}
 
 class MUSCLEDEFORMATIONFILTERS_EXPORT vtkOpenSimModelReader : public vtkMultiBlockDataSetAlgorithm
 {
@@ -145,4 +152,18 @@ private:
   struct Internals;
   std::unique_ptr<Internals> Internal;
   bool Load(); ///< (re)reads what changed; reports and returns false on failure
+  /// The parts of Load, each only when what it reads from changed (throw md::InputError).
+  void LoadModel(const std::string& fileName, std::vector<std::string>& warnings);
+  void LoadMotion(std::vector<std::string>& warnings);
+  void LoadRestPose();
+  /// Body `body` in pose `poses` -> the output frame (lengths not yet scaled).
+  md::RigidTransform Placed(const std::vector<md::RigidTransform>& poses, size_t body) const;
+  /// The bodies' meshes as blocks of `tree`, each with RestToCurrentTransform.
+  void WriteBodies(const std::vector<md::RigidTransform>& poses, vtkMultiBlockDataSet* tree) const;
+  /// The muscles' paths at `coordinates` as polylines, blocks of `tree`.
+  void WritePaths(const std::vector<double>& coordinates, const std::vector<md::RigidTransform>& poses,
+    vtkMultiBlockDataSet* tree) const;
+  /// Output BODY_TRANSFORMS: each body's rest-to-current motion; the time and coordinates as field data.
+  void WriteTransforms(const std::vector<md::RigidTransform>& poses, const std::vector<double>& coordinates,
+    double time, vtkTable* table) const;
 };

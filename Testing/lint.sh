@@ -36,7 +36,7 @@ case "$check" in
     build_dir=$3
     command -v clang-tidy >/dev/null || { echo "clang-tidy is not installed: skipped"; exit 77; }
     [ -f "$build_dir/compile_commands.json" ] || { echo "no $build_dir/compile_commands.json" >&2; exit 1; }
-    project_files 'Filters/Core/*.cxx' | xargs -P "$(nproc)" -n 1 clang-tidy -p "$build_dir" --quiet
+    project_files 'Filters/Algorithms/*/*.cxx' | xargs -P "$(nproc)" -n 1 clang-tidy -p "$build_dir" --quiet
     echo "clang-tidy finds nothing in the algorithm core"
     ;;
   *)

@@ -1,18 +1,18 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // One rest-pose -> current-pose pass of the muscle deformation
-// (Filters/Core/MuscleDeformer.h) on the phantom and, when present, the LHDL
+// (Filters/Algorithms/Deformation/MuscleDeformer.h) on the phantom and, when present, the LHDL
 // right hip at hip flexion 30 and 60 degrees and adduction -40 and 40: per
 // muscle and pose, iterations, time, volume change, flipped triangles, points
 // held by obstacles and left inside them, action-line samples inside. Prints
 // figures; asserts nothing (see the tests).
 //
 //   BenchmarkDeformation [data folder]
-#include "ActionLineMatching.h"
-#include "MuscleDeformer.h"
-#include "Phantom.h"
-#include "ProgressiveHull.h"
+#include "Deformation/MuscleDeformer.h"
+#include "Geometry/SurfaceRepair.h"
+#include "Hull/ProgressiveHull.h"
+#include "Motion/ActionLineMatching.h"
+#include "Phantom/Phantom.h"
 #include "RealData.h"
-#include "SurfaceRepair.h"
 
 #include <algorithm>
 #include <chrono>

@@ -4,22 +4,27 @@
 // ../shared/data/vhf_right. Prints figures; asserts nothing (see the tests).
 //
 //   BenchmarkHull [data folder] [target points]
-#include "MeanValueCoordinates.h"
-#include "MeshChecks.h"
-#include "Phantom.h"
-#include "ProgressiveHull.h"
+#include "Common/Fnv1a.h"
+#include "Geometry/MeanValueCoordinates.h"
+#include "Geometry/MeshChecks.h"
+#include "Geometry/SurfaceRepair.h"
+#include "Hull/ProgressiveHull.h"
+#include "Phantom/Phantom.h"
 #include "RealData.h"
-#include "SurfaceRepair.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace
 {
+/// Of every repaired surface, hull and weight matrix, so that two builds can be compared to the bit.
+md::Fnv1a checksum;
+
 double Seconds(std::chrono::steady_clock::time_point since)
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
@@ -64,6 +69,12 @@ void Measure(const std::string& name, const md::TriangleMesh& muscle, int target
   const double mvcTime = Seconds(start);
   const md::Points reproduced = weights * hull.points;
   const double mvcError = (reproduced - muscle.points).rowwise().norm().maxCoeff() / size;
+  for (const md::TriangleMesh* mesh : { &std::as_const(clean), &hull })
+  {
+    checksum.Add(mesh->points.data(), sizeof(double) * static_cast<size_t>(mesh->points.size()));
+    checksum.Add(mesh->triangles.data(), sizeof(std::int64_t) * static_cast<size_t>(mesh->triangles.size()));
+  }
+  checksum.Add(reproduced.data(), sizeof(double) * static_cast<size_t>(reproduced.size()));
   const double sumError = (weights.rowwise().sum().array() - 1.0).abs().maxCoeff();
 
   // The muscle's points are those its triangles use (files carry unused ones too).
@@ -129,5 +140,7 @@ int main(int argc, char** argv)
               "hull, every point tested, tolerance 1e-9 of the muscle's size. mfld: closed, manifold, oriented. self: "
               "intersecting triangle\n"
               "pairs of the hull. MVC err: largest |sum w_j h_j - x| over the muscle's points / muscle size.\n");
+  std::printf("checksum of every repaired surface, hull and reproduction: %016llx\n",
+    static_cast<unsigned long long>(checksum.Value()));
   return 0;
 }

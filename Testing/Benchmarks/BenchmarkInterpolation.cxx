@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The whole interpolation method (Filters/Core/InterpolatedDeformation.h) on
+// The whole interpolation method (Filters/Algorithms/Method/InterpolatedDeformation.h) on
 // the phantom (30 degrees of flexion unless told) and, when present, the LHDL right hip at
 // hip flexion 60 degrees: the one-pass method (one step, then the static
 // resolution), the interpolation method with the hull refitted (Refit) and

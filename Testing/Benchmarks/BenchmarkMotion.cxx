@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Muscles through a whole motion in the core (Filters/Core/MotionDeformation.h): the four LHDL
+// Muscles through a whole motion in the core (Filters/Algorithms/Method/MotionDeformation.h): the four LHDL
 // hip muscles through every frame of hip_flexion or hip_adduction (iliac bone, sacrum and femur),
 // or the phantom through a flexion sweep. Per frame: steps, settle iterations, time, the largest
 // |VolumeChangePercent|, new bone penetration, flipped triangles, new sharp edges and the
@@ -12,7 +12,7 @@
 // too, and the largest distance between the two runs' surfaces at any frame.
 //
 //   BenchmarkMotion [data folder] [hip_flexion|hip_adduction|phantom] [seed: -1 none, 0 float, s > 0 noise]
-#include "Fnv1a.h"
+#include "Common/Fnv1a.h"
 #include "MotionFrames.h"
 #include "StepChecksum.h"
 

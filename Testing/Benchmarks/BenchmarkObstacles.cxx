@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Obstacle queries (the bounding-volume hierarchy of Filters/Core/TriangleTree.h)
+// Obstacle queries (the bounding-volume hierarchy of Filters/Algorithms/Geometry/TriangleTree.h)
 // on the phantom's femur and, when present, the LHDL bones: build time,
 // inside tests and first hits per second. Prints figures; asserts nothing.
 //
 //   BenchmarkObstacles [data folder]
-#include "Phantom.h"
+#include "Geometry/TriangleTree.h"
+#include "Phantom/Phantom.h"
 #include "RealData.h"
-#include "TriangleTree.h"
 
 #include <chrono>
 #include <cstdio>

@@ -4,8 +4,8 @@
 // meshes) and the other models of ../shared/data/opensim. Prints figures; asserts nothing.
 //
 //   BenchmarkOpenSim [data folder]
-#include "OpenSimKinematics.h"
-#include "OpenSimMotion.h"
+#include "OpenSim/OpenSimKinematics.h"
+#include "OpenSim/OpenSimMotion.h"
 #include "RealData.h"
 #include "vtkOpenSimModelReader.h"
 

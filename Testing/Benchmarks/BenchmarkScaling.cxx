@@ -7,9 +7,9 @@
 // between sizes. Asserts nothing.
 //
 //   BenchmarkScaling [data folder]
-#include "MeanValueCoordinates.h"
-#include "MuscleDeformer.h"
-#include "ProgressiveHull.h"
+#include "Deformation/MuscleDeformer.h"
+#include "Geometry/MeanValueCoordinates.h"
+#include "Hull/ProgressiveHull.h"
 #include "RealData.h"
 
 #include <Eigen/Eigenvalues>

@@ -14,10 +14,10 @@
 //                      [seeds (3)] [methods: all|one-pass|filter|filter-surface|N (1, 4, 8)|settle|settle-N|settle-all]
 #include "RealData.h"
 
-#include "LocalFrame.h"
-#include "MeanValueCoordinates.h"
-#include "ProgressiveHull.h"
-#include "SurfacePass.h"
+#include "Geometry/LocalFrame.h"
+#include "Geometry/MeanValueCoordinates.h"
+#include "Hull/ProgressiveHull.h"
+#include "Intersections/SurfacePass.h"
 
 #include <chrono>
 #include <cmath>

@@ -3,8 +3,8 @@
 // be compared to the bit: a change that should not move a bit (a refactoring) is checked by it.
 #pragma once
 
-#include "Fnv1a.h"
-#include "InterpolatedDeformation.h"
+#include "Common/Fnv1a.h"
+#include "Method/InterpolatedDeformation.h"
 
 #include <cstdint>
 #include <vector>

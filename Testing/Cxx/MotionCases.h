@@ -4,9 +4,9 @@
 // right hip: LhdlMotion in RealData.h). Shared by the tests and the benchmark.
 #pragma once
 
-#include "ActionLineMatching.h"
-#include "InterpolatedDeformation.h"
-#include "Phantom.h"
+#include "Method/InterpolatedDeformation.h"
+#include "Motion/ActionLineMatching.h"
+#include "Phantom/Phantom.h"
 
 #include <functional>
 #include <random>

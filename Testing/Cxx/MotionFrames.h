@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Motions as MotionDeformation's input (Filters/Core/MotionDeformation.h): the LHDL right hip
+// Motions as MotionDeformation's input (Filters/Algorithms/Method/MotionDeformation.h): the LHDL right hip
 // through every frame of one of its motions (RealData.h), or the phantom through a flexion sweep;
 // each frame also as the interpolation method's input. Shared by the tests and the benchmark.
 #pragma once
 
-#include "MotionDeformation.h"
+#include "Method/MotionDeformation.h"
 #include "RealData.h"
 
 #include <string>

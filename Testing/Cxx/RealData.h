@@ -2,7 +2,7 @@
 // Finding and reading the real data sets (../shared/data) for tests and benchmarks.
 #pragma once
 
-#include "MeshTypes.h"
+#include "Common/MeshTypes.h"
 #include "MotionCases.h"
 
 #include <vtkCellArray.h>

@@ -3,8 +3,8 @@
 // point arrays shorter than the points. Each must be refused with a message naming the input and
 // the block, never read past an array's end (these crashed ParaView before).
 #include "FilterTestUtilities.h"
+#include "Geometry/MeshChecks.h"
 #include "MDBlocks.h"
-#include "MeshChecks.h"
 
 #include "vtkActionLineGrouping.h"
 #include "vtkActionLineMatching.h"

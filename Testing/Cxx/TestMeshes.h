@@ -2,10 +2,11 @@
 // Small closed meshes shared by the core tests.
 #pragma once
 
-#include "MeshTypes.h"
+#include "Common/MeshTypes.h"
 
 #include <array>
 #include <cmath>
+#include <random>
 #include <vector>
 
 /// The regular octahedron of points (+-1, 0, 0), (0, +-1, 0), (0, 0, +-1): 8 outward-facing triangles.
@@ -82,4 +83,17 @@ inline md::TriangleMesh Sphere(const Eigen::Vector3d& centre, double radius, int
     sphere.triangles.row(static_cast<Eigen::Index>(f)) << faces[f][0], faces[f][1], faces[f][2];
   }
   return sphere;
+}
+
+/// `n` points drawn uniformly from the box [-size, size] x [-size, size] x [-3 size, 3 size].
+inline md::Points RandomCloud(int n, unsigned seed, double size)
+{
+  std::mt19937 generator(seed);
+  std::uniform_real_distribution<double> coordinate(-size, size);
+  md::Points p(n, 3);
+  for (int i = 0; i < n; ++i)
+  {
+    p.row(i) << coordinate(generator), coordinate(generator), 3 * coordinate(generator);
+  }
+  return p;
 }

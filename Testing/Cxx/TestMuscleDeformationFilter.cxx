@@ -6,9 +6,9 @@
 // exactly what a new one gives. And a user's cancel (AbortExecute) stops a run cleanly.
 #include "FilterTestUtilities.h"
 
+#include "Deformation/MuscleDeformer.h"
+#include "Geometry/TriangleTree.h"
 #include "MDBlocks.h"
-#include "MuscleDeformer.h"
-#include "TriangleTree.h"
 
 #include "vtkActionLineMatching.h"
 #include "vtkBoneInterpolation.h"

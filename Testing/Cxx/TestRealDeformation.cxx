@@ -7,9 +7,9 @@
 #include "FilterTestUtilities.h"
 #include "RealData.h"
 
-#include "ActionLineMatching.h"
-#include "MuscleDeformer.h"
-#include "ProgressiveHull.h"
+#include "Deformation/MuscleDeformer.h"
+#include "Hull/ProgressiveHull.h"
+#include "Motion/ActionLineMatching.h"
 #include "vtkActionLineMatching.h"
 #include "vtkMuscleDeformation.h"
 

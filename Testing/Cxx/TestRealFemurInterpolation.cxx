@@ -5,7 +5,7 @@
 #include "FilterTestUtilities.h"
 #include "RealData.h"
 
-#include "BoneInterpolation.h"
+#include "Motion/BoneInterpolation.h"
 #include "vtkBoneInterpolation.h"
 
 #include <vtkFieldData.h>

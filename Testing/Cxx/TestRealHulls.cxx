@@ -2,11 +2,11 @@
 // Hulls and mean value coordinates of every real muscle: ../shared/data
 // (MUSCLEDEFORMATION_DATA_DIR), lhdl_hip_r and vhf_right. Skipped, and
 // reported as skipped by ctest, when the data is absent.
-#include "MeanValueCoordinates.h"
-#include "MeshChecks.h"
-#include "ProgressiveHull.h"
+#include "Geometry/MeanValueCoordinates.h"
+#include "Geometry/MeshChecks.h"
+#include "Geometry/SurfaceRepair.h"
+#include "Hull/ProgressiveHull.h"
 #include "RealData.h"
-#include "SurfaceRepair.h"
 
 #include <gtest/gtest.h>
 

@@ -4,8 +4,8 @@
 // the one-pass method, the interpolation with the hull refitted (N = 4) and
 // with the hull rebuilt before every step (the paper), judged by the measures
 // of docs/DESIGN.md. Skipped when ../shared/data is absent.
-#include "InterpolatedDeformation.h"
-#include "ProgressiveHull.h"
+#include "Hull/ProgressiveHull.h"
+#include "Method/InterpolatedDeformation.h"
 #include "RealData.h"
 
 #include <gtest/gtest.h>

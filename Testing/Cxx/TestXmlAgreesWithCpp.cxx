@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The defaults a user sees in ParaView (ServerManagerXML) and the ones a C++ or VTK user gets
-// (the filters' constructors) are written twice: this test holds them to each other, through
-// each filter's PrintSelf. (HullTargetNumberOfPoints once had a minimum of 4 in one and 8 in the
-// other.)
+// The defaults and ranges a user sees in ParaView (ServerManagerXML) and the ones a C++ or VTK
+// user gets (the filters' constructors, which take the core's defaults, and their clamps) are
+// written twice, the XML being ParaView's own format: this test holds them to each other, the
+// defaults through each filter's PrintSelf, the ranges against the headers' vtkSetClampMacro.
+// (HullTargetNumberOfPoints once had a minimum of 4 in one and 8 in the other.)
 #include "vtkActionLineGrouping.h"
 #include "vtkActionLineMatching.h"
 #include "vtkBoneInterpolation.h"
@@ -16,10 +17,12 @@
 #include "vtkOpenSimModelReader.h"
 
 #include <vtkSmartPointer.h>
+#include <vtkType.h>
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -146,4 +149,86 @@ TEST(ServerManagerXml, EveryNumericDefaultIsTheConstructorsDefault)
     }
   }
   EXPECT_GE(compared, 39); // every numeric property the XML had when this was written: the parsing works
+}
+
+namespace
+{
+/// A bound of vtkSetClampMacro as written in a header: a number, VTK_INT_MAX or VTK_DOUBLE_MAX;
+/// NaN for anything else (an enumeration's names).
+double Bound(const std::string& token)
+{
+  if (token == "VTK_INT_MAX")
+  {
+    return VTK_INT_MAX;
+  }
+  if (token == "VTK_DOUBLE_MAX")
+  {
+    return VTK_DOUBLE_MAX;
+  }
+  char* rest = nullptr;
+  const double value = std::strtod(token.c_str(), &rest);
+  return rest && *rest == '\0' ? value : std::nan("");
+}
+
+std::string ReadText(const std::string& path)
+{
+  std::ifstream in(path);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+}
+
+TEST(ServerManagerXml, EveryRangeTheGuiOffersTheFilterAccepts)
+{
+  // The XML's RangeDomain is what the GUI's sliders offer; the header's vtkSetClampMacro what the
+  // filter accepts. The first must lie within the second (a value offered and then silently
+  // clamped is another value than the one shown), and every clamped property offers a range or
+  // an enumeration.
+  const std::string source = MUSCLEDEFORMATION_SOURCE_DIR;
+  int compared = 0;
+  static const std::regex proxy(R"re(<SourceProxy([^>]*)>([\s\S]*?)</SourceProxy>)re");
+  static const std::regex property(R"re(<(Int|Double)VectorProperty([^>]*[^/])>([\s\S]*?)</\1VectorProperty>)re");
+  static const std::regex range(R"re(<(Int|Double)RangeDomain([^>]*)/>)re");
+  for (const auto& file : std::filesystem::directory_iterator(source + "/ServerManagerXML"))
+  {
+    const std::string text = ReadText(file.path().string());
+    for (std::sregex_iterator p(text.begin(), text.end(), proxy), end; p != end; ++p)
+    {
+      const std::string className = Attributes((*p)[1])["class"];
+      const std::string header = ReadText(source + "/Filters/" + className + ".h");
+      ASSERT_FALSE(header.empty()) << className;
+      const std::string body = (*p)[2];
+      for (std::sregex_iterator q(body.begin(), body.end(), property); q != end; ++q)
+      {
+        std::map<std::string, std::string> a = Attributes((*q)[2]);
+        const std::string elements = (*q)[3];
+        const std::regex clamp(
+          "vtkSetClampMacro\\(\\s*" + a["name"] + "\\s*,\\s*\\w+\\s*,\\s*([^,]+?)\\s*,\\s*([^)]+?)\\s*\\)");
+        std::smatch c;
+        if (!std::regex_search(header, c, clamp))
+        {
+          continue;
+        }
+        std::smatch r;
+        const bool hasRange = std::regex_search(elements, r, range);
+        EXPECT_TRUE(hasRange || elements.find("EnumerationDomain") != std::string::npos)
+          << className << "." << a["name"] << " is clamped in C++ but offers no range in the XML";
+        if (!hasRange)
+        {
+          continue;
+        }
+        std::map<std::string, std::string> domain = Attributes(r[2]);
+        const double low = Bound(c[1]), high = Bound(c[2]);
+        ASSERT_FALSE(std::isnan(low) || std::isnan(high)) << className << "." << a["name"];
+        EXPECT_GE(std::stod(domain["min"]), low)
+          << className << "." << a["name"] << ": the GUI offers below the minimum";
+        if (!domain["max"].empty())
+        {
+          EXPECT_LE(std::stod(domain["max"]), high)
+            << className << "." << a["name"] << ": the GUI offers above the maximum";
+        }
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GE(compared, 30); // the ranges the XML had when this was written: the parsing works
 }

@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// A bounding-volume hierarchy over the triangles of a closed surface, for the
+// queries intersection handling needs against obstacles (bones, other muscles):
+// first hit along a segment, inside or outside, closest point.
+#pragma once
+
+#include "Common/MeshTypes.h"
+
+#include <limits>
+#include <optional>
+#include <vector>
+
+namespace md
+{
+class TriangleTree
+{
+public:
+  /// Builds the tree (median splits on the longest axis, a few triangles a
+  /// leaf). The mesh is copied: the tree stays valid whatever happens to it.
+  explicit TriangleTree(const TriangleMesh& mesh);
+
+  struct Hit
+  {
+    double t = 0; ///< fraction of the segment, in [0, 1]
+    Eigen::Index triangle = -1;
+    Eigen::Vector3d point;
+  };
+  /// The first triangle the segment from `from` to `to` meets, if any.
+  std::optional<Hit> FirstHit(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
+
+  /// How many triangles the segment from `from` to `to` crosses: odd when
+  /// the segment leaves or enters the closed surface, even when both ends are
+  /// on the same side.
+  int Crossings(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
+
+  /// Whether p is inside the closed surface: the parity of crossings along
+  /// rays towards the nearest sides of the surface's box, decided by the
+  /// majority of three (two that agree) so that a ray grazing an edge or a
+  /// point cannot decide alone.
+  bool Inside(const Eigen::Vector3d& p) const;
+
+  struct Closest
+  {
+    double distance = 0;
+    Eigen::Index triangle = -1;
+    Eigen::Vector3d point;
+  };
+  /// The point of the surface closest to p; with `within`, only if closer
+  /// than that (else triangle -1), which prunes the search to that radius.
+  Closest ClosestPoint(const Eigen::Vector3d& p, double within = std::numeric_limits<double>::max()) const;
+
+  const TriangleMesh& Mesh() const { return this->Surface; }
+
+  /// Moves the surface's points (same triangles) and updates the boxes
+  /// bottom-up: O(triangles), far cheaper than a rebuild, for obstacles that
+  /// deform a little at a time (muscles). Queries stay exact; only their speed
+  /// suffers if the points move far.
+  void Refit(const Points& points);
+
+  /// Whether p lies inside the box of the whole surface.
+  bool InBounds(const Eigen::Vector3d& p) const
+  {
+    return (p.array() >= this->Nodes[0].low.array()).all() && (p.array() <= this->Nodes[0].high.array()).all();
+  }
+
+  /// Unit normal of a triangle (by its point order).
+  Eigen::Vector3d Normal(Eigen::Index triangle) const
+  {
+    return (this->Corner(triangle, 1) - this->Corner(triangle, 0))
+      .cross(this->Corner(triangle, 2) - this->Corner(triangle, 0))
+      .normalized();
+  }
+
+private:
+  struct Node
+  {
+    Eigen::Vector3d low, high;
+    int first = 0, count = 0; // leaf: triangles Order[first .. first + count)
+    int left = -1, right = -1;
+    int pointFirst = 0, pointCount = 0; // leaf: its triangles' points LeafPoints[pointFirst ..)
+  };
+  struct BuildItem
+  {
+    Eigen::Vector3d centroid;
+    Eigen::Index triangle;
+  };
+  int Build(std::vector<BuildItem>& items, int first, int count, int depth);
+  void LeafBox(Node& node) const;
+  void UpdateBoxes();
+  Eigen::Vector3d Corner(Eigen::Index triangle, int k) const
+  {
+    return this->Surface.points.row(this->Surface.triangles(triangle, k)).transpose();
+  }
+  int CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, bool& grazed) const;
+  /// Triangles the segment from + t d, t in [0, 1], crosses, counting those it
+  /// meets within `edgeTolerance` (barycentric) of their edges, and whether
+  /// any crossing was that close to an edge or a point (`grazed`).
+  int SegmentCrossings(const Eigen::Vector3d& from, const Eigen::Vector3d& d, double edgeTolerance, bool& grazed) const;
+  /// Calls visit(triangle) for every triangle whose leaf box the segment
+  /// from + t direction, t in [0, limit], meets.
+  template<typename Visit>
+  void ForTrianglesNearSegment(
+    const Eigen::Vector3d& from, const Eigen::Vector3d& direction, const double& limit, Visit&& visit) const;
+
+  TriangleMesh Surface;
+  std::vector<Node> Nodes;
+  std::vector<Eigen::Index> Order;
+  /// Each leaf's points, once each: a refit reads each point about twice rather than six times.
+  std::vector<Eigen::Index> LeafPoints;
+  double Size = 0;
+};
+
+/// Just outside a surface: `offset` beyond its point `closest` nearest to p,
+/// p being inside (closest.distance > 0), on the way out.
+inline Eigen::Vector3d JustOutside(const TriangleTree::Closest& closest, const Eigen::Vector3d& p, double offset)
+{
+  return closest.point + (offset / closest.distance) * (closest.point - p);
+}
+}

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Forward kinematics of an OpenSim model: coordinates -> body poses -> muscle paths.
+#pragma once
+
+#include "OpenSim/OpenSimModel.h"
+
+#include <string>
+#include <vector>
+
+namespace md::osim
+{
+/// Every coordinate at its default value, couplers applied.
+std::vector<double> DefaultCoordinates(const Model& model);
+
+/// Sets each coupled (dependent) coordinate from its independent one, in order.
+void ApplyCouplers(const Model& model, std::vector<double>& coordinates);
+
+/// The pose of every body in ground (body frame -> ground), indexed as Model::bodies.
+std::vector<RigidTransform> BodyPoses(const Model& model, const std::vector<double>& coordinates);
+
+/// A muscle path at one pose: its active points in ground, in order.
+struct PathGeometry
+{
+  Points points;
+  std::vector<int> pointIndex; ///< index into Path::points of each active point
+};
+
+/// The active points of `path` in ground. Conditional points are active while their coordinate
+/// is within their range (+-1e-5, as OpenSim); moving points evaluate their functions at their
+/// coordinates clamped to the coordinates' ranges (as OpenSim).
+PathGeometry PathAt(const Model& model, const Path& path, const std::vector<double>& coordinates,
+  const std::vector<RigidTransform>& bodyPoses);
+
+/// Length of a polyline (sum of its segments).
+double PolylineLength(const Points& points);
+
+/// A closed triangle surface of a wrap object in its body's frame.
+TriangleMesh WrapSurface(const WrapObject& wrap, int resolution = 24);
+}

@@ -1,0 +1,162 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Reading a model: joints composed as Simbody composes them, wrap surfaces, bad input named.
+#include "OpenSim/OpenSimKinematics.h"
+#include "OpenSimTestModels.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+using namespace md::osim;
+using namespace md::osim::test;
+
+namespace
+{
+Eigen::Matrix3d Rot(const Eigen::Vector3d& axis, double angle)
+{
+  return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+}
+}
+
+TEST(OpenSimModel, JointsComposeAsSimbody)
+{
+  const Model model = ParseModel(kSmallModel, "small.osim");
+  ASSERT_EQ(model.bodies.size(), 6u);
+  ASSERT_EQ(model.coordinates.size(), 13u);
+  EXPECT_EQ(model.coordinates[model.FindCoordinate("flex")].motionType, MotionType::Rotational);
+  EXPECT_EQ(model.coordinates[model.FindCoordinate("add")].motionType, MotionType::Rotational); // slope -1
+  EXPECT_EQ(model.coordinates[model.FindCoordinate("beta")].motionType, MotionType::Coupled);
+  EXPECT_EQ(model.coordinates[model.FindCoordinate("tx")].motionType, MotionType::Translational);
+  EXPECT_EQ(model.coordinates[model.FindCoordinate("sled_rz")].motionType, MotionType::Rotational);
+  EXPECT_EQ(model.coordinates[model.FindCoordinate("sled_ty")].motionType, MotionType::Translational);
+  EXPECT_EQ(model.bodies[model.FindBody("pelvis")].geometry.size(), 1u);
+  EXPECT_EQ(model.bodies[model.FindBody("pelvis")].geometry[0].scale, Eigen::Vector3d(2, 2, 2));
+  ASSERT_EQ(model.wrapObjects.size(), 1u);
+
+  std::vector<double> q = DefaultCoordinates(model);
+  auto set = [&](const char* name, double v) {
+    q[model.FindCoordinate(name)] = v;
+  };
+  set("rx", 0.1);
+  set("ry", -0.2);
+  set("rz", 0.3);
+  set("tx", 1);
+  set("ty", 2);
+  set("tz", 3);
+  set("flex", 0.7);
+  set("add", 0.4);
+  set("knee_angle", -0.6);
+  set("sled_rz", 0.5);
+  set("sled_tx", 0.25);
+  set("sled_ty", -1);
+  ApplyCouplers(model, q);
+  EXPECT_DOUBLE_EQ(q[model.FindCoordinate("beta")], 2 * 0.7 + 0.1);
+  const std::vector<md::RigidTransform> poses = BodyPoses(model, q);
+
+  const Eigen::Vector3d X = Eigen::Vector3d::UnitX(), Y = Eigen::Vector3d::UnitY(), Z = Eigen::Vector3d::UnitZ();
+  // FreeJoint: body-fixed X-Y-Z rotations, translation in the parent (ground) frame.
+  const Eigen::Matrix3d Rp = Rot(X, 0.1) * Rot(Y, -0.2) * Rot(Z, 0.3);
+  const Eigen::Vector3d tp(1, 2, 3);
+  const md::RigidTransform& pelvis = poses[model.FindBody("pelvis")];
+  EXPECT_LT((pelvis.rotation - Rp).norm(), 1e-14);
+  EXPECT_LT((pelvis.translation - tp).norm(), 1e-14);
+  // CustomJoint: R = Rz(flex) Rx(-add); translation along Y = 2 spline(flex), along X = 0.5 beta^2.
+  const Function spline = Function::SimmSpline({ -2, 0, 1, 2 }, { 0, 0.01, 0.03, 0.02 });
+  const double beta = 1.5;
+  const Eigen::Matrix3d Rf = Rp * Rot(Z, 0.7) * Rot(X, -0.4);
+  const Eigen::Vector3d tf = Rp * (Eigen::Vector3d(0.1, 0, 0) + 2 * spline(0.7) * Y + 0.5 * beta * beta * X) + tp;
+  const md::RigidTransform& femur = poses[model.FindBody("femur")];
+  EXPECT_LT((femur.rotation - Rf).norm(), 1e-14);
+  EXPECT_LT((femur.translation - tf).norm(), 1e-14);
+  // PinJoint about the offset frames' Z: femur * F * Rz(q) * inverse(B).
+  const Eigen::Matrix3d RF = Rot(X, 0.3), RB = Rot(Y, 0.2);
+  const Eigen::Matrix3d Rt = Rf * RF * Rot(Z, -0.6) * RB.transpose();
+  const Eigen::Vector3d tt = Rf * Eigen::Vector3d(0, -0.4, 0) + tf - Rt * Eigen::Vector3d(0, 0.05, 0);
+  const md::RigidTransform& tibia = poses[model.FindBody("tibia")];
+  EXPECT_LT((tibia.rotation - Rt).norm(), 1e-14);
+  EXPECT_LT((tibia.translation - tt).norm(), 1e-14);
+  // PlanarJoint: rotation about Z, translations along X and Y; the welded body follows.
+  const md::RigidTransform& sled = poses[model.FindBody("sled")];
+  EXPECT_LT((sled.rotation - Rot(Z, 0.5)).norm(), 1e-14);
+  EXPECT_LT((sled.translation - Eigen::Vector3d(0.25, -1, 0)).norm(), 1e-14);
+  EXPECT_LT((poses[model.FindBody("glued")].translation - sled.translation).norm(), 1e-14);
+
+  // The path: the conditional point is active for flex in [0, 1]; the moving point's x follows
+  // the knee angle clamped to its range [-1, 0.5].
+  const Path& path = model.paths[0];
+  EXPECT_EQ(path.wrapObjects, std::vector<std::string>{ "cyl" });
+  PathGeometry g = PathAt(model, path, q, poses);
+  ASSERT_EQ(g.points.rows(), 3);
+  EXPECT_LT((g.points.row(1).transpose() - femur.Apply(Eigen::Vector3d(0.02, -0.1, 0))).norm(), 1e-14);
+  EXPECT_LT((g.points.row(2).transpose() - tibia.Apply(Eigen::Vector3d(-0.06, -0.2, 0))).norm(), 1e-14);
+  set("flex", 1.2);
+  set("knee_angle", -3);
+  ApplyCouplers(model, q);
+  const std::vector<md::RigidTransform> poses2 = BodyPoses(model, q);
+  g = PathAt(model, path, q, poses2);
+  ASSERT_EQ(g.points.rows(), 2);
+  EXPECT_EQ(g.pointIndex, (std::vector<int>{ 0, 2 }));
+  EXPECT_LT(
+    (g.points.row(1).transpose() - poses2[model.FindBody("tibia")].Apply(Eigen::Vector3d(-0.1, -0.2, 0))).norm(),
+    1e-14);
+}
+
+TEST(OpenSimModel, WrapSurfacesAreClosedAndOutward)
+{
+  for (WrapShape shape : { WrapShape::Cylinder, WrapShape::Sphere, WrapShape::Ellipsoid, WrapShape::Torus })
+  {
+    WrapObject w;
+    w.shape = shape;
+    w.dimensions = shape == WrapShape::Cylinder ? std::vector<double>{ 0.1, 0.4 }
+      : shape == WrapShape::Sphere              ? std::vector<double>{ 0.1 }
+      : shape == WrapShape::Ellipsoid           ? std::vector<double>{ 0.1, 0.2, 0.3 }
+                                                : std::vector<double>{ 0.2, 0.05 };
+    const md::TriangleMesh mesh = WrapSurface(w, 64);
+    double volume = 0;
+    for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
+    {
+      const Eigen::Vector3d a = mesh.points.row(mesh.triangles(t, 0)), b = mesh.points.row(mesh.triangles(t, 1)),
+                            c = mesh.points.row(mesh.triangles(t, 2));
+      volume += a.dot(b.cross(c)) / 6;
+    }
+    const double expected = shape == WrapShape::Cylinder ? M_PI * 0.01 * 0.4
+      : shape == WrapShape::Sphere                       ? 4.0 / 3 * M_PI * 1e-3
+      : shape == WrapShape::Ellipsoid                    ? 4.0 / 3 * M_PI * 0.006
+                                                         : 2 * M_PI * M_PI * 0.2 * 0.05 * 0.05;
+    EXPECT_NEAR(volume / expected, 1.0, 0.02) << static_cast<int>(shape);
+  }
+}
+
+TEST(OpenSimModel, BadInputIsNamed)
+{
+  std::string e =
+    ExpectInputError([] { ParseModel("<OpenSimDocument Version=\"40000\"><Model><BodySet>", "bad.osim"); });
+  EXPECT_NE(e.find("bad.osim"), std::string::npos) << e;
+  EXPECT_NE(e.find("malformed XML"), std::string::npos) << e;
+
+  std::string text = kSmallModel;
+  text.replace(text.find("<PinJoint name=\"knee\">"), 22, "<HingeJoint name=\"knee\">");
+  text.replace(text.find("</PinJoint>"), 11, "</HingeJoint>");
+  e = ExpectInputError([&] { ParseModel(text, "small.osim"); });
+  EXPECT_NE(e.find("unknown joint type 'HingeJoint'"), std::string::npos) << e;
+  EXPECT_NE(e.find("line "), std::string::npos) << e;
+  EXPECT_NE(e.find("'knee'"), std::string::npos) << e;
+
+  text = kSmallModel;
+  text.replace(text.find("<PolynomialFunction name=\"function\">"), 35, "<GCVSpline name=\"function\">");
+  text.replace(text.find("</PolynomialFunction>"), 21, "</GCVSpline>");
+  e = ExpectInputError([&] { ParseModel(text, "small.osim"); });
+  EXPECT_NE(e.find("unknown function type 'GCVSpline'"), std::string::npos) << e;
+  EXPECT_NE(e.find("TransformAxis 'translation2'"), std::string::npos) << e;
+
+  text = kSmallModel;
+  text.replace(text.find("<socket_parent_frame>/bodyset/femur</socket_parent_frame><location>0.02"), 52,
+    "<socket_parent_frame>/bodyset/femr</socket_parent_frame>");
+  e = ExpectInputError([&] { ParseModel(text, "small.osim"); });
+  EXPECT_NE(e.find("no body or frame named '/bodyset/femr'"), std::string::npos) << e;
+  EXPECT_NE(e.find("ConditionalPathPoint 'c'"), std::string::npos) << e;
+
+  e = ExpectInputError([] { ReadModel("/nonexistent/model.osim"); });
+  EXPECT_NE(e.find("cannot be opened"), std::string::npos) << e;
+}
