@@ -18,7 +18,6 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import mdexamples  # noqa: E402
 from paraview import servermanager, simple  # noqa: E402
 
-SKIPPED = 77
 BONES = ("iliac_r", "sacrum", "femur_r")
 MUSCLES = ("gluteus_maximus_r", "gluteus_medius_r", "iliacus_r", "psoas_r")
 SETTINGS = dict(Scale=1000.0, ReferenceBody="pelvis", IgnoreUnknownColumns=1, PlayMotion=0, CurrentPoseTime=0.35,
@@ -51,10 +50,9 @@ def main(argv=None):
     parser.add_argument("--data", help="folder holding lhdl_hip_r (default ../shared/data)")
     parser.add_argument("--save-state", help="write the pipeline as a ParaView state file")
     args = parser.parse_args(argv)
-    data = mdexamples.data_dir(args.data)
+    data = mdexamples.lhdl_data_dir(args.data)
     if data is None:
-        print("SKIPPED: the LHDL data (lhdl_hip_r) was not found; pass --data or set MUSCLEDEFORMATION_DATA_DIR")
-        return SKIPPED
+        return mdexamples.SKIPPED
     mdexamples.load_plugin(explicit=args.plugin)
     pipeline = build(os.path.join(data, "lhdl_hip_r"))
     if args.save_state:

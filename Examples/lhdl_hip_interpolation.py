@@ -26,7 +26,6 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import lhdl  # noqa: E402
 import mdexamples  # noqa: E402
 
-SKIPPED = 77
 HIP_CENTRE = (143.48, 243.44, -432.67)
 
 
@@ -46,10 +45,9 @@ def main(argv=None):
     parser.add_argument("--steps", type=int, default=4, help="interpolation steps N (0 = automatic)")
     parser.add_argument("--mode", choices=["Rigid", "Linear"], default="Rigid")
     args = parser.parse_args(argv)
-    data = mdexamples.data_dir(args.data)
+    data = mdexamples.lhdl_data_dir(args.data)
     if data is None:
-        print("SKIPPED: the LHDL data (lhdl_hip_r) was not found; pass --data or set MUSCLEDEFORMATION_DATA_DIR")
-        return SKIPPED
+        return mdexamples.SKIPPED
     mdexamples.load_plugin(explicit=args.plugin)
 
     inputs = lhdl.load(os.path.join(data, "lhdl_hip_r"), args.motion, args.frame)

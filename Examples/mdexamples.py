@@ -49,6 +49,19 @@ def data_dir(explicit=None):
     return os.path.abspath(folder) if os.path.isdir(os.path.join(folder, "lhdl_hip_r")) else None
 
 
+SKIPPED = 77  # the exit code ctest reports as skipped
+
+
+def lhdl_data_dir(explicit=None, what=None):
+    """data_dir(explicit); when the LHDL data is absent, says that `what` (the run, when None) is
+    skipped and returns None."""
+    data = data_dir(explicit)
+    if data is None:
+        print("SKIPPED%s: the LHDL data (lhdl_hip_r) was not found; pass --data or set MUSCLEDEFORMATION_DATA_DIR"
+              % ("" if what is None else " " + what))
+    return data
+
+
 def make_view(size=(900, 900)):
     """A render view with a white background and no orientation axes."""
     view = simple.CreateView("RenderView")

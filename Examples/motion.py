@@ -204,17 +204,15 @@ def main(argv=None):
     if args.case in ("all", "phantom"):
         motion, camera = phantom_pipeline()
         results.append(run_case("phantom", motion, camera, args.output, args.every))
-    data = mdexamples.data_dir(args.data)
     for name in ("hip_flexion", "hip_adduction"):
         if args.case not in ("all", name):
             continue
+        data = mdexamples.lhdl_data_dir(args.data, name)
         if data is None:
-            print("SKIPPED %s: the LHDL data (lhdl_hip_r) was not found; pass --data or set "
-                  "MUSCLEDEFORMATION_DATA_DIR" % name)
             continue
         motion, camera = lhdl_pipeline(data, name)
         results.append(run_case("lhdl_" + name, motion, camera, args.output, args.every))
-    return 0 if results else 77
+    return 0 if results else mdexamples.SKIPPED
 
 
 if __name__ == "__main__":

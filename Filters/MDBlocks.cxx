@@ -547,6 +547,25 @@ int NearestTime(const std::vector<double>& times, double time)
   return static_cast<int>(k);
 }
 
+int AdvertiseSteps(vtkAlgorithm* filter, vtkInformationVector* outputVector, int numberOfSteps,
+  const std::vector<int>& ports, const std::function<int(int& steps)>& automatic, int& resolved)
+{
+  int steps = numberOfSteps;
+  if (steps == 0)
+  {
+    // The automatic count depends on the inputs' data, which the pipeline only produces after
+    // this pass: bring those inputs up to date first.
+    UpdateInputs(filter, ports);
+    if (const int result = automatic(steps); result != 1 || steps == 0)
+    {
+      return result;
+    }
+  }
+  resolved = steps;
+  AdvertiseTimes(outputVector, StepTimes(steps));
+  return 1;
+}
+
 void SetDataTime(vtkInformationVector* outputVector, double time)
 {
   for (int port = 0; port < outputVector->GetNumberOfInformationObjects(); ++port)

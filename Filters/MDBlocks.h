@@ -135,6 +135,11 @@ constexpr const char* FrameSeconds = "FrameSeconds";
 constexpr const char* Frame = "Frame";
 constexpr const char* Time = "Time";
 constexpr const char* ActionLineName = "ActionLineName";
+constexpr const char* Body = "Body"; ///< a body's name: BodyTransforms' first column, MoveWithBodies' field data
+/// BodyTransforms' other columns (OpenSimModelReader writes them, MoveWithBodies reads them): each
+/// body's rest-to-current rotation, row by row, then its translation.
+constexpr const char* TransformColumns[12] = { "R00", "R01", "R02", "R10", "R11", "R12", "R20", "R21", "R22", "Tx",
+  "Ty", "Tz" };
 }
 
 /// Writes `role` as the cell array Role of every polydata leaf of `data` (in leaf order: muscle
@@ -229,6 +234,12 @@ int StepAsked(vtkInformation* outInfo, int steps, int fallback);
 void InputsAtTheirOwnTime(vtkInformationVector** inputVector, int ports);
 /// Brings the inputs of `ports` up to date, for RequestInformation to read their data.
 void UpdateInputs(vtkAlgorithm* filter, const std::vector<int>& ports);
+/// RequestInformation of a filter whose time is its interpolation step: `numberOfSteps` steps, or
+/// when that is 0 as many as `automatic` finds (called once the inputs of `ports` are up to date;
+/// it returns RequestInformation's result, and sets `steps` when that is 1), advertised as the
+/// times 0 ... N on every output, N in `resolved`. Returns RequestInformation's result.
+int AdvertiseSteps(vtkAlgorithm* filter, vtkInformationVector* outputVector, int numberOfSteps,
+  const std::vector<int>& ports, const std::function<int(int& steps)>& automatic, int& resolved);
 /// Index of the entry of `times` (ascending, not empty) nearest `time`; the earlier one at a tie.
 int NearestTime(const std::vector<double>& times, double time);
 /// Stamps every output of `outputVector` with DATA_TIME_STEP `time`.

@@ -151,12 +151,7 @@ bool vtkBoneInterpolation::ReadPoses(vtkDataObject* restInput, vtkDataObject* cu
 int vtkBoneInterpolation::RequestInformation(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  int steps = this->NumberOfSteps;
-  if (steps == 0)
-  {
-    // The automatic count depends on the data, which the pipeline only
-    // produces after this pass: bring the inputs up to date first.
-    mdvtk::UpdateInputs(this, { 0, 1 });
+  auto automatic = [&](int& steps) {
     std::vector<Pose> poses;
     if (!this->ReadPoses(vtkDataObject::GetData(inputVector[0], 0),
           this->GetNumberOfInputConnections(1) ? vtkDataObject::GetData(inputVector[1], 0) : nullptr, poses))
@@ -169,15 +164,12 @@ int vtkBoneInterpolation::RequestInformation(
       largest = std::max(largest, md::MaximumDisplacement(pose.rest, pose.current));
     }
     int result = 1;
-    if (!mdvtk::CallCore(
-          this, "", [&] { steps = md::AutomaticNumberOfSteps(largest, this->MaximumStepDisplacement); }, result))
-    {
-      return result;
-    }
-  }
-  this->ResolvedNumberOfSteps = steps;
-  mdvtk::AdvertiseTimes(outputVector, mdvtk::StepTimes(steps));
-  return 1;
+    mdvtk::CallCore(
+      this, "", [&] { steps = md::AutomaticNumberOfSteps(largest, this->MaximumStepDisplacement); }, result);
+    return result;
+  };
+  return mdvtk::AdvertiseSteps(
+    this, outputVector, this->NumberOfSteps, { 0, 1 }, automatic, this->ResolvedNumberOfSteps);
 }
 
 int vtkBoneInterpolation::RequestUpdateExtent(

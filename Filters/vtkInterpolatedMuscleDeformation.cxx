@@ -169,12 +169,7 @@ int vtkInterpolatedMuscleDeformation::FillInputPortInformation(int, vtkInformati
 int vtkInterpolatedMuscleDeformation::RequestInformation(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  int steps = this->NumberOfSteps;
-  if (steps == 0)
-  {
-    // The automatic count depends on the bones, which the pipeline only
-    // produces after this pass: bring those inputs up to date first.
-    mdvtk::UpdateInputs(this, { 1, 2 });
+  auto automatic = [&](int& steps) {
     std::vector<md::BoneMotion> bones;
     std::string error;
     if (!mdvtk::ReadBones(nullptr, vtkDataObject::GetData(inputVector[1], 0), PortNames[1],
@@ -187,15 +182,12 @@ int vtkInterpolatedMuscleDeformation::RequestInformation(
     parameters.numberOfSteps = 0;
     parameters.maximumStepDisplacement = this->MaximumStepDisplacement; // bones in world units here
     int result = 1;
-    if (!mdvtk::CallCore(
-          this, "", [&] { steps = md::ResolveNumberOfSteps(bones, parameters); }, result))
-    {
-      return result;
-    }
-  }
-  this->ResolvedNumberOfSteps = steps;
-  mdvtk::AdvertiseTimes(outputVector, mdvtk::StepTimes(steps));
-  return 1;
+    mdvtk::CallCore(
+      this, "", [&] { steps = md::ResolveNumberOfSteps(bones, parameters); }, result);
+    return result;
+  };
+  return mdvtk::AdvertiseSteps(
+    this, outputVector, this->NumberOfSteps, { 1, 2 }, automatic, this->ResolvedNumberOfSteps);
 }
 
 int vtkInterpolatedMuscleDeformation::RequestUpdateExtent(

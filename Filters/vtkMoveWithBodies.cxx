@@ -69,10 +69,9 @@ int vtkMoveWithBodies::RequestData(
     vtkErrorMacro(<< error);
     return 0;
   }
-  static const char* columns[12] = { "R00", "R01", "R02", "R10", "R11", "R12", "R20", "R21", "R22", "Tx", "Ty", "Tz" };
-  vtkStringArray* bodies = table ? vtkStringArray::SafeDownCast(table->GetColumnByName("Body")) : nullptr;
+  vtkStringArray* bodies = table ? vtkStringArray::SafeDownCast(table->GetColumnByName(mdvtk::array::Body)) : nullptr;
   std::vector<vtkDataArray*> values;
-  for (const char* name : columns)
+  for (const char* name : mdvtk::array::TransformColumns)
   {
     values.push_back(table ? vtkDataArray::SafeDownCast(table->GetColumnByName(name)) : nullptr);
   }
@@ -136,7 +135,7 @@ int vtkMoveWithBodies::RequestData(
     vtkNew<vtkFieldData> fieldData;
     fieldData->ShallowCopy(leaves[i].data->GetFieldData());
     vtkNew<vtkStringArray> bodyArray;
-    bodyArray->SetName("Body");
+    bodyArray->SetName(mdvtk::array::Body);
     bodyArray->InsertNextValue(bodyNames[body]);
     fieldData->AddArray(bodyArray);
     moved->SetFieldData(fieldData);

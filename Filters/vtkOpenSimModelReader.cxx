@@ -506,11 +506,10 @@ void vtkOpenSimModelReader::WriteTransforms(const std::vector<md::RigidTransform
 {
   const Internals& in = *this->Internal;
   const osim::Model& model = in.model;
-  auto bodyNames = Strings("Body");
+  auto bodyNames = Strings(mdvtk::array::Body);
   table->AddColumn(bodyNames);
   std::vector<vtkSmartPointer<vtkDoubleArray>> columns;
-  static const char* names[12] = { "R00", "R01", "R02", "R10", "R11", "R12", "R20", "R21", "R22", "Tx", "Ty", "Tz" };
-  for (const char* name : names)
+  for (const char* name : mdvtk::array::TransformColumns)
   {
     auto column = vtkSmartPointer<vtkDoubleArray>::New();
     column->SetName(name);
