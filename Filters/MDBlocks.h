@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Helpers shared by the MuscleDeformation filters: walking and pairing the
-// leaves of polydata / multiblock inputs, and moving geometry between VTK and
-// the Eigen-based core. Not part of the public API.
+// What the MuscleDeformation filters share about their inputs and outputs: walking and pairing the
+// leaves of polydata / multiblock inputs, putting results back in the input's structure, the
+// roles (Role) and the names of the arrays the filters write. Not part of the public API; with
+// MDConvert.h (VTK <-> the core's meshes), MDReport.h (calling the core, failures, measures) and
+// MDTime.h (time steps).
 #pragma once
 
 #include "Common/MeshTypes.h"
@@ -9,33 +11,18 @@
 #include <vtkSmartPointer.h>
 #include <vtkType.h>
 
-#include <functional>
-#include <map>
 #include <string>
 #include <vector>
 
-class vtkAlgorithm;
-class vtkDataArray;
-class vtkDoubleArray;
 class vtkDataObject;
-class vtkFieldData;
 class vtkInformation;
 class vtkInformationVector;
 class vtkMultiBlockDataSet;
 class vtkObject;
-class vtkPoints;
 class vtkPolyData;
-
-namespace md
-{
-struct BoneMotion;
-struct MuscleStepMeasures;
-}
 
 namespace mdvtk
 {
-using md::Points;
-using md::TriangleMesh;
 /// One polydata of an input: the input itself, or a leaf of a multiblock.
 struct Leaf
 {
@@ -164,94 +151,6 @@ void AssignLeaves(
 /// Appends `block` to `tree` under the block name `name`.
 void AddBlock(vtkMultiBlockDataSet* tree, const std::string& name, vtkDataObject* block);
 
-/// Adds a one-value array to field data (a double, or an int for counts).
-void AddFieldValue(vtkFieldData* fieldData, const char* name, double value);
-void AddFieldValue(vtkFieldData* fieldData, const char* name, int value);
-void AddFieldValue(vtkFieldData* fieldData, const char* name, std::int64_t value);
-
-/// Advertises the time steps and range of `from` (an input's information) on `to` (an output's),
-/// or none when `from` has none.
-void CopyTimeSteps(vtkInformation* from, vtkInformation* to);
-
-/// A progress callback for the core: reports `offset + share * fraction` as the filter's
-/// progress and throws md::Cancelled when the user has asked the filter to stop (ParaView's
-/// abort). Call only from the filter's own thread.
-std::function<void(double)> ProgressOrCancel(vtkAlgorithm* filter, double offset = 0.0, double share = 1.0);
-/// Reports `fraction` as the filter's progress; true when the user has asked it to stop (the
-/// executive then empties the outputs, and RequestData returns 1).
-bool ProgressOrStop(vtkAlgorithm* filter, double fraction);
-/// Runs `work` (calls into the core) and turns the core's exceptions into what a filter reports:
-/// md::InputError becomes an error (`context` + its message) and RequestData's result 0;
-/// md::Cancelled (the user stopped the run) notes the abort, so that the executive empties the
-/// outputs, and the result 1. Returns true when `work` completed; otherwise `result` is what
-/// RequestData returns, and `reported` (optional) receives the error reported (empty when the
-/// user stopped the run), for a filter that goes on with its other muscles.
-bool CallCore(vtkAlgorithm* filter, const std::string& context, const std::function<void()>& work, int& result,
-  std::string* reported = nullptr);
-
-/// How messages and tables name a leaf: its block name, else its label.
-std::string NameOf(const Leaf& leaf);
-
-/// The surface of muscle `leaf` (ReadTriangles); false, with `error` naming the leaf, when it has
-/// no triangles.
-bool ReadMuscleSurface(const Leaf& leaf, TriangleMesh& surface, std::string& error);
-
-/// Reports `message` as an error of `filter` (unless `reported`) and records it as the failure of
-/// muscle block `block`: one muscle's fault leaves that muscle out, the others go on.
-void FailBlock(vtkObject* filter, std::map<size_t, std::string>& failedBlocks, size_t block, const std::string& message,
-  bool reported = false);
-
-/// A copy of `input` at `points`: its cells and arrays shared, its field data its own (for the
-/// measures a filter adds).
-vtkSmartPointer<vtkPolyData> MovedCopy(vtkPolyData* input, const Points& points);
-/// MovedCopy of a muscle, with point array Displacement (`displacement`, a row per point).
-vtkSmartPointer<vtkPolyData> MovedMuscle(vtkPolyData* input, const Points& points, const Points& displacement);
-
-/// One measure of a muscle, as the filters write it: to the muscle's field data (an int array for
-/// a count, a double array otherwise) and to a column of their measures table.
-struct Measure
-{
-  const char* name;
-  double value;
-  bool count = false;
-};
-/// Adds each of `measures` to `fieldData` (AddFieldValue).
-void AddMeasures(vtkFieldData* fieldData, const std::vector<Measure>& measures);
-/// What a muscle's step of the method, or frame of a motion, measured, in the order the filters
-/// write it: `iterations` is the count to report, `stepShift` adds StepStaticShift.
-std::vector<Measure> StepMeasures(const md::MuscleStepMeasures& s, int iterations, bool stepShift);
-
-/// The time steps 0, 1, ..., `steps` of a filter whose time is its interpolation step.
-std::vector<double> StepTimes(int steps);
-/// Advertises `times` (TIME_STEPS and TIME_RANGE) on every output of `outputVector`, or none
-/// when `times` is empty.
-void AdvertiseTimes(vtkInformationVector* outputVector, const std::vector<double>& times);
-/// The interpolation step asked of output `outInfo` (its UPDATE_TIME_STEP rounded into
-/// [0, steps]), or `fallback` when none is asked.
-int StepAsked(vtkInformation* outInfo, int steps, int fallback);
-/// Asks the inputs of ports 0 .. `ports` - 1 for their default time (a filter whose time is its
-/// interpolation step, not one of its inputs').
-void InputsAtTheirOwnTime(vtkInformationVector** inputVector, int ports);
-/// Brings the inputs of `ports` up to date, for RequestInformation to read their data.
-void UpdateInputs(vtkAlgorithm* filter, const std::vector<int>& ports);
-/// RequestInformation of a filter whose time is its interpolation step: `numberOfSteps` steps, or
-/// when that is 0 as many as `automatic` finds (called once the inputs of `ports` are up to date;
-/// it returns RequestInformation's result, and sets `steps` when that is 1), advertised as the
-/// times 0 ... N on every output, N in `resolved`. Returns RequestInformation's result.
-int AdvertiseSteps(vtkAlgorithm* filter, vtkInformationVector* outputVector, int numberOfSteps,
-  const std::vector<int>& ports, const std::function<int(int& steps)>& automatic, int& resolved);
-/// Index of the entry of `times` (ascending, not empty) nearest `time`; the earlier one at a tie.
-int NearestTime(const std::vector<double>& times, double time);
-/// Stamps every output of `outputVector` with DATA_TIME_STEP `time`.
-void SetDataTime(vtkInformationVector* outputVector, double time);
-
-/// The output block of a muscle that could not be processed: no geometry (nothing silently
-/// wrong to show), the input block's field data, and DeformationFailed / FailureMessage.
-vtkSmartPointer<vtkPolyData> FailedMuscle(vtkPolyData* input, const std::string& message);
-/// Whether the user has asked `filter` to stop; safe to ask from worker threads (it only reads
-/// the flag), for md::HullParameters::cancelled.
-std::function<bool()> AbortRequested(vtkAlgorithm* filter);
-
 /// RequestDataObject of a filter whose output k has the type of input `followed[k]` (when that
 /// input is connected) and whose output `tablePort` is a vtkTable.
 void OutputsFollowInputs(vtkInformationVector** inputVector, vtkInformationVector* outputVector,
@@ -264,34 +163,4 @@ void ClearOutputs(vtkInformationVector* outputVector);
 
 /// Accept vtkPolyData or vtkMultiBlockDataSet on an input port.
 void AcceptPolyDataOrMultiBlock(vtkInformation* info);
-
-/// Point coordinates in double precision.
-Points ToPoints(vtkPoints* points);
-/// The tuples of a 3-component array (such as CurrentPosition) in double precision.
-Points ToPoints(vtkDataArray* array);
-vtkSmartPointer<vtkPoints> ToVtkPoints(const Points& points);
-/// A 3-component point array named `name` holding the rows of `values` (displacements, shifts).
-vtkSmartPointer<vtkDoubleArray> ToVtkArray(const char* name, const Points& values);
-vtkSmartPointer<vtkPolyData> ToPolyData(const TriangleMesh& mesh);
-/// The polygons of `input` as triangles (polygons and strips triangulated),
-/// with all of its points. Returns the number of cells that were not triangles.
-vtkIdType ReadTriangles(vtkPolyData* input, TriangleMesh& mesh);
-/// The polylines of a polydata, each as its point coordinates, or as the rows
-/// of `values` (one per point of the polydata, e.g. a point array) when given.
-std::vector<Points> ToPolylines(vtkPolyData* polyData, const Points* values = nullptr);
-/// A polydata with one polyline cell per entry of `lines`, their points in order.
-vtkSmartPointer<vtkPolyData> ToPolyLines(const std::vector<Points>& lines);
-/// The meshes of every block of every connection of a repeatable input port
-/// (such as Obstacles), named by block name or label. Fails, with a message,
-/// on a block without triangles or with non-finite coordinates.
-bool ReadMeshes(vtkInformationVector* port, const std::string& portName, std::vector<std::string>& names,
-  std::vector<TriangleMesh>& meshes, std::string& error);
-
-/// The bones of `rest` (input `restName`) and `current` (input `currentName`) paired as PairLeaves
-/// pairs them, each with the same points in both; an empty block in both is skipped. Fails, naming
-/// the block, on a bone empty in one pose only, another number of points, or no polygons.
-/// `leafOfBone` (optional) receives the leaf of `rest` of each bone.
-bool ReadBones(vtkObject* reporter, vtkDataObject* rest, const std::string& restName, vtkDataObject* current,
-  const std::string& currentName, std::vector<md::BoneMotion>& bones, std::string& error,
-  std::vector<size_t>* leafOfBone = nullptr);
 }

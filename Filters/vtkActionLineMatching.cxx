@@ -2,6 +2,8 @@
 #include "vtkActionLineMatching.h"
 
 #include "MDBlocks.h"
+#include "MDConvert.h"
+#include "MDReport.h"
 #include "Motion/ActionLineMatching.h"
 
 #include <vtkCellArray.h>

@@ -2,6 +2,9 @@
 #include "vtkBoneInterpolation.h"
 
 #include "MDBlocks.h"
+#include "MDConvert.h"
+#include "MDReport.h"
+#include "MDTime.h"
 #include "Motion/BoneInterpolation.h"
 
 #include <vtkAlgorithmOutput.h>

@@ -4,6 +4,8 @@
 #include "Geometry/MeshChecks.h"
 #include "Hull/ProgressiveHull.h"
 #include "MDBlocks.h"
+#include "MDConvert.h"
+#include "MDReport.h"
 
 #include <vtkFieldData.h>
 #include <vtkInformation.h>

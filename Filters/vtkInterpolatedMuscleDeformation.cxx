@@ -3,6 +3,9 @@
 
 #include "Geometry/LocalFrame.h"
 #include "MDBlocks.h"
+#include "MDConvert.h"
+#include "MDReport.h"
+#include "MDTime.h"
 #include "Method/InterpolatedDeformation.h"
 #include "Motion/ActionLineMatching.h"
 

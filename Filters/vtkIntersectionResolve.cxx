@@ -6,6 +6,8 @@
 #include "Geometry/MeshChecks.h"
 #include "Intersections/StaticIntersections.h"
 #include "MDBlocks.h"
+#include "MDConvert.h"
+#include "MDReport.h"
 
 #include <vtkDoubleArray.h>
 #include <vtkFieldData.h>

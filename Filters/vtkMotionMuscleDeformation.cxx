@@ -2,6 +2,9 @@
 #include "vtkMotionMuscleDeformation.h"
 
 #include "MDBlocks.h"
+#include "MDConvert.h"
+#include "MDReport.h"
+#include "MDTime.h"
 #include "Method/InterpolatedDeformation.h"
 #include "Method/MotionDeformation.h"
 

@@ -3,6 +3,9 @@
 
 #include "Geometry/RigidMotion.h"
 #include "MDBlocks.h"
+#include "MDConvert.h"
+#include "MDReport.h"
+#include "MDTime.h"
 #include "OpenSim/OpenSimAttachment.h"
 
 #include <vtkAbstractArray.h>

@@ -8,6 +8,8 @@
 #include "Hull/ProgressiveHull.h"
 #include "Intersections/SurfacePass.h"
 #include "MDBlocks.h"
+#include "MDConvert.h"
+#include "MDReport.h"
 
 #include <vtkCellArray.h>
 #include <vtkDataArray.h>

@@ -2,6 +2,8 @@
 #include "vtkMusculoskeletalPhantom.h"
 
 #include "MDBlocks.h"
+#include "MDConvert.h"
+#include "MDReport.h"
 #include "Phantom/Phantom.h"
 
 #include <vtkCellArray.h>

@@ -2,6 +2,9 @@
 #include "vtkOpenSimModelReader.h"
 
 #include "MDBlocks.h"
+#include "MDConvert.h"
+#include "MDReport.h"
+#include "MDTime.h"
 #include "OpenSim/OpenSimKinematics.h"
 #include "OpenSim/OpenSimMotion.h"
 

@@ -5,6 +5,7 @@
 #include "FilterTestUtilities.h"
 #include "Geometry/MeshChecks.h"
 #include "MDBlocks.h"
+#include "MDReport.h"
 
 #include "vtkActionLineGrouping.h"
 #include "vtkActionLineMatching.h"

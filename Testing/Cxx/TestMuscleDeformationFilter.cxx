@@ -9,6 +9,7 @@
 #include "Deformation/MuscleDeformer.h"
 #include "Geometry/TriangleTree.h"
 #include "MDBlocks.h"
+#include "MDConvert.h"
 
 #include "vtkActionLineMatching.h"
 #include "vtkBoneInterpolation.h"

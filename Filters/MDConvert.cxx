@@ -1,0 +1,315 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "MDConvert.h"
+
+#include "Method/InterpolatedDeformation.h"
+
+#include <vtkAOSDataArrayTemplate.h>
+#include <vtkAbstractArray.h>
+#include <vtkCellArray.h>
+#include <vtkCellArrayIterator.h>
+#include <vtkCellData.h>
+#include <vtkCompositeDataSet.h>
+#include <vtkDataObjectTreeIterator.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkIdList.h>
+#include <vtkIdTypeArray.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
+#include <vtkMultiBlockDataSet.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkTriangleFilter.h>
+
+#include <algorithm>
+
+namespace mdvtk
+{
+using md::Points;
+using md::TriangleMesh;
+
+std::string NameOf(const Leaf& leaf)
+{
+  return leaf.name.empty() ? leaf.label : leaf.name;
+}
+
+bool ReadMuscleSurface(const Leaf& leaf, TriangleMesh& surface, std::string& error)
+{
+  ReadTriangles(leaf.data, surface);
+  if (surface.triangles.rows() == 0)
+  {
+    error = leaf.label + " has no surface (no polygons); a muscle must be a closed triangle surface";
+    return false;
+  }
+  return true;
+}
+
+vtkSmartPointer<vtkPolyData> MovedCopy(vtkPolyData* input, const Points& points)
+{
+  auto output = vtkSmartPointer<vtkPolyData>::New();
+  output->ShallowCopy(input);
+  vtkNew<vtkFieldData> fieldData;
+  fieldData->DeepCopy(input->GetFieldData());
+  output->SetFieldData(fieldData);
+  output->SetPoints(ToVtkPoints(points));
+  return output;
+}
+
+vtkSmartPointer<vtkPolyData> MovedMuscle(vtkPolyData* input, const Points& points, const Points& displacement)
+{
+  vtkSmartPointer<vtkPolyData> output = MovedCopy(input, points);
+  output->GetPointData()->AddArray(ToVtkArray(DisplacementArrayName, displacement));
+  return output;
+}
+
+Points ToPoints(vtkDataArray* array)
+{
+  const vtkIdType n = array ? array->GetNumberOfTuples() : 0;
+  Points out(n, 3);
+  if (n == 0)
+  {
+    return out;
+  }
+  // One call into VTK per array rather than per point: VTK here is built -O0. Scans are usually
+  // float: read from its memory directly (a DeepCopy into doubles goes value by value).
+  if (auto* floats = vtkAOSDataArrayTemplate<float>::FastDownCast(array))
+  {
+    if (floats->GetNumberOfComponents() == 3)
+    {
+      const float* values = floats->GetPointer(0);
+      std::copy(values, values + 3 * n, out.data());
+      return out;
+    }
+  }
+  vtkSmartPointer<vtkDoubleArray> doubles = vtkDoubleArray::SafeDownCast(array);
+  if (!doubles)
+  {
+    doubles = vtkSmartPointer<vtkDoubleArray>::New();
+    doubles->DeepCopy(array);
+  }
+  std::copy(doubles->GetPointer(0), doubles->GetPointer(0) + 3 * n, out.data());
+  return out;
+}
+
+Points ToPoints(vtkPoints* points)
+{
+  return ToPoints(points ? points->GetData() : nullptr);
+}
+
+vtkSmartPointer<vtkPoints> ToVtkPoints(const Points& points)
+{
+  auto out = vtkSmartPointer<vtkPoints>::New();
+  out->SetData(ToVtkArray(nullptr, points));
+  return out;
+}
+
+vtkSmartPointer<vtkDoubleArray> ToVtkArray(const char* name, const Points& values)
+{
+  auto array = vtkSmartPointer<vtkDoubleArray>::New();
+  array->SetName(name);
+  array->SetNumberOfComponents(3);
+  array->SetNumberOfTuples(values.rows());
+  std::copy(values.data(), values.data() + values.size(), array->GetPointer(0));
+  return array;
+}
+
+vtkSmartPointer<vtkPolyData> ToPolyData(const TriangleMesh& mesh)
+{
+  auto polyData = vtkSmartPointer<vtkPolyData>::New();
+  polyData->SetPoints(ToVtkPoints(mesh.points));
+  vtkNew<vtkIdTypeArray> connectivity;
+  connectivity->SetNumberOfValues(mesh.triangles.size());
+  std::copy(mesh.triangles.data(), mesh.triangles.data() + mesh.triangles.size(), connectivity->GetPointer(0));
+  vtkNew<vtkCellArray> polys;
+  polys->SetData(3, connectivity);
+  polyData->SetPolys(polys);
+  return polyData;
+}
+
+vtkSmartPointer<vtkPolyData> ToPolyLines(const std::vector<Points>& lines)
+{
+  Eigen::Index total = 0;
+  for (const Points& line : lines)
+  {
+    total += line.rows();
+  }
+  Points all(total, 3);
+  vtkNew<vtkCellArray> cells;
+  vtkIdType next = 0;
+  for (const Points& line : lines)
+  {
+    const auto n = static_cast<vtkIdType>(line.rows());
+    all.middleRows(next, n) = line;
+    cells->InsertNextCell(n);
+    for (vtkIdType k = 0; k < n; ++k)
+    {
+      cells->InsertCellPoint(next + k);
+    }
+    next += n;
+  }
+  auto output = vtkSmartPointer<vtkPolyData>::New();
+  output->SetPoints(ToVtkPoints(all));
+  output->SetLines(cells);
+  return output;
+}
+
+std::vector<Points> ToPolylines(vtkPolyData* polyData, const Points* values)
+{
+  std::vector<Points> lines;
+  vtkCellArray* cells = polyData ? polyData->GetLines() : nullptr;
+  if (!cells || cells->GetNumberOfCells() == 0)
+  {
+    return lines;
+  }
+  const Points all = values ? Points() : ToPoints(polyData->GetPoints());
+  const Points& source = values ? *values : all;
+  auto it = vtk::TakeSmartPointer(cells->NewIterator());
+  for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
+  {
+    vtkIdType size;
+    const vtkIdType* ids;
+    it->GetCurrentCell(size, ids);
+    Points line(size, 3);
+    for (vtkIdType k = 0; k < size; ++k)
+    {
+      line.row(k) = source.row(ids[k]);
+    }
+    lines.push_back(std::move(line));
+  }
+  return lines;
+}
+
+/// The polygons of `input` as triangles (polygons and strips triangulated).
+/// Returns the number of cells that were not triangles.
+vtkIdType ReadTriangles(vtkPolyData* input, TriangleMesh& mesh)
+{
+  vtkIdType converted = input->GetNumberOfStrips();
+  vtkCellArray* polys = input->GetPolys();
+  if (polys->IsHomogeneous() != 3)
+  {
+    auto it = vtk::TakeSmartPointer(polys->NewIterator());
+    for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
+    {
+      converted += it->GetCurrentCell()->GetNumberOfIds() != 3 ? 1 : 0;
+    }
+  }
+  vtkSmartPointer<vtkPolyData> triangles = input;
+  if (converted > 0)
+  {
+    vtkNew<vtkTriangleFilter> triangulate;
+    triangulate->SetInputData(input);
+    triangulate->PassVertsOff();
+    triangulate->PassLinesOff();
+    triangulate->Update();
+    triangles = triangulate->GetOutput();
+  }
+  mesh.points = ToPoints(triangles->GetPoints());
+  vtkCellArray* cells = triangles->GetPolys();
+  if (cells->GetNumberOfConnectivityIds() == 3 * cells->GetNumberOfCells())
+  {
+    vtkNew<vtkIdTypeArray> connectivity;
+    connectivity->DeepCopy(cells->GetConnectivityArray());
+    mesh.triangles.resize(cells->GetNumberOfCells(), 3);
+    std::copy(connectivity->GetPointer(0), connectivity->GetPointer(0) + mesh.triangles.size(), mesh.triangles.data());
+    return converted;
+  }
+  // Cells the triangulation left as they were (polygons of one or two points): not triangles.
+  std::vector<std::int64_t> ids;
+  auto it = vtk::TakeSmartPointer(cells->NewIterator());
+  for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
+  {
+    vtkIdType size;
+    const vtkIdType* cell;
+    it->GetCurrentCell(size, cell);
+    if (size == 3)
+    {
+      ids.insert(ids.end(), cell, cell + 3);
+    }
+  }
+  mesh.triangles.resize(static_cast<Eigen::Index>(ids.size() / 3), 3);
+  std::copy(ids.begin(), ids.end(), mesh.triangles.data());
+  return converted;
+}
+
+bool ReadMeshes(vtkInformationVector* port, const std::string& portName, std::vector<std::string>& names,
+  std::vector<TriangleMesh>& meshes, std::string& error)
+{
+  for (int c = 0; c < port->GetNumberOfInformationObjects(); ++c)
+  {
+    std::vector<Leaf> leaves;
+    const std::string name = portName + " connection " + std::to_string(c + 1);
+    if (!CollectLeaves(vtkDataObject::GetData(port, c), name, leaves, error))
+    {
+      return false;
+    }
+    for (const Leaf& leaf : leaves)
+    {
+      if (!leaf.data)
+      {
+        continue;
+      }
+      TriangleMesh mesh;
+      ReadTriangles(leaf.data, mesh);
+      if (mesh.triangles.rows() == 0)
+      {
+        error = leaf.label + " is not a usable mesh: it has no triangles";
+        return false;
+      }
+      names.push_back(leaf.name.empty() ? leaf.label : leaf.name);
+      meshes.push_back(std::move(mesh));
+    }
+  }
+  return true;
+}
+
+bool ReadBones(vtkObject* reporter, vtkDataObject* rest, const std::string& restName, vtkDataObject* current,
+  const std::string& currentName, std::vector<md::BoneMotion>& bones, std::string& error,
+  std::vector<size_t>* leafOfBone)
+{
+  std::vector<Leaf> restLeaves, currentLeaves;
+  std::vector<size_t> partner;
+  if (!CollectLeaves(rest, restName, restLeaves, error) || !CollectLeaves(current, currentName, currentLeaves, error) ||
+    !PairLeaves(reporter, restLeaves, restName, currentLeaves, currentName, partner, error))
+  {
+    return false;
+  }
+  for (size_t b = 0; b < restLeaves.size(); ++b)
+  {
+    const Leaf& r = restLeaves[b];
+    const Leaf& c = currentLeaves[partner[b]];
+    if (!r.data && !c.data)
+    {
+      continue; // an empty block in both poses
+    }
+    if (!r.data || !c.data)
+    {
+      // Dropping it would silently take an obstacle away.
+      error = (r.data ? c.label : r.label) + " is empty but " + (r.data ? r.label : c.label) +
+        " is not: a bone needs its surface in both poses";
+      return false;
+    }
+    md::BoneMotion bone;
+    bone.name = r.name.empty() ? r.label : r.name;
+    ReadTriangles(r.data, bone.rest);
+    bone.current = ToPoints(c.data->GetPoints());
+    if (bone.rest.points.rows() != bone.current.rows())
+    {
+      error = r.label + " has " + std::to_string(bone.rest.points.rows()) + " points but " + c.label + " has " +
+        std::to_string(bone.current.rows()) + ": a bone must have the same points in both poses";
+      return false;
+    }
+    if (bone.rest.triangles.rows() == 0)
+    {
+      error = r.label + " has no surface (no polygons)";
+      return false;
+    }
+    bones.push_back(std::move(bone));
+    if (leafOfBone)
+    {
+      leafOfBone->push_back(b);
+    }
+  }
+  return true;
+}
+}

@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Geometry between VTK and the core's Eigen meshes: points, triangles, polylines, a muscle read,
+// the bones in both poses, the moved copy of an input. Not part of the public API.
+#pragma once
+
+#include "MDBlocks.h"
+
+#include <vtkSmartPointer.h>
+#include <vtkType.h>
+
+#include <string>
+#include <vector>
+
+class vtkDataArray;
+class vtkDoubleArray;
+class vtkInformationVector;
+class vtkObject;
+class vtkPoints;
+class vtkPolyData;
+
+namespace md
+{
+struct BoneMotion;
+}
+
+namespace mdvtk
+{
+using md::Points;
+using md::TriangleMesh;
+/// How messages and tables name a leaf: its block name, else its label.
+std::string NameOf(const Leaf& leaf);
+
+/// The surface of muscle `leaf` (ReadTriangles); false, with `error` naming the leaf, when it has
+/// no triangles.
+bool ReadMuscleSurface(const Leaf& leaf, TriangleMesh& surface, std::string& error);
+
+/// A copy of `input` at `points`: its cells and arrays shared, its field data its own (for the
+/// measures a filter adds).
+vtkSmartPointer<vtkPolyData> MovedCopy(vtkPolyData* input, const Points& points);
+/// MovedCopy of a muscle, with point array Displacement (`displacement`, a row per point).
+vtkSmartPointer<vtkPolyData> MovedMuscle(vtkPolyData* input, const Points& points, const Points& displacement);
+
+/// Point coordinates in double precision.
+Points ToPoints(vtkPoints* points);
+/// The tuples of a 3-component array (such as CurrentPosition) in double precision.
+Points ToPoints(vtkDataArray* array);
+vtkSmartPointer<vtkPoints> ToVtkPoints(const Points& points);
+/// A 3-component point array named `name` holding the rows of `values` (displacements, shifts).
+vtkSmartPointer<vtkDoubleArray> ToVtkArray(const char* name, const Points& values);
+vtkSmartPointer<vtkPolyData> ToPolyData(const TriangleMesh& mesh);
+/// The polygons of `input` as triangles (polygons and strips triangulated),
+/// with all of its points. Returns the number of cells that were not triangles.
+vtkIdType ReadTriangles(vtkPolyData* input, TriangleMesh& mesh);
+/// The polylines of a polydata, each as its point coordinates, or as the rows
+/// of `values` (one per point of the polydata, e.g. a point array) when given.
+std::vector<Points> ToPolylines(vtkPolyData* polyData, const Points* values = nullptr);
+/// A polydata with one polyline cell per entry of `lines`, their points in order.
+vtkSmartPointer<vtkPolyData> ToPolyLines(const std::vector<Points>& lines);
+/// The meshes of every block of every connection of a repeatable input port
+/// (such as Obstacles), named by block name or label. Fails, with a message,
+/// on a block without triangles or with non-finite coordinates.
+bool ReadMeshes(vtkInformationVector* port, const std::string& portName, std::vector<std::string>& names,
+  std::vector<TriangleMesh>& meshes, std::string& error);
+
+/// The bones of `rest` (input `restName`) and `current` (input `currentName`) paired as PairLeaves
+/// pairs them, each with the same points in both; an empty block in both is skipped. Fails, naming
+/// the block, on a bone empty in one pose only, another number of points, or no polygons.
+/// `leafOfBone` (optional) receives the leaf of `rest` of each bone.
+bool ReadBones(vtkObject* reporter, vtkDataObject* rest, const std::string& restName, vtkDataObject* current,
+  const std::string& currentName, std::vector<md::BoneMotion>& bones, std::string& error,
+  std::vector<size_t>* leafOfBone = nullptr);
+}
