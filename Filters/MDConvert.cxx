@@ -34,9 +34,13 @@ std::string NameOf(const Leaf& leaf)
   return leaf.name.empty() ? leaf.label : leaf.name;
 }
 
-bool ReadMuscleSurface(const Leaf& leaf, TriangleMesh& surface, std::string& error)
+bool ReadMuscleSurface(const Leaf& leaf, TriangleMesh& surface, std::string& error, vtkIdType* converted)
 {
-  ReadTriangles(leaf.data, surface);
+  const vtkIdType notTriangles = ReadTriangles(leaf.data, surface);
+  if (converted)
+  {
+    *converted = notTriangles;
+  }
   if (surface.triangles.rows() == 0)
   {
     error = leaf.label + " has no surface (no polygons); a muscle must be a closed triangle surface";

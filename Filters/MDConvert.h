@@ -30,9 +30,9 @@ using md::TriangleMesh;
 /// How messages and tables name a leaf: its block name, else its label.
 std::string NameOf(const Leaf& leaf);
 
-/// The surface of muscle `leaf` (ReadTriangles); false, with `error` naming the leaf, when it has
-/// no triangles.
-bool ReadMuscleSurface(const Leaf& leaf, TriangleMesh& surface, std::string& error);
+/// The surface of muscle `leaf` (ReadTriangles; `converted`, optional, receives its count of cells
+/// that were not triangles); false, with `error` naming the leaf, when it has no triangles.
+bool ReadMuscleSurface(const Leaf& leaf, TriangleMesh& surface, std::string& error, vtkIdType* converted = nullptr);
 
 /// A copy of `input` at `points`: its cells and arrays shared, its field data its own (for the
 /// measures a filter adds).

@@ -72,18 +72,17 @@ int vtkHullDecimation::RequestData(
       continue;
     }
     ++muscleCount;
-    if (leaf.data->GetNumberOfPolys() + leaf.data->GetNumberOfStrips() == 0)
+    const auto start = std::chrono::steady_clock::now();
+    md::TriangleMesh muscle;
+    vtkIdType converted = 0;
+    std::string message;
+    if (!mdvtk::ReadMuscleSurface(leaf, muscle, message, &converted))
     {
-      const std::string message =
-        leaf.label + " has no surface (no polygons); a muscle must be a closed triangle surface";
       vtkErrorMacro(<< message);
       results[b] = mdvtk::FailedMuscle(leaf.data, message); // the other muscles go on
       ++failedCount;
       continue;
     }
-    const auto start = std::chrono::steady_clock::now();
-    md::TriangleMesh muscle;
-    const vtkIdType converted = mdvtk::ReadTriangles(leaf.data, muscle);
     md::MuscleHull built;
     int result = 1;
     std::string failure;

@@ -261,17 +261,19 @@ int vtkInterpolatedMuscleDeformation::Deform(vtkDataObject* const inputs[5], con
   std::vector<md::MuscleMotion> motions;
   for (size_t b = 0; b < muscles.size(); ++b)
   {
+    if (!muscles[b].data)
+    {
+      continue; // an empty block
+    }
     md::MuscleMotion motion;
     motion.name = mdvtk::NameOf(muscles[b]);
-    if (muscles[b].data && !mdvtk::ReadMuscleSurface(muscles[b], motion.muscle, error))
+    if (!mdvtk::ReadMuscleSurface(muscles[b], motion.muscle, error))
     {
       mdvtk::FailBlock(this, cache.failedBlocks, b, error);
+      continue;
     }
-    else if (muscles[b].data)
-    {
-      motions.push_back(std::move(motion));
-      cache.blockOf.push_back(b);
-    }
+    motions.push_back(std::move(motion));
+    cache.blockOf.push_back(b);
   }
   // Everything in the muscles' local frame from here on, the matching of the action lines
   // too: the same answer wherever the data sits and whatever its units.

@@ -98,18 +98,6 @@ struct FrameMeasures
     all.push_back({ mdvtk::array::SmoothnessRatio, this->smoothnessRatio[m] });
     return all;
   }
-  /// The measure of muscle `m` called `name`.
-  double Value(size_t m, const std::string& name) const
-  {
-    for (const mdvtk::Measure& measure : this->Of(m))
-    {
-      if (name == measure.name)
-      {
-        return measure.value;
-      }
-    }
-    return std::nan("");
-  }
 };
 
 struct vtkMotionMuscleDeformation::Internals
@@ -119,7 +107,6 @@ struct vtkMotionMuscleDeformation::Internals
   md::RestMappingCache kept;
   std::vector<size_t> blockOf;                    // muscle block of each muscle given to the core
   std::map<size_t, std::string> failedBlocks;     // muscle blocks left out, and why
-  std::vector<size_t> restLinesOf;                // ActionLinesRest leaf of each muscle block
   std::vector<size_t> boneLeaf;                   // BonesRest leaf of each bone
   std::vector<md::Points> restPoints;             // [muscle given]: as given, in the data's coordinates
   std::vector<std::vector<md::Points>> restLines; // [muscle given]
@@ -138,7 +125,6 @@ struct vtkMotionMuscleDeformation::Internals
     this->deformation.reset();
     this->blockOf.clear();
     this->failedBlocks.clear();
-    this->restLinesOf.clear();
     this->boneLeaf.clear();
     this->restPoints.clear();
     this->restLines.clear();
@@ -774,10 +760,23 @@ void vtkMotionMuscleDeformation::WriteTable(const Leaves& leaves, vtkTable* tabl
   column(mdvtk::array::FrameSeconds, [](int, const FrameMeasures& f) { return f.seconds; });
   for (const auto& [b, m] : in.MuscleOfBlock())
   {
-    for (const char* measure : TableMeasures)
+    // The muscle's measures at every frame, each found once; a column per measure of the table.
+    std::vector<std::vector<mdvtk::Measure>> frames;
+    for (const auto& entry : in.measures)
     {
-      column(std::string(measure) + " (" + mdvtk::NameOf(leaves.muscles[b]) + ")",
-        [&, m = m](int, const FrameMeasures& f) { return f.Value(m, measure); });
+      frames.push_back(entry.second.Of(m));
+    }
+    for (const char* name : TableMeasures)
+    {
+      vtkNew<vtkDoubleArray> array;
+      array->SetName((std::string(name) + " (" + mdvtk::NameOf(leaves.muscles[b]) + ")").c_str());
+      for (const std::vector<mdvtk::Measure>& frame : frames)
+      {
+        const auto found = std::find_if(
+          frame.begin(), frame.end(), [&](const mdvtk::Measure& measure) { return std::string(measure.name) == name; });
+        array->InsertNextValue(found != frame.end() ? found->value : std::nan(""));
+      }
+      table->AddColumn(array);
     }
   }
 }

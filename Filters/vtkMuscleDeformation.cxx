@@ -214,13 +214,8 @@ bool vtkMuscleDeformation::PassOnSurface(const PassInput& in, std::vector<std::s
         this, "",
         [&] {
           const std::vector<md::Obstacle> obstacles = md::BuildObstacles(in.obstacleNames, in.obstacleMeshes);
-          std::vector<md::FixedObstacle> fixed;
-          for (const md::Obstacle& o : obstacles)
-          {
-            fixed.push_back({ o.name, o.tree.get() });
-          }
-          settled =
-            md::SettleInOnePassThatCan(toSettle, fixed, parameters, failures, mdvtk::ProgressOrCancel(this, 0.3, 0.7));
+          settled = md::SettleInOnePassThatCan(
+            toSettle, md::FixedObstacles(obstacles), parameters, failures, mdvtk::ProgressOrCancel(this, 0.3, 0.7));
         },
         result))
   {

@@ -84,70 +84,96 @@ std::string Printed(vtkObject* object, const std::string& name)
   }
   return "";
 }
+
+std::string ReadText(const std::string& path)
+{
+  std::ifstream in(path);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-TEST(ServerManagerXml, EveryNumericDefaultIsTheConstructorsDefault)
+/// One numeric property of a proxy of ServerManagerXML.
+struct XmlProperty
 {
-  int compared = 0;
-  std::vector<std::string> files;
+  std::string className;                         ///< the proxy's VTK class
+  std::map<std::string, std::string> attributes; ///< the property's
+  std::string elements;                          ///< its domains, documentation, hints
+};
+
+/// Every Int or Double vector property of every SourceProxy of every file of ServerManagerXML
+/// (files in name order), and how many files there are.
+std::vector<XmlProperty> NumericProperties(size_t& files)
+{
+  std::vector<std::string> paths;
   for (const auto& file :
     std::filesystem::directory_iterator(std::string(MUSCLEDEFORMATION_SOURCE_DIR) + "/ServerManagerXML"))
   {
     if (file.path().extension() == ".xml")
     {
-      files.push_back(file.path().string());
+      paths.push_back(file.path().string());
     }
   }
-  std::sort(files.begin(), files.end());
-  ASSERT_EQ(files.size(), 11u) << "one file per proxy";
-  for (const std::string& file : files)
+  std::sort(paths.begin(), paths.end());
+  files = paths.size();
+  static const std::regex proxy(R"re(<SourceProxy([^>]*)>([\s\S]*?)</SourceProxy>)re");
+  static const std::regex property(R"re(<(Int|Double)VectorProperty([^>]*[^/])>([\s\S]*?)</\1VectorProperty>)re");
+  std::vector<XmlProperty> properties;
+  for (const std::string& path : paths)
   {
-    std::ifstream in(file);
-    ASSERT_TRUE(in) << file;
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    static const std::regex proxy(R"re(<SourceProxy([^>]*)>([\s\S]*?)</SourceProxy>)re");
-    static const std::regex property(R"re(<(Int|Double)VectorProperty([^>]*[^/])>([\s\S]*?)</\1VectorProperty>)re");
-    static const std::regex entry(R"re(<Entry([^>]*)/>)re");
+    const std::string text = ReadText(path);
     for (std::sregex_iterator p(text.begin(), text.end(), proxy), end; p != end; ++p)
     {
       const std::string className = Attributes((*p)[1])["class"];
-      ASSERT_EQ(Classes.count(className), 1u) << className << " is in the XML but not in this test";
-      vtkSmartPointer<vtkObject> object = Classes.at(className)();
       const std::string body = (*p)[2];
       for (std::sregex_iterator q(body.begin(), body.end(), property); q != end; ++q)
       {
-        std::map<std::string, std::string> a = Attributes((*q)[2]);
-        if (a["information_only"] == "1" || a["number_of_elements"] != "1" || a["default_values"].empty() ||
-          a["command"] != "Set" + a["name"])
-        {
-          continue;
-        }
-        const std::string printed = Printed(object, a["name"]);
-        ASSERT_FALSE(printed.empty()) << className << "::PrintSelf does not print " << a["name"];
-        char* rest = nullptr;
-        double value = std::strtod(printed.c_str(), &rest);
-        if (!rest || *rest != '\0')
-        {
-          // An enumeration may print its entry's text: the XML's Entry says its value.
-          const std::string elements = (*q)[3];
-          bool found = false;
-          for (std::sregex_iterator e(elements.begin(), elements.end(), entry); e != end && !found; ++e)
-          {
-            std::map<std::string, std::string> item = Attributes((*e)[1]);
-            if (item["text"] == printed)
-            {
-              value = std::stod(item["value"]);
-              found = true;
-            }
-          }
-          ASSERT_TRUE(found) << className << "." << a["name"] << " prints '" << printed << "', no number or entry";
-        }
-        EXPECT_DOUBLE_EQ(value, std::stod(a["default_values"]))
-          << className << "." << a["name"] << ": XML default " << a["default_values"] << ", C++ " << printed;
-        ++compared;
+        properties.push_back({ className, Attributes((*q)[2]), (*q)[3] });
       }
     }
   }
+  return properties;
+}
+}
+
+TEST(ServerManagerXml, EveryNumericDefaultIsTheConstructorsDefault)
+{
+  int compared = 0;
+  size_t files = 0;
+  static const std::regex entry(R"re(<Entry([^>]*)/>)re");
+  for (XmlProperty& xml : NumericProperties(files))
+  {
+    std::map<std::string, std::string>& a = xml.attributes;
+    const std::string& className = xml.className;
+    ASSERT_EQ(Classes.count(className), 1u) << className << " is in the XML but not in this test";
+    if (a["information_only"] == "1" || a["number_of_elements"] != "1" || a["default_values"].empty() ||
+      a["command"] != "Set" + a["name"])
+    {
+      continue;
+    }
+    vtkSmartPointer<vtkObject> object = Classes.at(className)();
+    const std::string printed = Printed(object, a["name"]);
+    ASSERT_FALSE(printed.empty()) << className << "::PrintSelf does not print " << a["name"];
+    char* rest = nullptr;
+    double value = std::strtod(printed.c_str(), &rest);
+    if (!rest || *rest != '\0')
+    {
+      // An enumeration may print its entry's text: the XML's Entry says its value.
+      bool found = false;
+      for (std::sregex_iterator e(xml.elements.begin(), xml.elements.end(), entry), end; e != end && !found; ++e)
+      {
+        std::map<std::string, std::string> item = Attributes((*e)[1]);
+        if (item["text"] == printed)
+        {
+          value = std::stod(item["value"]);
+          found = true;
+        }
+      }
+      ASSERT_TRUE(found) << className << "." << a["name"] << " prints '" << printed << "', no number or entry";
+    }
+    EXPECT_DOUBLE_EQ(value, std::stod(a["default_values"]))
+      << className << "." << a["name"] << ": XML default " << a["default_values"] << ", C++ " << printed;
+    ++compared;
+  }
+  EXPECT_EQ(files, 11u) << "one file per proxy";
   EXPECT_GE(compared, 39); // every numeric property the XML had when this was written: the parsing works
 }
 
@@ -169,12 +195,6 @@ double Bound(const std::string& token)
   const double value = std::strtod(token.c_str(), &rest);
   return rest && *rest == '\0' ? value : std::nan("");
 }
-
-std::string ReadText(const std::string& path)
-{
-  std::ifstream in(path);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
 }
 
 TEST(ServerManagerXml, EveryRangeTheGuiOffersTheFilterAccepts)
@@ -183,52 +203,38 @@ TEST(ServerManagerXml, EveryRangeTheGuiOffersTheFilterAccepts)
   // filter accepts. The first must lie within the second (a value offered and then silently
   // clamped is another value than the one shown), and every clamped property offers a range or
   // an enumeration.
-  const std::string source = MUSCLEDEFORMATION_SOURCE_DIR;
   int compared = 0;
-  static const std::regex proxy(R"re(<SourceProxy([^>]*)>([\s\S]*?)</SourceProxy>)re");
-  static const std::regex property(R"re(<(Int|Double)VectorProperty([^>]*[^/])>([\s\S]*?)</\1VectorProperty>)re");
+  size_t files = 0;
   static const std::regex range(R"re(<(Int|Double)RangeDomain([^>]*)/>)re");
-  for (const auto& file : std::filesystem::directory_iterator(source + "/ServerManagerXML"))
+  for (XmlProperty& xml : NumericProperties(files))
   {
-    const std::string text = ReadText(file.path().string());
-    for (std::sregex_iterator p(text.begin(), text.end(), proxy), end; p != end; ++p)
+    const std::string header = ReadText(std::string(MUSCLEDEFORMATION_SOURCE_DIR) + "/Filters/" + xml.className + ".h");
+    ASSERT_FALSE(header.empty()) << xml.className;
+    const std::string name = xml.className + "." + xml.attributes["name"];
+    const std::regex clamp(
+      "vtkSetClampMacro\\(\\s*" + xml.attributes["name"] + "\\s*,\\s*\\w+\\s*,\\s*([^,]+?)\\s*,\\s*([^)]+?)\\s*\\)");
+    std::smatch c;
+    if (!std::regex_search(header, c, clamp))
     {
-      const std::string className = Attributes((*p)[1])["class"];
-      const std::string header = ReadText(source + "/Filters/" + className + ".h");
-      ASSERT_FALSE(header.empty()) << className;
-      const std::string body = (*p)[2];
-      for (std::sregex_iterator q(body.begin(), body.end(), property); q != end; ++q)
-      {
-        std::map<std::string, std::string> a = Attributes((*q)[2]);
-        const std::string elements = (*q)[3];
-        const std::regex clamp(
-          "vtkSetClampMacro\\(\\s*" + a["name"] + "\\s*,\\s*\\w+\\s*,\\s*([^,]+?)\\s*,\\s*([^)]+?)\\s*\\)");
-        std::smatch c;
-        if (!std::regex_search(header, c, clamp))
-        {
-          continue;
-        }
-        std::smatch r;
-        const bool hasRange = std::regex_search(elements, r, range);
-        EXPECT_TRUE(hasRange || elements.find("EnumerationDomain") != std::string::npos)
-          << className << "." << a["name"] << " is clamped in C++ but offers no range in the XML";
-        if (!hasRange)
-        {
-          continue;
-        }
-        std::map<std::string, std::string> domain = Attributes(r[2]);
-        const double low = Bound(c[1]), high = Bound(c[2]);
-        ASSERT_FALSE(std::isnan(low) || std::isnan(high)) << className << "." << a["name"];
-        EXPECT_GE(std::stod(domain["min"]), low)
-          << className << "." << a["name"] << ": the GUI offers below the minimum";
-        if (!domain["max"].empty())
-        {
-          EXPECT_LE(std::stod(domain["max"]), high)
-            << className << "." << a["name"] << ": the GUI offers above the maximum";
-        }
-        ++compared;
-      }
+      continue;
     }
+    std::smatch r;
+    const bool hasRange = std::regex_search(xml.elements, r, range);
+    EXPECT_TRUE(hasRange || xml.elements.find("EnumerationDomain") != std::string::npos)
+      << name << " is clamped in C++ but offers no range in the XML";
+    if (!hasRange)
+    {
+      continue;
+    }
+    std::map<std::string, std::string> domain = Attributes(r[2]);
+    const double low = Bound(c[1]), high = Bound(c[2]);
+    ASSERT_FALSE(std::isnan(low) || std::isnan(high)) << name;
+    EXPECT_GE(std::stod(domain["min"]), low) << name << ": the GUI offers below the minimum";
+    if (!domain["max"].empty())
+    {
+      EXPECT_LE(std::stod(domain["max"]), high) << name << ": the GUI offers above the maximum";
+    }
+    ++compared;
   }
   EXPECT_GE(compared, 30); // the ranges the XML had when this was written: the parsing works
 }

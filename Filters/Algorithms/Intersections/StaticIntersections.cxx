@@ -608,6 +608,16 @@ std::vector<double> RestoreVolumes(std::vector<TriangleMesh>& meshes, const std:
   return left;
 }
 
+std::vector<FixedObstacle> FixedObstacles(const std::vector<Obstacle>& obstacles)
+{
+  std::vector<FixedObstacle> fixed;
+  for (const Obstacle& o : obstacles)
+  {
+    fixed.push_back({ o.name, o.tree.get() });
+  }
+  return fixed;
+}
+
 StaticStep ResolveStatically(const std::vector<TriangleMesh>& meshes, const std::vector<TriangleMesh>* meshesRest,
   const std::vector<std::string>& obstacleNames, const std::vector<TriangleMesh>& obstacles,
   const std::vector<std::string>& restObstacleNames, const std::vector<TriangleMesh>& restObstacles,
@@ -619,14 +629,6 @@ StaticStep ResolveStatically(const std::vector<TriangleMesh>& meshes, const std:
       progress(fraction);
     }
   };
-  auto fixedOf = [](const std::vector<Obstacle>& list) {
-    std::vector<FixedObstacle> fixed;
-    for (const Obstacle& o : list)
-    {
-      fixed.push_back({ o.name, o.tree.get() });
-    }
-    return fixed;
-  };
   const std::vector<Obstacle> trees = BuildObstacles(obstacleNames, obstacles);
   report(0.2);
   OverlapMasks existing;
@@ -634,10 +636,10 @@ StaticStep ResolveStatically(const std::vector<TriangleMesh>& meshes, const std:
   {
     const std::vector<Obstacle> restTrees =
       restObstacles.empty() ? std::vector<Obstacle>{} : BuildObstacles(restObstacleNames, restObstacles);
-    existing = FindOverlaps(*meshesRest, fixedOf(restObstacles.empty() ? trees : restTrees));
+    existing = FindOverlaps(*meshesRest, FixedObstacles(restObstacles.empty() ? trees : restTrees));
   }
   report(0.4);
-  const std::vector<FixedObstacle> fixed = fixedOf(trees);
+  const std::vector<FixedObstacle> fixed = FixedObstacles(trees);
   StaticStep step;
   step.resolved = ResolveStaticIntersections(meshes, fixed, meshesRest ? &existing : nullptr, parameters);
   report(0.8);

@@ -21,6 +21,11 @@ struct FixedObstacle
   const TriangleTree* tree = nullptr;
 };
 
+struct Obstacle;
+
+/// Views of the trees of `obstacles` (BuildObstacles), which must outlive them.
+std::vector<FixedObstacle> FixedObstacles(const std::vector<Obstacle>& obstacles);
+
 /// overlap[m][o][i] != 0: point i of deformable mesh m lies inside obstacle o,
 /// where o counts the fixed obstacles first, then the deformable meshes (a
 /// mesh's own entry is empty). Used for the overlap a rest pose already has.

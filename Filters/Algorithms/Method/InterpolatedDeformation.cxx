@@ -674,11 +674,7 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   // pose already has (the scans overlap the bones) is left alone by the
   // static resolution and not counted as new penetration.
   const std::vector<Obstacle> obstacles = RestBoneObstacles(bones);
-  std::vector<FixedObstacle> fixed;
-  for (const Obstacle& o : obstacles)
-  {
-    fixed.push_back({ o.name, o.tree.get() });
-  }
+  const std::vector<FixedObstacle> fixed = FixedObstacles(obstacles);
   std::vector<TriangleMesh> current(count);
   for (size_t m = 0; m < count; ++m)
   {

@@ -228,10 +228,7 @@ MotionDeformation::MotionDeformation(const std::vector<Muscle>& muscles, const s
     in.frame.ToLocal(restBones.back().points);
   }
   in.obstacles = BuildObstacles(in.boneNames, restBones);
-  for (const Obstacle& o : in.obstacles)
-  {
-    in.fixed.push_back({ o.name, o.tree.get() });
-  }
+  in.fixed = FixedObstacles(in.obstacles);
   auto state = std::make_shared<State>();
   for (const MuscleMotion& m : in.muscles)
   {
