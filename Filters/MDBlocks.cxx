@@ -89,11 +89,9 @@ std::optional<vtkIdType> FirstIdOutOfRange(vtkDataArray* ids, vtkIdType points)
   copy->DeepCopy(ids);
   return FirstOutOfRange(copy->GetPointer(0), count, points);
 }
+}
 
-/// Fails, naming the block, on coordinates that are not finite or beyond 1e100, a cell that
-/// refers to a point the block does not have, or a point array whose tuples do not match the
-/// points: what would otherwise be read past an array's end or overflow.
-bool CheckLeaf(vtkPolyData* data, const std::string& label, std::string& error)
+bool CheckPolyData(vtkPolyData* data, const std::string& label, std::string& error)
 {
   const vtkIdType points = data->GetNumberOfPoints();
   // Coordinates: finite, and small enough that products of three of them (volumes) stay finite.
@@ -144,7 +142,6 @@ bool CheckLeaf(vtkPolyData* data, const std::string& label, std::string& error)
   }
   return true;
 }
-}
 
 namespace
 {
@@ -160,7 +157,7 @@ bool CollectLeaves(
   if (auto* polyData = vtkPolyData::SafeDownCast(input))
   {
     leaves.push_back(Leaf{ "", polyData, inputName });
-    return !checkData || CheckLeaf(polyData, inputName, error);
+    return !checkData || CheckPolyData(polyData, inputName, error);
   }
   auto* tree = vtkMultiBlockDataSet::SafeDownCast(input);
   if (!tree)
@@ -187,7 +184,7 @@ bool CollectLeaves(
     }
     if (polyData && ok && checkData)
     {
-      ok = CheckLeaf(polyData, label, error);
+      ok = CheckPolyData(polyData, label, error);
     }
     leaves.push_back(Leaf{ name, polyData, label });
   });

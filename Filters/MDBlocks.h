@@ -38,6 +38,11 @@ struct Leaf
 /// not have, or a point array whose length is not its number of points.
 bool CollectLeaves(vtkDataObject* input, const std::string& inputName, std::vector<Leaf>& leaves, std::string& error);
 
+/// Fails, naming the block by `label`, on coordinates that are not finite or beyond 1e100, a cell
+/// that refers to a point the block does not have, or a point array whose tuples do not match the
+/// points: what would otherwise be read past an array's end or overflow.
+bool CheckPolyData(vtkPolyData* data, const std::string& label, std::string& error);
+
 /// The latest modification time of `input` and of every leaf of it (a multiblock's own time
 /// does not change when a leaf is modified in place); 0 for none.
 vtkMTimeType DataMTime(vtkDataObject* input);

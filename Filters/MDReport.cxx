@@ -158,6 +158,13 @@ vtkSmartPointer<vtkPolyData> FailedMuscle(vtkPolyData* input, const std::string&
   return output;
 }
 
+std::string UpstreamFailure(vtkPolyData* block)
+{
+  auto* why =
+    block ? vtkStringArray::SafeDownCast(block->GetFieldData()->GetAbstractArray(FailureMessageArrayName)) : nullptr;
+  return why && why->GetNumberOfValues() > 0 ? " (left out upstream: " + why->GetValue(0) + ")" : "";
+}
+
 std::function<bool()> AbortRequested(vtkAlgorithm* filter)
 {
   return [filter] {

@@ -69,6 +69,9 @@ std::vector<Measure> StepMeasures(const md::MuscleStepMeasures& s, int iteration
 /// The output block of a muscle that could not be processed: no geometry (nothing silently
 /// wrong to show), the input block's field data, and DeformationFailed / FailureMessage.
 vtkSmartPointer<vtkPolyData> FailedMuscle(vtkPolyData* input, const std::string& message);
+/// " (left out upstream: <why>)" for a block an earlier filter failed (its FailureMessage), or "":
+/// for a message that says why the block is empty.
+std::string UpstreamFailure(vtkPolyData* block);
 /// Whether the user has asked `filter` to stop; safe to ask from worker threads (it only reads
 /// the flag), for md::HullParameters::cancelled.
 std::function<bool()> AbortRequested(vtkAlgorithm* filter);

@@ -24,6 +24,7 @@
 #include <vtkStringArray.h>
 
 #include <cstdint>
+#include <map>
 #include <sstream>
 
 vtkStandardNewMacro(vtkActionLineGrouping);
@@ -36,6 +37,8 @@ struct vtkActionLineGrouping::Grouped
   std::string assignments;
   md::osim::PathGrouping grouping;
   std::string decision;
+  /// The muscles no path runs inside, and why: named failed blocks, the others go on.
+  std::map<size_t, std::string> failed;
   /// Output 0 (the rest pose's paths grouped) as built from paths with `pathsDigest`: the same
   /// while the grouping and the paths are, so it is not built again at every frame.
   vtkSmartPointer<vtkMultiBlockDataSet> pathsOutput;
@@ -273,16 +276,22 @@ bool vtkActionLineGrouping::Group(Inputs& in, const std::string& assignments, in
              << (decided.assignedByUser[p] ? "as given, " : "")
              << static_cast<int>(100 * decided.insideFraction[p] + 0.5) << " % of its length inside)\n";
   }
+  // A muscle no path reaches is left out, named, as a failed block; the others go on.
+  std::map<size_t, std::string> failed;
   for (size_t m = 0; m < in.muscles.size(); ++m)
   {
     if (std::find(decided.muscleOfPath.begin(), decided.muscleOfPath.end(), static_cast<int>(m)) ==
       decided.muscleOfPath.end())
     {
-      vtkErrorMacro(<< in.muscles[m].label << ": no path runs inside this muscle; name its paths in PathsOfMuscle "
-                    << "(e.g. " << in.muscleNames[m] << "=" << in.pathNames.front() << ")");
-      result = 0;
-      return false;
+      mdvtk::FailBlock(this, failed, m,
+        in.muscles[m].label + ": no path runs inside this muscle (at least 5 % of a path's length); name its paths " +
+          "in PathsOfMuscle (e.g. " + in.muscleNames[m] + "=" + in.pathNames.front() + ")");
     }
+  }
+  if (failed.size() == in.muscles.size())
+  {
+    result = 0;
+    return false; // nothing left to group, each failure said
   }
   this->Decision = decision.str();
   vtkOutputWindow::GetInstance()->DisplayText(("ActionLineGrouping:\n" + this->Decision).c_str());
@@ -291,8 +300,8 @@ bool vtkActionLineGrouping::Group(Inputs& in, const std::string& assignments, in
     vtkWarningMacro(<< "paths that run inside no muscle (less than 5 % of their length) are left out: "
                     << unassigned.str());
   }
-  this->LastGrouping.reset(
-    new Grouped{ std::move(in.meshes), in.lines, in.muscleNames, in.pathNames, assignments, decided, this->Decision });
+  this->LastGrouping.reset(new Grouped{
+    std::move(in.meshes), in.lines, in.muscleNames, in.pathNames, assignments, decided, this->Decision, failed });
   return true;
 }
 
@@ -304,6 +313,12 @@ void vtkActionLineGrouping::BuildGrouped(const Inputs& in, bool current, vtkMult
   vtkNew<vtkAppendPolyData> append;
   for (size_t m = 0; m < in.muscles.size(); ++m)
   {
+    const auto failed = this->LastGrouping->failed.find(m);
+    if (failed != this->LastGrouping->failed.end())
+    {
+      mdvtk::AddBlock(output, in.muscleNames[m], mdvtk::FailedMuscle(nullptr, failed->second));
+      continue;
+    }
     std::vector<vtkSmartPointer<vtkPolyData>> copies;
     vtkNew<vtkStringArray> names;
     names->SetName("ActionLinePaths");

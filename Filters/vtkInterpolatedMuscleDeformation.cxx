@@ -368,7 +368,7 @@ bool vtkInterpolatedMuscleDeformation::MatchLines(const std::vector<mdvtk::Leaf>
     if (rest.empty())
     {
       mdvtk::FailBlock(this, cache.failedBlocks, b,
-        restLeaf.label + " has no polylines: muscle " + muscles[b].label +
+        restLeaf.label + " has no polylines" + mdvtk::UpstreamFailure(restLeaf.data) + ": muscle " + muscles[b].label +
           " needs its action lines, or nothing says where it goes");
       continue;
     }

@@ -227,6 +227,19 @@ bool vtkIntersectionResolve::ReadInputs(vtkInformationVector** inputVector, Read
       }
       read.deformableRest.push_back({ rest.points, meshes[b].triangles });
     }
+    // The volume change is measured against this volume: a flat surface has none to keep.
+    const md::Points& reference = read.restGiven ? read.deformableRest.back().points : meshes[b].points;
+    const double size = md::BoxDiagonal(reference);
+    if (!(std::abs(md::SignedVolume(reference, meshes[b].triangles)) > md::kDegenerateShare * size * size * size))
+    {
+      read.failedBlocks[b] = (read.restGiven ? restLeaves[restOf[b]].label : read.leaves[b].label) +
+        " encloses no volume (it is flat or degenerate): a muscle must be a closed surface around its volume";
+      if (read.restGiven)
+      {
+        read.deformableRest.pop_back();
+      }
+      continue;
+    }
     read.deformable.push_back(meshes[b]);
     read.used.push_back(b);
   }

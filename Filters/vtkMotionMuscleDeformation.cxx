@@ -22,6 +22,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 
 vtkStandardNewMacro(vtkMotionMuscleDeformation);
@@ -193,6 +194,9 @@ struct vtkMotionMuscleDeformation::Internals
     // What drives the muscles (the bones' points and the lines), once for all muscles.
     const double driven =
       threeFrames ? md::LargestSecondDifference(older->second.pose, before->second.pose, pose) : 0.0;
+    // A frame computed again (after the cache dropped it) is the same to the bit: where the two
+    // frames before it were dropped too, its smoothness stays as first measured.
+    const auto measuredBefore = this->measures.find(k);
     for (size_t m = 0; m < this->blockOf.size(); ++m)
     {
       kept.points[m] = advanced.points[m];
@@ -204,6 +208,11 @@ struct vtkMotionMuscleDeformation::Internals
       {
         second = md::LargestSecondDifference(older->second.points[m], before->second.points[m], kept.points[m]);
         ratio = driven > 0 ? second / driven : std::nan("");
+      }
+      else if (!threeFrames && measuredBefore != this->measures.end())
+      {
+        second = measuredBefore->second.secondDifference[m];
+        ratio = measuredBefore->second.smoothnessRatio[m];
       }
       measures.secondDifference.push_back(second);
       measures.smoothnessRatio.push_back(ratio);
@@ -301,6 +310,16 @@ int vtkMotionMuscleDeformation::RequestInformation(
                      "and MoveWithBodies and ActionLineGrouping after it); for one pose use "
                      "InterpolatedMuscleDeformation");
     return 0;
+  }
+  for (const auto& [port, times] : { std::make_pair(2, &bones), std::make_pair(4, &lines) })
+  {
+    const auto back = std::adjacent_find(times->begin(), times->end(), std::greater_equal<double>());
+    if (back != times->end())
+    {
+      vtkErrorMacro(<< PortNames[port] << "'s time steps do not increase (" << *back << " then " << *(back + 1)
+                    << "): a motion's frames must come in the order of their times");
+      return 0;
+    }
   }
   const double scale = std::max(std::abs(bones.front()), std::abs(bones.back())) + 1.0;
   bool agree = bones.size() == lines.size();
@@ -529,7 +548,7 @@ bool vtkMotionMuscleDeformation::Start(const Leaves& leaves, int& result)
     if (muscle.restLines.empty())
     {
       mdvtk::FailBlock(this, in.failedBlocks, b,
-        lines.label + " has no polylines: muscle " + leaf.label +
+        lines.label + " has no polylines" + mdvtk::UpstreamFailure(lines.data) + ": muscle " + leaf.label +
           " needs its action lines, or nothing says where it goes");
       continue;
     }

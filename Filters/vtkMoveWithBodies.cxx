@@ -98,14 +98,29 @@ int vtkMoveWithBodies::RequestData(
     {
       t.translation[i] = values[9 + i]->GetComponent(row, 0);
     }
+    const std::string problem = md::NotARigidMotion(t);
+    if (!problem.empty())
+    {
+      vtkErrorMacro(<< "BodyTransforms row " << row << " (body '" << bodyNames.back() << "'): " << problem);
+      return 0;
+    }
     motions.push_back(t);
   }
   std::vector<vtkSmartPointer<vtkPolyData>> results(leaves.size());
   std::vector<std::pair<std::string, std::vector<std::string>>> assignments;
+  std::vector<int> bodyOfLeaf(leaves.size(), -1);
   int result = 1;
   if (!mdvtk::CallCore(
         this, "BodyOfSurface: ",
-        [&] { assignments = md::osim::ParseAssignments(this->BodyOfSurface ? this->BodyOfSurface : ""); }, result))
+        [&] {
+          assignments = md::osim::ParseAssignments(this->BodyOfSurface ? this->BodyOfSurface : "");
+          for (size_t i = 0; i < leaves.size(); ++i)
+          {
+            bodyOfLeaf[i] =
+              md::osim::BodyOfSurface(leaves[i].name.empty() ? "Input" : leaves[i].name, bodyNames, assignments);
+          }
+        },
+        result))
   {
     return result;
   }
@@ -116,7 +131,7 @@ int vtkMoveWithBodies::RequestData(
       continue;
     }
     const std::string name = leaves[i].name.empty() ? "Input" : leaves[i].name;
-    const int body = md::osim::BodyOfSurface(name, bodyNames, assignments);
+    const int body = bodyOfLeaf[i];
     if (body < 0)
     {
       std::string list;

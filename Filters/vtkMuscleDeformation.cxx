@@ -47,7 +47,7 @@ bool ReadMatchedLines(
   vtkPolyData* data = leaf.data;
   if (!data || !data->GetLines() || data->GetLines()->GetNumberOfCells() == 0)
   {
-    error = leaf.label + " has no polylines: each muscle needs its action lines";
+    error = leaf.label + " has no polylines" + mdvtk::UpstreamFailure(data) + ": each muscle needs its action lines";
     return false;
   }
   vtkDataArray* current = data->GetPointData()->GetArray(mdvtk::CurrentPositionArrayName);

@@ -5,6 +5,7 @@
 #include "MDConvert.h"
 #include "MDReport.h"
 #include "MDTime.h"
+#include "OpenSim/MeshFileCheck.h"
 #include "OpenSim/OpenSimKinematics.h"
 #include "OpenSim/OpenSimMotion.h"
 
@@ -74,25 +75,47 @@ vtkSmartPointer<vtkPolyData> ReadWith(const std::string& path)
   return reader->GetOutput();
 }
 
-/// A mesh file (.vtp, .stl, .obj, .vtk); null when it cannot be read or has no points.
-vtkSmartPointer<vtkPolyData> ReadMeshFile(const std::string& path)
+/// A mesh file (.vtp, .stl, .obj, .vtk) of body `body`, its header checked before VTK allocates
+/// what it claims, its cells and coordinates after. Null for another extension; throws
+/// md::InputError naming the file for one that is damaged or holds no points.
+vtkSmartPointer<vtkPolyData> ReadMeshFile(const std::string& path, const std::string& body)
 {
   const std::string extension = vtksys::SystemTools::LowerCase(vtksys::SystemTools::GetFilenameLastExtension(path));
+  if (extension != ".vtp" && extension != ".stl" && extension != ".obj" && extension != ".vtk")
+  {
+    return nullptr;
+  }
+  md::osim::CheckMeshFileHeader(path);
   vtkSmartPointer<vtkPolyData> mesh = extension == ".vtp" ? ReadWith<vtkXMLPolyDataReader>(path)
     : extension == ".stl"                                 ? ReadWith<vtkSTLReader>(path)
     : extension == ".obj"                                 ? ReadWith<vtkOBJReader>(path)
-    : extension == ".vtk"                                 ? ReadWith<vtkPolyDataReader>(path)
-                                                          : nullptr;
-  if (mesh && (!mesh->GetPoints() || mesh->GetNumberOfPoints() == 0))
+                                                          : ReadWith<vtkPolyDataReader>(path);
+  const std::string label = "mesh file '" + path + "' (body '" + body + "')";
+  if (!mesh || !mesh->GetPoints() || mesh->GetNumberOfPoints() == 0)
   {
-    mesh = nullptr;
+    throw md::InputError(label + " holds no points: it is empty, damaged or not a " + extension + " file");
+  }
+  std::string error;
+  if (!mdvtk::CheckPolyData(mesh, label, error))
+  {
+    throw md::InputError(error);
   }
   return mesh;
 }
 
+/// Whether `path` lies inside `folder` (both as the file system resolves them).
+bool IsInside(const std::string& path, const std::string& folder)
+{
+  const std::string real = vtksys::SystemTools::GetRealPath(path);
+  const std::string base = vtksys::SystemTools::GetRealPath(folder.empty() ? "." : folder);
+  return real.size() > base.size() && real.compare(0, base.size(), base) == 0 && real[base.size()] == '/';
+}
+
 /// A body's meshes (the files of its geometry, found in `folders`) as one mesh in the body's
-/// frame; the files not found are added to `missing`.
-BodyMesh ReadBodyMesh(const osim::Body& body, const std::vector<std::string>& folders, std::string& missing)
+/// frame; the files not found are added to `missing`, those found outside every folder (a name
+/// with '../' or an absolute one) to `outside`.
+BodyMesh ReadBodyMesh(
+  const osim::Body& body, const std::vector<std::string>& folders, std::string& missing, std::string& outside)
 {
   std::vector<md::Points> parts;
   vtkNew<vtkCellArray> polys;
@@ -105,6 +128,7 @@ BodyMesh ReadBodyMesh(const osim::Body& body, const std::vector<std::string>& fo
     std::replace(relative.begin(), relative.end(), '\\', '/');
     const std::string bare = vtksys::SystemTools::GetFilenameName(relative);
     vtkSmartPointer<vtkPolyData> mesh;
+    std::string found;
     for (const std::string& f : folders)
     {
       for (const std::string& name : { relative, bare })
@@ -112,7 +136,8 @@ BodyMesh ReadBodyMesh(const osim::Body& body, const std::vector<std::string>& fo
         const std::string path = vtksys::SystemTools::FileIsFullPath(name) ? name : f + "/" + name;
         if (!mesh && vtksys::SystemTools::FileExists(path, true))
         {
-          mesh = ReadMeshFile(path);
+          mesh = ReadMeshFile(path, body.name);
+          found = path;
         }
       }
     }
@@ -120,6 +145,11 @@ BodyMesh ReadBodyMesh(const osim::Body& body, const std::vector<std::string>& fo
     {
       missing += (missing.empty() ? "" : ", ") + g.file + " (" + body.name + ")";
       continue;
+    }
+    if (std::none_of(folders.begin(), folders.end(), [&](const std::string& f) { return IsInside(found, f); }))
+    {
+      outside += (outside.empty() ? "" : ", ") + g.file + " (" + body.name + ") at '" +
+        vtksys::SystemTools::GetRealPath(found) + "'";
     }
     md::Points local = mdvtk::ToPoints(mesh->GetPoints());
     local = local * g.scale.asDiagonal();
@@ -149,6 +179,23 @@ BodyMesh ReadBodyMesh(const osim::Body& body, const std::vector<std::string>& fo
   }
   target.polys = polys;
   return target;
+}
+
+/// Throws md::InputError naming `what` when `points` or `motion` hold a value that is not finite
+/// or is beyond what the filters downstream take (1e100): a model or motion whose values are
+/// finite but huge, built on one another.
+void CheckPlaced(const md::Points& points, const RigidTransform& motion, const std::string& what)
+{
+  constexpr double kLargest = 1e100;
+  const bool finite = points.allFinite() && (points.size() == 0 || points.cwiseAbs().maxCoeff() <= kLargest) &&
+    motion.rotation.allFinite() && motion.translation.allFinite() &&
+    motion.translation.cwiseAbs().maxCoeff() <= kLargest;
+  if (!finite)
+  {
+    throw md::InputError(what +
+      " comes out at non-finite or huge coordinates: the model's offsets, scale factors or functions, or the "
+      "motion's values, are too large");
+  }
 }
 
 /// How the reader's motions are read (AngleUnit, IgnoreUnknownColumns).
@@ -273,14 +320,20 @@ void vtkOpenSimModelReader::LoadModel(const std::string& fileName, std::vector<s
     }
   }
   in.meshes.assign(in.model.bodies.size(), BodyMesh());
-  std::string missing;
+  std::string missing, outside;
   for (size_t b = 0; b < in.model.bodies.size() && this->LoadGeometry; ++b)
   {
-    in.meshes[b] = ReadBodyMesh(in.model.bodies[b], folders, missing);
+    in.meshes[b] = ReadBodyMesh(in.model.bodies[b], folders, missing, outside);
   }
   if (!missing.empty())
   {
     warnings.push_back("mesh files not found (the bodies still move): " + missing);
+  }
+  if (!outside.empty())
+  {
+    warnings.push_back("mesh files read from outside the model's folder, its Geometry folders and "
+                       "GeometrySearchPath: " +
+      outside);
   }
   in.wraps.clear();
   for (const osim::WrapObject& w : in.model.wrapObjects)
@@ -397,12 +450,49 @@ int vtkOpenSimModelReader::RequestData(
     const int k = mdvtk::NearestTime(in.trajectory.times, requested);
     q = in.trajectory.frames[k];
     time = in.trajectory.times[k];
+    const double first = in.trajectory.times.front(), last = in.trajectory.times.back();
+    const double slack = 1e-9 * (std::abs(first) + std::abs(last) + 1.0);
+    if (requested < first - slack || requested > last + slack)
+    {
+      vtkWarningMacro(<< (this->PlayMotion ? "the time asked for, " : "CurrentPoseTime ") << requested
+                      << (this->PlayMotion ? "," : "") << " lies outside the motion's times (" << first << " to "
+                      << last << "): the nearest frame, at time " << time << ", is shown");
+    }
   }
-  const std::vector<RigidTransform> poses = osim::BodyPoses(in.model, q);
-  this->WriteBodies(poses, vtkMultiBlockDataSet::GetData(outputVector, BODIES));
-  this->WriteBodies(in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, BODIES_REST));
-  this->WritePaths(q, poses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS));
-  this->WritePaths(in.rest, in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS_REST));
+  int result = 1;
+  std::ostringstream when;
+  when << (in.trajectory.times.empty() ? "at the rest pose" : "at time ");
+  if (!in.trajectory.times.empty())
+  {
+    when << time;
+  }
+  if (!mdvtk::CallCore(
+        this, "",
+        [&] {
+          const std::vector<RigidTransform> poses = osim::BodyPoses(in.model, q);
+          this->WriteBodies(poses, vtkMultiBlockDataSet::GetData(outputVector, BODIES), when.str());
+          this->WriteBodies(in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, BODIES_REST), "at the rest pose");
+          this->WritePaths(q, poses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS), when.str());
+          this->WritePaths(
+            in.rest, in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS_REST), "at the rest pose");
+          this->WriteWrapsAndTransforms(poses, q, time, outputVector);
+        },
+        result))
+  {
+    mdvtk::ClearOutputs(outputVector);
+    return result;
+  }
+  if (this->PlayMotion && !in.trajectory.times.empty())
+  {
+    mdvtk::SetDataTime(outputVector, time);
+  }
+  return 1;
+}
+
+void vtkOpenSimModelReader::WriteWrapsAndTransforms(const std::vector<md::RigidTransform>& poses,
+  const std::vector<double>& q, double time, vtkInformationVector* outputVector) const
+{
+  const Internals& in = *this->Internal;
   for (int port : { BODIES, BODIES_REST })
   {
     mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, port), mdvtk::Role::Bone);
@@ -419,11 +509,6 @@ int vtkOpenSimModelReader::RequestData(
     mdvtk::AddBlock(wraps, in.model.wrapObjects[w].name, mdvtk::ToPolyData(mesh));
   }
   this->WriteTransforms(poses, q, time, vtkTable::GetData(outputVector, BODY_TRANSFORMS));
-  if (this->PlayMotion && !in.trajectory.times.empty())
-  {
-    mdvtk::SetDataTime(outputVector, time);
-  }
-  return 1;
 }
 
 md::RigidTransform vtkOpenSimModelReader::Placed(const std::vector<md::RigidTransform>& poses, size_t body) const
@@ -431,7 +516,8 @@ md::RigidTransform vtkOpenSimModelReader::Placed(const std::vector<md::RigidTran
   return Compose(this->Internal->toOutput, poses[body]); // body frame -> output frame (scaled apart)
 }
 
-void vtkOpenSimModelReader::WriteBodies(const std::vector<md::RigidTransform>& poses, vtkMultiBlockDataSet* tree) const
+void vtkOpenSimModelReader::WriteBodies(
+  const std::vector<md::RigidTransform>& poses, vtkMultiBlockDataSet* tree, const std::string& when) const
 {
   const Internals& in = *this->Internal;
   const osim::Model& model = in.model;
@@ -443,13 +529,15 @@ void vtkOpenSimModelReader::WriteBodies(const std::vector<md::RigidTransform>& p
     }
     auto block = vtkSmartPointer<vtkPolyData>::New();
     const BodyMesh& mesh = in.meshes[b];
-    if (mesh.points.rows() > 0)
-    {
-      block->SetPoints(mdvtk::ToVtkPoints(this->Scale * this->Placed(poses, b).Apply(mesh.points)));
-      block->SetPolys(mesh.polys);
-    }
     // Rest to this pose, in the output frame and units.
     const RigidTransform motion = Motion(this->Placed(poses, b), this->Placed(in.restPoses, b));
+    const md::Points placed = this->Scale * this->Placed(poses, b).Apply(mesh.points);
+    CheckPlaced(placed, motion, "body '" + model.bodies[b].name + "' " + when);
+    if (mesh.points.rows() > 0)
+    {
+      block->SetPoints(mdvtk::ToVtkPoints(placed));
+      block->SetPolys(mesh.polys);
+    }
     vtkNew<vtkDoubleArray> transform;
     transform->SetName("RestToCurrentTransform");
     transform->SetNumberOfComponents(12);
@@ -469,7 +557,7 @@ void vtkOpenSimModelReader::WriteBodies(const std::vector<md::RigidTransform>& p
 }
 
 void vtkOpenSimModelReader::WritePaths(const std::vector<double>& coordinates,
-  const std::vector<md::RigidTransform>& poses, vtkMultiBlockDataSet* tree) const
+  const std::vector<md::RigidTransform>& poses, vtkMultiBlockDataSet* tree, const std::string& when) const
 {
   const Internals& in = *this->Internal;
   const osim::Model& model = in.model;
@@ -481,6 +569,7 @@ void vtkOpenSimModelReader::WritePaths(const std::vector<double>& coordinates,
     {
       points.row(i) = this->Scale * in.toOutput.Apply(Eigen::Vector3d(points.row(i).transpose())).transpose();
     }
+    CheckPlaced(points, RigidTransform(), "path '" + path.name + "' " + when);
     auto block = vtkSmartPointer<vtkPolyData>::New();
     block->SetPoints(mdvtk::ToVtkPoints(points));
     vtkNew<vtkCellArray> line;

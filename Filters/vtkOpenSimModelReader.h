@@ -94,7 +94,8 @@ public:
   vtkSetClampMacro(AngleUnit, int, ANGLES_AS_FILE_SAYS, ANGLES_IN_RADIANS);
   vtkGetMacro(AngleUnit, int);
 
-  /// Skip motion columns that name no coordinate of the model (with a warning) instead of failing.
+  /// Skip motion columns that name no coordinate of the model (with a warning) instead of failing,
+  /// as OpenSim does. Default on.
   vtkSetMacro(IgnoreUnknownColumns, bool);
   vtkGetMacro(IgnoreUnknownColumns, bool);
   vtkBooleanMacro(IgnoreUnknownColumns, bool);
@@ -141,7 +142,7 @@ protected:
   double CurrentPoseTime = 0.0;
   bool PlayMotion = true;
   int AngleUnit = ANGLES_AS_FILE_SAYS;
-  bool IgnoreUnknownColumns = false;
+  bool IgnoreUnknownColumns = true;
   bool LoadGeometry = true;
   int ModelReadCount = 0;
 
@@ -158,11 +159,16 @@ private:
   void LoadRestPose();
   /// Body `body` in pose `poses` -> the output frame (lengths not yet scaled).
   md::RigidTransform Placed(const std::vector<md::RigidTransform>& poses, size_t body) const;
-  /// The bodies' meshes as blocks of `tree`, each with RestToCurrentTransform.
-  void WriteBodies(const std::vector<md::RigidTransform>& poses, vtkMultiBlockDataSet* tree) const;
-  /// The muscles' paths at `coordinates` as polylines, blocks of `tree`.
+  /// The bodies' meshes as blocks of `tree`, each with RestToCurrentTransform; throws
+  /// md::InputError for a body placed at non-finite coordinates (`when`: "at time 0.5").
+  void WriteBodies(
+    const std::vector<md::RigidTransform>& poses, vtkMultiBlockDataSet* tree, const std::string& when) const;
+  /// The muscles' paths at `coordinates` as polylines, blocks of `tree` (throws as WriteBodies).
   void WritePaths(const std::vector<double>& coordinates, const std::vector<md::RigidTransform>& poses,
-    vtkMultiBlockDataSet* tree) const;
+    vtkMultiBlockDataSet* tree, const std::string& when) const;
+  /// Outputs WRAP_OBJECTS and BODY_TRANSFORMS at `poses`.
+  void WriteWrapsAndTransforms(const std::vector<md::RigidTransform>& poses, const std::vector<double>& q, double time,
+    vtkInformationVector* outputVector) const;
   /// Output BODY_TRANSFORMS: each body's rest-to-current motion; the time and coordinates as field data.
   void WriteTransforms(const std::vector<md::RigidTransform>& poses, const std::vector<double>& coordinates,
     double time, vtkTable* table) const;

@@ -253,6 +253,17 @@ TEST(MotionMuscleDeformation, BadMotionsGiveClearErrorsAndNoCrash)
     EXPECT_TRUE(messages.Contains("the motion has one frame (time 0.5)")) << messages.Text();
   }
   {
+    // Times that decrease: asked for 0.9, it showed the frame of time 0. Refused, naming the input.
+    CapturedMessages messages;
+    vtkNew<TimedCopy> bones, lines;
+    bones->Times = lines->Times = { 1.0, 0.5, 0.0 };
+    vtkNew<vtkMotionMuscleDeformation> motion;
+    pipeline(bones, lines, motion);
+    EXPECT_EQ(motion->UpdateTimeStep(0.9), 0);
+    EXPECT_TRUE(messages.Contains("BonesMotion's time steps do not increase (1 then 0.5)")) << messages.Text();
+    EXPECT_EQ(motion->GetFramesComputed(), 0);
+  }
+  {
     CapturedMessages messages;
     vtkNew<TimedCopy> bones, lines;
     bones->Times = lines->Times = { 0.0, 1.0, 2.0 };
@@ -327,4 +338,35 @@ TEST(MotionMuscleDeformation, AStoppedRunKeepsTheFramesDoneAndTheNextGoesOnFromT
   ASSERT_EQ(p.At(6), 1);
   EXPECT_EQ(p.motion->GetFramesComputed(), 7); // the frames kept are not computed again
   EXPECT_GT(vtkCompositeDataSet::SafeDownCast(p.motion->GetOutputDataObject(0))->GetNumberOfPoints(), 0);
+}
+
+TEST(MotionMuscleDeformation, FramesComputedAgainAfterTheCacheDroppedThemKeepTheirSmoothness)
+{
+  // A small CacheMemoryLimit, the motion played to its end, then scrubbed back: the frames
+  // computed again had NaN SecondDifference and SmoothnessRatio where the two frames before them
+  // had been dropped too.
+  PhantomMotionPipeline whole(30, 12), scrubbed(30, 12);
+  ASSERT_EQ(whole.At(12), 1);
+  const double frameMegabytes = whole.motion->GetCacheMegabytes() / whole.motion->GetFramesKept();
+  scrubbed.motion->SetCacheMemoryLimit(std::max(1.0, 3.5 * frameMegabytes));
+  ASSERT_EQ(scrubbed.At(12), 1);
+  ASSERT_LT(scrubbed.motion->GetFramesKept(), 13) << "the cache dropped nothing: the test would test nothing";
+  for (int frame : { 9, 6, 4, 10 })
+  {
+    ASSERT_EQ(whole.At(frame), 1);
+    ASSERT_EQ(scrubbed.At(frame), 1);
+    const unsigned int muscles =
+      vtkMultiBlockDataSet::SafeDownCast(scrubbed.motion->GetOutputDataObject(0))->GetNumberOfBlocks();
+    ASSERT_EQ(muscles, 3u);
+    for (unsigned int b = 0; b < muscles; ++b)
+    {
+      for (const char* name : { "SecondDifference", "SmoothnessRatio" })
+      {
+        const double expected = Field(whole.Muscle(b), name);
+        ASSERT_TRUE(std::isfinite(expected)) << name;
+        EXPECT_EQ(Field(scrubbed.Muscle(b), name), expected) << name << " of muscle " << b << " at frame " << frame;
+      }
+    }
+  }
+  EXPECT_GT(scrubbed.motion->GetFramesComputed(), 13); // frames were computed again
 }

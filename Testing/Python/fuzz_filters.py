@@ -6,8 +6,10 @@
 Each case takes the phantom's valid inputs, breaks one input of one filter at random (point ids
 out of range or negative, NaN and infinite coordinates, empty blocks, points without cells, cells
 of the wrong kind, point arrays of the wrong length or width, blocks that are not polydata,
-duplicate block names, huge or tiny coordinates, a malformed OpenSim model or motion) and runs
-the filter. A filter may refuse the input with a message or compute a result; it must not crash,
+duplicate block names, huge or tiny coordinates, a malformed OpenSim model or motion, a body mesh
+file of random bytes, of counts it does not hold or of a cell beyond its points, a model nested deep
+or of huge numbers, a body-transform table of NaN, scalings, reflections or missing columns, the
+phantom's properties at their extremes) and runs the filter: each of the eleven proxies. A filter may refuse the input with a message or compute a result; it must not crash,
 and a result must not hold non-finite coordinates. Before each case the script prints
 "case K: <what>" so that a crash names the case; at the end it prints "fuzz: N cases, R refused,
 A accepted". Exit code 0 when every case ended cleanly.
@@ -21,8 +23,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import mdtesting  # noqa: E402
 from paraview import simple  # noqa: E402
-from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkIdList  # noqa: E402
-from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkImageData, vtkMultiBlockDataSet, vtkPolyData  # noqa: E402
+from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkIdList, vtkStringArray  # noqa: E402
+from vtkmodules.vtkCommonDataModel import (vtkCellArray, vtkImageData, vtkMultiBlockDataSet, vtkPolyData,  # noqa: E402
+                                           vtkTable)
 
 mdtesting.load_plugin()
 
@@ -46,6 +49,8 @@ SMALL_MODEL = """<?xml version="1.0"?>
 </Model></OpenSimDocument>
 """
 MOTION = "knee\nversion=1\ninDegrees=yes\nendheader\ntime angle\n0 0\n0.5 45\n1 90\n"
+TETRAHEDRON = ("# vtk DataFile Version 3.0\ntetrahedron\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n"
+               "0 0 0 0.1 0 0 0 0.1 0 0 0 0.1\nPOLYGONS 4 16\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n")
 
 
 def copy_tree(tree):
@@ -179,6 +184,62 @@ class Inputs:
         matching.UpdatePipeline()
         self.data["matched"] = vtkMultiBlockDataSet()
         self.data["matched"].DeepCopy(matching.GetClientSideObject().GetOutputDataObject(0))
+        self.data["transforms"] = body_transforms(self.data["bones_rest"])
+
+
+def body_transforms(bones):
+    """A BodyTransforms table (as OpenSimModelReader writes it) naming each of `bones`' blocks,
+    each a small rotation about z and a translation."""
+    table = vtkTable()
+    names = vtkStringArray()
+    names.SetName("Body")
+    table.AddColumn(names)
+    columns = []
+    for name in ["R%d%d" % (i, j) for i in range(3) for j in range(3)] + ["Tx", "Ty", "Tz"]:
+        column = vtkDoubleArray()
+        column.SetName(name)
+        table.AddColumn(column)
+        columns.append(column)
+    c, s = math.cos(0.1), math.sin(0.1)
+    for b in range(bones.GetNumberOfBlocks()):
+        names.InsertNextValue(bones.GetMetaData(b).Get(vtkMultiBlockDataSet.NAME()))
+        for column, value in zip(columns, (c, -s, 0, s, c, 0, 0, 0, 1, 1.0, 2.0, 3.0)):
+            column.InsertNextValue(value)
+    return table
+
+
+def mutate_table(rng, table):
+    """A broken copy of a BodyTransforms table, and what was done."""
+    out = vtkTable()
+    out.DeepCopy(table)
+    kind = rng.choice(["nan", "inf", "scaled", "reflected", "huge", "no_column", "text_column", "no_rows",
+                       "unknown_body"])
+    row = rng.randrange(max(out.GetNumberOfRows(), 1))
+    if kind in ("nan", "inf", "huge"):
+        column = out.GetColumnByName(rng.choice(["R00", "R11", "R21", "Tx", "Tz"]))
+        column.SetValue(row, {"nan": math.nan, "inf": -math.inf, "huge": 1e300}[kind])
+    elif kind in ("scaled", "reflected"):
+        for name in ("R00", "R01", "R02") if kind == "reflected" else ("R00", "R11", "R22"):
+            column = out.GetColumnByName(name)
+            column.SetValue(row, -column.GetValue(row) if kind == "reflected" else 2 * column.GetValue(row))
+    elif kind == "no_column":
+        out.RemoveColumnByName(rng.choice(["Body", "R12", "Ty"]))
+    elif kind == "text_column":
+        out.RemoveColumnByName("R00")
+        text = vtkStringArray()
+        text.SetName("R00")
+        for _ in range(out.GetNumberOfRows()):
+            text.InsertNextValue("x")
+        out.AddColumn(text)
+    elif kind == "no_rows":
+        out = vtkTable()
+        for c in range(table.GetNumberOfColumns()):
+            empty = table.GetColumn(c).NewInstance()
+            empty.SetName(table.GetColumn(c).GetName())
+            out.AddColumn(empty)
+    else:
+        out.GetColumnByName("Body").SetValue(row, "nobody")
+    return out, kind
 
 
 # Each filter: its inputs as (property, data key, repeatable), and properties that keep it quick.
@@ -196,27 +257,46 @@ FILTERS = [
                                        ("ActionLinesCurrent", "lines_current", False)],
      {"NumberOfSteps": 1, "HullTargetNumberOfPoints": 40, "MaximumNumberOfIterations": 10}),
     ("ActionLineGrouping", [("Input", "muscles", False), ("Paths", "lines_rest", False)], {}),
+    ("MoveWithBodies", [("Input", "bones_rest", False), ("BodyTransforms", "transforms", False)], {}),
+    # The bones and the lines of the motion: BoneInterpolation from the rest to the current pose.
+    ("MotionMuscleDeformation", [("Input", "muscles", False), ("BonesRest", "bones_rest", False),
+                                 ("BonesMotion", ("bones_rest", "bones_current"), False),
+                                 ("ActionLinesRest", "lines_rest", False),
+                                 ("ActionLinesMotion", ("lines_rest", "lines_current"), False)], {}),
 ]
 
 
 def finite_output(proxy):
-    data = proxy.GetClientSideObject().GetOutputDataObject(0)
-    blocks = [data] if isinstance(data, vtkPolyData) else \
-        [data.GetBlock(i) for i in range(data.GetNumberOfBlocks())] if data else []
-    for block in blocks:
-        if isinstance(block, vtkPolyData) and block.GetNumberOfPoints():
-            values = block.GetPoints().GetData()
-            for c in range(3):
-                low, high = values.GetRange(c)
-                if not (math.isfinite(low) and math.isfinite(high)):
-                    return False
+    """Every output's points finite, and every muscle's VolumeChangePercent that is given."""
+    algorithm = proxy.GetClientSideObject()
+    for port in range(algorithm.GetNumberOfOutputPorts()):
+        data = algorithm.GetOutputDataObject(port)
+        blocks = [data] if isinstance(data, vtkPolyData) else \
+            [data.GetBlock(i) for i in range(data.GetNumberOfBlocks())] if isinstance(data, vtkMultiBlockDataSet) \
+            else []
+        for block in blocks:
+            if not isinstance(block, vtkPolyData):
+                continue
+            if block.GetNumberOfPoints():
+                values = block.GetPoints().GetData()
+                for c in range(3):
+                    low, high = values.GetRange(c)
+                    if not (math.isfinite(low) and math.isfinite(high)):
+                        return False
+            change = block.GetFieldData().GetArray("VolumeChangePercent")
+            if change is not None and not all(math.isfinite(change.GetValue(i))
+                                              for i in range(change.GetNumberOfValues())):
+                return False
     return True
 
 
 def opensim_case(rng, folder):
     text, motion = SMALL_MODEL, MOTION
     kind = rng.choice(["truncate", "swap_tag", "bad_number", "bad_reference", "motion_truncate", "motion_nan",
-                       "motion_column", "garbage"])
+                       "motion_column", "garbage", "mesh_bytes", "mesh_count", "mesh_id", "deep", "huge"])
+    mesh = "shank.vtk"
+    with open(os.path.join(folder, mesh), "w") as f:
+        f.write(TETRAHEDRON)
     if kind == "truncate":
         text = text[:rng.randrange(len(text))]
     elif kind == "swap_tag":
@@ -232,8 +312,29 @@ def opensim_case(rng, folder):
         motion = motion.replace("45", rng.choice(["nan", "inf", "x", ""]))
     elif kind == "motion_column":
         motion = motion.replace("time angle", rng.choice(["angle time", "time elbow", "time", "time angle angle"]))
+    elif kind == "mesh_bytes":
+        mesh = rng.choice(["noise.stl", "noise.vtk", "noise.vtp", "noise.obj"])
+        with open(os.path.join(folder, mesh), "wb") as f:
+            f.write(bytes(rng.randrange(256) for _ in range(rng.choice([0, 10, 84, 600, 5000]))))
+    elif kind == "mesh_count":
+        mesh = "count.vtk"
+        word = rng.choice(["POINTS 4", "POLYGONS 4 16"])
+        with open(os.path.join(folder, mesh), "w") as f:
+            f.write(TETRAHEDRON.replace(word, word.replace("4", str(rng.choice([0, 5, 2 ** 31 - 1, 10 ** 12])), 1)))
+    elif kind == "mesh_id":
+        mesh = "id.vtk"
+        with open(os.path.join(folder, mesh), "w") as f:
+            f.write(TETRAHEDRON.replace("3 1 2 3", "3 1 2 %d" % rng.choice([-1, 4, 10 ** 9])))
+    elif kind == "deep":
+        depth = rng.choice([300, 5000])
+        text = text.replace('<Body name="shank"/>', '<Body name="shank">' + "<x>" * depth + "</x>" * depth + "</Body>")
+    elif kind == "huge":
+        text = text.replace("0 -1 0", rng.choice(["1e300 -1 0", "0 -1e12 0", "1e13 0 0"]), 1)
+        motion = motion.replace("45", rng.choice(["1e307", "1e12", "45"]))
     else:
         text = "".join(chr(rng.randrange(32, 127)) for _ in range(200))
+    text = text.replace('<Body name="shank"/>', '<Body name="shank"><attached_geometry><Mesh name="m"><mesh_file>%s'
+                        '</mesh_file></Mesh></attached_geometry></Body>' % mesh)
     model = os.path.join(folder, "fuzz.osim")
     with open(model, "w") as f:
         f.write(text)
@@ -254,21 +355,43 @@ def main():
     chosen = {int(k) for k in os.environ.get("FUZZ_CASES", "").split(",") if k}
     for case in range(count):
         run = not chosen or case in chosen
-        if rng.random() < 0.12:
+        draw = rng.random()
+        if draw < 0.03:
+            settings = {"Resolution": rng.choice([1, 2, 3, 8, 64]), "Flexion": rng.uniform(-400, 400)}
+            print("case %d: MusculoskeletalPhantom %s" % (case, settings), flush=True)
+            with mdtesting.CapturedMessages() as messages:
+                proxy = simple.MusculoskeletalPhantom(**settings)
+                if run:
+                    proxy.UpdatePipeline()
+            if run and not finite_output(proxy):
+                print("case %d: MusculoskeletalPhantom put out non-finite coordinates" % case, flush=True)
+                return 1
+        elif draw < 0.15:
             with mdtesting.CapturedMessages() as messages:
                 proxy, what = opensim_case(rng, folder)
                 print("case %d: %s" % (case, what), flush=True)
                 if run:
                     proxy.UpdatePipeline()
+            if run and not finite_output(proxy):
+                print("case %d: OpenSimModelReader put out non-finite coordinates" % case, flush=True)
+                return 1
         else:
             name, ports, settings = rng.choice(FILTERS)
             broken = rng.randrange(len(ports))
             sources, what = {}, None
             for index, (prop, key, repeatable) in enumerate(ports):
-                data = inputs.data[key]
+                keys = key if isinstance(key, tuple) else (key,)
+                datas = [inputs.data[k] for k in keys]
                 if index == broken:
-                    data, what = mutate_tree(rng, data)
-                sources[prop] = [producer(data)] if repeatable else producer(data)
+                    which = rng.randrange(len(datas))
+                    mutate = mutate_table if isinstance(datas[which], vtkTable) else mutate_tree
+                    datas[which], what = mutate(rng, datas[which])
+                if len(datas) == 2:
+                    source = simple.BoneInterpolation(Input=producer(datas[0]), CurrentPose=producer(datas[1]),
+                                                      NumberOfSteps=2)
+                else:
+                    source = producer(datas[0])
+                sources[prop] = [source] if repeatable else source
             print("case %d: %s.%s %s" % (case, name, ports[broken][0], what), flush=True)
             with mdtesting.CapturedMessages() as messages:
                 proxy = getattr(simple, name)(**sources, **settings)

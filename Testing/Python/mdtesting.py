@@ -75,7 +75,10 @@ class CapturedMessages:
 
     @property
     def text(self):
-        return self.window.GetOutput()
+        text = self.window.GetOutput()
+        # VTK hands back bytes when the messages are not UTF-8 (a file name or a block name of
+        # another encoding, quoted in a message).
+        return text.decode("utf-8", "replace") if isinstance(text, bytes) else text
 
 
 def main():

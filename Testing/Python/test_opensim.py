@@ -296,7 +296,7 @@ class SmallModel(unittest.TestCase):
                 (MOTION.replace("0.5\t90", "0.5\tnan"), "holds 'nan', not a finite number"),
                 (MOTION.replace("shoulder_angle", "elbow_angle"), "column 'elbow_angle' names no coordinate")):
             path = write(self.folder, "bad.mot", motion)
-            _, messages = self.reader(MotionFileName=path)
+            _, messages = self.reader(MotionFileName=path, IgnoreUnknownColumns=0)
             self.assertIn(expected, messages)
             self.assertIn("bad.mot", messages)
         _, messages = self.reader(MotionFileName=os.path.join(self.folder, "arm.mot"), IgnoreUnknownColumns=1)

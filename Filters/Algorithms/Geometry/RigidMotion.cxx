@@ -10,6 +10,27 @@
 
 namespace md
 {
+std::string NotARigidMotion(const RigidTransform& t)
+{
+  if (!t.rotation.allFinite() || !t.translation.allFinite())
+  {
+    return "its rotation or translation holds NaN or infinite values";
+  }
+  const double offOrthonormal =
+    (t.rotation.transpose() * t.rotation - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (offOrthonormal > kRotationTolerance)
+  {
+    return "its R (R00 ... R22) is not a rotation: R^T R differs from the identity by " +
+      std::to_string(offOrthonormal) + " (a scaling or shear; at most " + std::to_string(kRotationTolerance) +
+      " is taken)";
+  }
+  if (t.rotation.determinant() < 0)
+  {
+    return "its R (R00 ... R22) is a reflection (determinant -1), not a rotation";
+  }
+  return "";
+}
+
 RigidTransform Compose(const RigidTransform& a, const RigidTransform& b)
 {
   RigidTransform t;

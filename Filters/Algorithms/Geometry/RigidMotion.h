@@ -6,6 +6,8 @@
 
 #include <Eigen/Geometry>
 
+#include <string>
+
 namespace md
 {
 /// x -> rotation * x + translation
@@ -19,6 +21,14 @@ struct RigidTransform
   /// Rotation about `centre` by `angleRadians` around `axis` (normalised here).
   static RigidTransform AboutPoint(const Eigen::Vector3d& axis, double angleRadians, const Eigen::Vector3d& centre);
 };
+
+/// How far a rotation matrix may be from orthonormal (largest entry of R^T R - I) and still be
+/// taken as a rotation: a table written with 7 significant digits passes.
+constexpr double kRotationTolerance = 1e-6;
+
+/// Why `t` is not a rigid motion (non-finite entries; a rotation part that is not orthonormal to
+/// kRotationTolerance, or is a reflection), or "" when it is one.
+std::string NotARigidMotion(const RigidTransform& t);
 
 /// a after b: x -> a(b(x)).
 RigidTransform Compose(const RigidTransform& a, const RigidTransform& b);

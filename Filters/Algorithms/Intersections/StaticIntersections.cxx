@@ -251,6 +251,32 @@ OverlapMasks FindOverlaps(const std::vector<TriangleMesh>& meshes, const std::ve
   return masks;
 }
 
+std::string MostlyInAnObstacle(const TriangleMesh& mesh, const std::string& name, size_t m,
+  const std::vector<FixedObstacle>& fixed, const OverlapMasks& masks)
+{
+  const std::vector<char> used = UsedMask(mesh);
+  const Eigen::Index points = std::count(used.begin(), used.end(), 1);
+  const double onSurface = 1e-6 * BoxDiagonal(mesh.points);
+  for (size_t o = 0; o < fixed.size(); ++o)
+  {
+    Eigen::Index in = 0;
+    for (Eigen::Index i = 0; i < mesh.points.rows(); ++i)
+    {
+      in += used[i] &&
+        (InOverlap(&masks, m, o, i) ||
+          fixed[o].tree->ClosestPoint(mesh.points.row(i).transpose(), onSurface).triangle >= 0);
+    }
+    if (2 * in > points)
+    {
+      return "muscle '" + name + "' lies in bone '" + fixed[o].name + "' in the rest pose (" + std::to_string(in) +
+        " of its " + std::to_string(points) +
+        " points inside it or on its surface): is it given as a bone too? A muscle must lie outside the bones, "
+        "but for where its scan overlaps them";
+    }
+  }
+  return "";
+}
+
 std::vector<Penetration> MeasureNewPenetration(
   const std::vector<TriangleMesh>& meshes, const std::vector<FixedObstacle>& fixed, const OverlapMasks* existing)
 {

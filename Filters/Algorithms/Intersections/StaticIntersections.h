@@ -38,6 +38,13 @@ bool InOverlap(const OverlapMasks* masks, size_t m, size_t o, Eigen::Index i);
 /// obstacle (see OverlapMasks), from trees of the meshes as they are.
 OverlapMasks FindOverlaps(const std::vector<TriangleMesh>& meshes, const std::vector<FixedObstacle>& fixed);
 
+/// "" unless most points of `mesh` (named `name`, mesh m of `masks`) lie inside one fixed
+/// obstacle or on its surface (within 1e-6 of the mesh's size) in the rest pose: a muscle given
+/// as a bone too, or scanned inside one, which the method cannot tell apart from it (whether a
+/// point on the bone's surface is inside is decided by rounding). Otherwise a message naming both.
+std::string MostlyInAnObstacle(const TriangleMesh& mesh, const std::string& name, size_t m,
+  const std::vector<FixedObstacle>& fixed, const OverlapMasks& masks);
+
 struct Penetration
 {
   std::int64_t count = 0;      ///< points inside an obstacle

@@ -681,6 +681,14 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
     current[m] = muscles[m].muscle;
   }
   const OverlapMasks restOverlap = FindOverlaps(current, fixed);
+  for (size_t m = 0; m < count; ++m)
+  {
+    if (const std::string problem = MostlyInAnObstacle(current[m], muscles[m].name, m, fixed, restOverlap);
+        !problem.empty())
+    {
+      throw OfMuscle(InputError(problem), m);
+    }
+  }
   const std::vector<NewSharpEdges> sharpEdges = MuscleSharpEdges(muscles);
   std::vector<std::string> names;
   for (const MuscleMotion& m : muscles)

@@ -103,6 +103,44 @@ int BodyOfSurface(const std::string& surfaceName, const std::vector<std::string>
   return best;
 }
 
+namespace
+{
+/// The length of the segment from `a` to `b` inside the closed surface of `tree`: the segment
+/// cut where it crosses the surface, each piece inside or not by its midpoint.
+double LengthInside(const TriangleTree& tree, const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+{
+  const double length = (b - a).norm();
+  if (!(length > 0))
+  {
+    return 0.0;
+  }
+  std::vector<double> cuts = { 0.0 };
+  // Past each hit by a hair, so that the next search starts beyond it; a bounded number of
+  // searches (a segment crosses a muscle a few times).
+  const double hair = 1e-9;
+  for (int search = 0; search < 10000 && cuts.back() < 1.0; ++search)
+  {
+    const Eigen::Vector3d from = a + (cuts.back() + hair) * (b - a);
+    const std::optional<TriangleTree::Hit> hit = tree.FirstHit(from, b);
+    if (!hit)
+    {
+      break;
+    }
+    cuts.push_back(std::min(1.0, cuts.back() + hair + hit->t * (1.0 - cuts.back() - hair)));
+  }
+  cuts.push_back(1.0);
+  double inside = 0.0;
+  for (size_t k = 0; k + 1 < cuts.size(); ++k)
+  {
+    if (cuts[k + 1] > cuts[k] && tree.Inside(a + 0.5 * (cuts[k] + cuts[k + 1]) * (b - a)))
+    {
+      inside += (cuts[k + 1] - cuts[k]) * length;
+    }
+  }
+  return inside;
+}
+}
+
 PathGrouping GroupPaths(const std::vector<TriangleMesh>& muscles, const std::vector<std::string>& muscleNames,
   const std::vector<Points>& paths, const std::vector<std::string>& pathNames,
   const std::vector<std::pair<std::string, std::vector<std::string>>>& assignments, double minimumShare)
@@ -140,26 +178,16 @@ PathGrouping GroupPaths(const std::vector<TriangleMesh>& muscles, const std::vec
   }
   for (size_t p = 0; p < paths.size(); ++p)
   {
-    // Length inside each muscle, from the midpoints of 16 pieces of every segment.
     const Points& line = paths[p];
     std::vector<double> inside(muscles.size(), 0.0);
     double total = 0.0;
-    constexpr int pieces = 16;
     for (Eigen::Index s = 0; s + 1 < line.rows(); ++s)
     {
       const Eigen::Vector3d a = line.row(s).transpose(), b = line.row(s + 1).transpose();
-      const double piece = (b - a).norm() / pieces;
-      total += piece * pieces;
-      for (int k = 0; k < pieces; ++k)
+      total += (b - a).norm();
+      for (size_t m = 0; m < muscles.size(); ++m)
       {
-        const Eigen::Vector3d x = a + (b - a) * ((k + 0.5) / pieces);
-        for (size_t m = 0; m < muscles.size(); ++m)
-        {
-          if (trees[m]->Inside(x))
-          {
-            inside[m] += piece;
-          }
-        }
+        inside[m] += LengthInside(*trees[m], a, b);
       }
     }
     if (grouping.assignedByUser[p])

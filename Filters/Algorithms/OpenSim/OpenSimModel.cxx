@@ -53,6 +53,8 @@ const std::set<std::string> kFunctionTypes = { "Constant", "LinearFunction", "Si
   "PiecewiseLinearFunction", "PolynomialFunction", "MultiplierFunction" };
 const std::set<std::string> kJointTypes = { "CustomJoint", "PinJoint", "WeldJoint", "BallJoint", "UniversalJoint",
   "SliderJoint", "PlanarJoint", "FreeJoint", "GimbalJoint" };
+/// The deepest nesting of elements read: OpenSim's own models nest about 12 deep.
+constexpr size_t kMaxElementDepth = 256;
 const std::set<std::string> kPointTypes = { "PathPoint", "ConditionalPathPoint", "MovingPathPoint" };
 
 /// Reads the document and says where things are for messages.
@@ -133,6 +135,10 @@ public:
       if (end == token.c_str() || *end != '\0' || !std::isfinite(value))
       {
         this->Fail(element, "'" + token + "' is not a finite number");
+      }
+      if (std::abs(value) > kLargestValue)
+      {
+        this->Fail(element, "'" + token + "' is beyond the +-1e12 a model's geometry can hold");
       }
       values.push_back(value);
     }
@@ -1077,6 +1083,35 @@ Model ParseModel(const std::string& text, const std::string& fileName)
         std::count(text.begin(), text.begin() + std::min<ptrdiff_t>(parsed.offset, text.size()), '\n'));
     throw InputError(
       "OpenSim model '" + fileName + "', line " + std::to_string(line) + ": malformed XML: " + parsed.description());
+  }
+  // The model is read by walks whose depth is the file's nesting: refuse a nesting no model has
+  // before any of them (a deep one would overflow the stack).
+  size_t depth = 0;
+  for (Node node = document.first_child(); node;)
+  {
+    if (node.type() == pugi::node_element && ++depth > kMaxElementDepth)
+    {
+      reader.Fail(node,
+        "elements nested more than " + std::to_string(kMaxElementDepth) + " deep; no OpenSim model nests so deep");
+    }
+    if (node.type() == pugi::node_element && node.first_child())
+    {
+      node = node.first_child();
+      continue;
+    }
+    if (node.type() == pugi::node_element)
+    {
+      --depth;
+    }
+    while (node && !node.next_sibling())
+    {
+      node = node.parent();
+      if (node && node.type() == pugi::node_element)
+      {
+        --depth;
+      }
+    }
+    node = node ? node.next_sibling() : Node();
   }
   Node root = document.child("OpenSimDocument");
   Model model;

@@ -15,6 +15,11 @@
 
 namespace md::osim
 {
+/// The largest magnitude a number of a model's geometry (offsets, scale factors, function values)
+/// or of a motion may have: beyond it, the poses of bodies built on one another overflow. Readers
+/// refuse larger ones, naming where they are.
+constexpr double kLargestValue = 1e12;
+
 enum class MotionType
 {
   Rotational,

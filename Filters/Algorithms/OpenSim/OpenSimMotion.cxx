@@ -3,6 +3,7 @@
 
 #include "OpenSim/OpenSimKinematics.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -156,6 +157,10 @@ MotionTable ReadMotion(const std::string& fileName)
       {
         fail(lineNumber, "column '" + labels[i] + "' holds '" + fields[i] + "', not a finite number");
       }
+      if (std::abs(row[i]) > kLargestValue)
+      {
+        fail(lineNumber, "column '" + labels[i] + "' holds " + fields[i] + ", beyond the +-1e12 a pose can hold");
+      }
     }
     if (!table.times.empty() && !(row[0] > table.times.back()))
     {
@@ -178,6 +183,12 @@ CoordinateTrajectory MapMotion(const Model& model, const MotionTable& motion, co
   std::vector<int> columnCoordinate(motion.labels.size(), -1);
   std::vector<bool> covered(model.coordinates.size(), false);
   std::string skipped;
+  // The coordinate columns whose values change over the motion: those that move something.
+  size_t movingColumns = 0, movingSkipped = 0, movingMatched = 0;
+  auto changes = [&](size_t column) {
+    return std::any_of(motion.rows.begin(), motion.rows.end(),
+      [&](const std::vector<double>& row) { return row[column] != motion.rows.front()[column]; });
+  };
   for (size_t i = 0; i < motion.labels.size(); ++i)
   {
     std::string label = motion.labels[i];
@@ -199,8 +210,14 @@ CoordinateTrajectory MapMotion(const Model& model, const MotionTable& motion, co
           "' names no coordinate of model '" + model.name + "' (to skip such columns, set IgnoreUnknownColumns)");
       }
       skipped += (skipped.empty() ? "" : ", ") + motion.labels[i];
+      const bool moving = changes(i);
+      movingColumns += moving;
+      movingSkipped += moving;
       continue;
     }
+    const bool moving = changes(i);
+    movingColumns += moving;
+    movingMatched += moving;
     columnCoordinate[i] = coordinate;
     covered[coordinate] = true;
   }
@@ -221,6 +238,16 @@ CoordinateTrajectory MapMotion(const Model& model, const MotionTable& motion, co
     {
       missing += (missing.empty() ? "" : ", ") + model.coordinates[c].name;
     }
+  }
+  // The motion of another model: most of what the file moves names no coordinate of this one,
+  // or it moves none of them. (Constant columns do not count: the LHDL motions carry six
+  // columns of zeros under other names.)
+  if (2 * movingSkipped > movingColumns || (movingColumns > 0 && movingMatched == 0))
+  {
+    trajectory.warnings.push_back("motion file '" + motion.file + "' does not look like a motion of model '" +
+      model.name + "': " + std::to_string(movingSkipped) + " of the " + std::to_string(movingColumns) +
+      " columns whose values change name no coordinate of the model, and it moves " + std::to_string(movingMatched) +
+      " of the model's coordinates");
   }
   if (!missing.empty())
   {

@@ -37,8 +37,8 @@ struct MotionOptions
 {
   AngleUnit angles = AngleUnit::FromFile;
   /// Skip columns that name no coordinate of the model (a full-body motion for a lower-body
-  /// model) instead of failing; each is reported in the warnings.
-  bool ignoreUnknownColumns = false;
+  /// model) instead of failing, as OpenSim does; each is reported in the warnings.
+  bool ignoreUnknownColumns = true;
 };
 
 /// The model's coordinates at every frame of a motion.

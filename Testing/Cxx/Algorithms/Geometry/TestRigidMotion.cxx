@@ -221,3 +221,24 @@ TEST(RigidMotion, TheFitsResidualsSayWhatIsNotRigid)
   EXPECT_LT(fit.maxResidual, 1.0);
   EXPECT_LT(fit.rmsResidual, fit.maxResidual / 5);
 }
+
+TEST(RigidMotion, ARotationTableEntryThatIsNoRotationIsSaidWhy)
+{
+  md::RigidTransform t = md::RigidTransform::AboutPoint(Eigen::Vector3d(1, 2, 3), 0.7, Eigen::Vector3d(4, 5, 6));
+  EXPECT_EQ(md::NotARigidMotion(t), "");
+  md::RigidTransform rounded = t; // written with 7 significant digits
+  rounded.rotation = (t.rotation.array() * 1e7).round() / 1e7;
+  EXPECT_EQ(md::NotARigidMotion(rounded), "");
+  md::RigidTransform scaled = t;
+  scaled.rotation *= 2.0;
+  EXPECT_NE(md::NotARigidMotion(scaled).find("is not a rotation"), std::string::npos);
+  md::RigidTransform mirrored = t;
+  mirrored.rotation.col(0) *= -1.0;
+  EXPECT_NE(md::NotARigidMotion(mirrored).find("reflection"), std::string::npos);
+  md::RigidTransform broken = t;
+  broken.translation[1] = std::nan("");
+  EXPECT_NE(md::NotARigidMotion(broken).find("NaN or infinite"), std::string::npos);
+  broken = t;
+  broken.rotation(2, 2) = std::numeric_limits<double>::infinity();
+  EXPECT_NE(md::NotARigidMotion(broken).find("NaN or infinite"), std::string::npos);
+}

@@ -48,10 +48,20 @@ TEST(OpenSimAttachment, APathGoesToTheMuscleThatHoldsMostOfIt)
   const std::vector<std::string> pathNames = { "a", "b", "c" };
   PathGrouping grouping = GroupPaths(muscles, muscleNames, paths, pathNames, {});
   EXPECT_EQ(grouping.muscleOfPath, (std::vector<int>{ 0, 1, -1 }));
-  // Shares measured at 16 points a segment: within 1/16 of the true ones.
-  EXPECT_NEAR(grouping.insideFraction[0], 4.0 / 6.0, 1.0 / 16);
-  EXPECT_NEAR(grouping.insideFraction[1], 0.9 / 3.4, 1.0 / 16);
+  // Shares from where the segments cross the surfaces: exact to rounding.
+  EXPECT_NEAR(grouping.insideFraction[0], 4.0 / 6.0, 1e-9);
+  EXPECT_NEAR(grouping.insideFraction[1], 0.9 / 3.4, 1e-9);
   EXPECT_EQ(grouping.insideFraction[2], 0.0);
+  // 4 % of a two-point path inside: below the 5 % a path needs (sampled at 16 points, it was
+  // taken for 6 %).
+  md::Points grazing(2, 3);
+  grazing << 0.5, 0.5, 3.8, 0.5, 0.5, 8.8;
+  const PathGrouping short4 = GroupPaths(muscles, muscleNames, { grazing }, { "d" }, {});
+  EXPECT_EQ(short4.muscleOfPath[0], -1);
+  grazing(0, 2) = 3.7; // 6 %: taken
+  const PathGrouping share6 = GroupPaths(muscles, muscleNames, { grazing }, { "d" }, {});
+  EXPECT_EQ(share6.muscleOfPath[0], 0);
+  EXPECT_NEAR(share6.insideFraction[0], 0.3 / 5.1, 1e-9);
   // Named in the assignments: where the user says, whatever the share.
   grouping = GroupPaths(muscles, muscleNames, paths, pathNames, ParseAssignments("left=b; right=c"));
   EXPECT_EQ(grouping.muscleOfPath, (std::vector<int>{ 0, 0, 1 }));

@@ -160,3 +160,38 @@ TEST(OpenSimModel, BadInputIsNamed)
   e = ExpectInputError([] { ReadModel("/nonexistent/model.osim"); });
   EXPECT_NE(e.find("cannot be opened"), std::string::npos) << e;
 }
+
+TEST(OpenSimModel, DeepNestingAndHugeNumbersAreRefusedNotOverflowed)
+{
+  // 20,000 elements nested in a body, 10,000 nested multiplier functions: the walks of the model
+  // would overflow the stack; refused before any of them.
+  std::string deep = kSmallModel;
+  const std::string body = "<Body name=\"femur\"/>";
+  ASSERT_NE(deep.find(body), std::string::npos);
+  std::string nested;
+  for (int i = 0; i < 20000; ++i)
+  {
+    nested += "<a>";
+  }
+  for (int i = 0; i < 20000; ++i)
+  {
+    nested += "</a>";
+  }
+  deep.replace(deep.find(body), body.size(), "<Body name=\"femur\">" + nested + "</Body>");
+  std::string e = ExpectInputError([&] { ParseModel(deep, "deep.osim"); });
+  EXPECT_NE(e.find("deep.osim"), std::string::npos) << e;
+  EXPECT_NE(e.find("nested more than 256 deep"), std::string::npos) << e;
+  // 250 deep is a model still (OpenSim's own nest about 12 deep).
+  std::string shallow = kSmallModel;
+  shallow.replace(shallow.find(body), body.size(),
+    "<Body name=\"femur\">" + nested.substr(0, 3 * 240) + nested.substr(nested.size() - 4 * 240) + "</Body>");
+  EXPECT_NO_THROW(ParseModel(shallow, "shallow.osim"));
+  // A number beyond +-1e12 in the geometry: named where it is.
+  std::string huge = kSmallModel;
+  const std::string offset = "<translation>0.1 0 0</translation>";
+  ASSERT_NE(huge.find(offset), std::string::npos);
+  huge.replace(huge.find(offset), offset.size(), "<translation>1e300 0 0</translation>");
+  e = ExpectInputError([&] { ParseModel(huge, "huge.osim"); });
+  EXPECT_NE(e.find("'1e300' is beyond the +-1e12"), std::string::npos) << e;
+  EXPECT_NE(e.find("PhysicalOffsetFrame 'pelvis_offset'"), std::string::npos) << e;
+}

@@ -53,11 +53,51 @@ TEST(OpenSimMotion, BadMotionsAreNamed)
   EXPECT_NE(e.find("endheader"), std::string::npos) << e;
   e = ExpectInputError([] { ReadMotion(WriteTemporary("back.mot", "endheader\ntime flex\n0 1\n0 2\n")); });
   EXPECT_NE(e.find("does not come after"), std::string::npos) << e;
+  e = ExpectInputError([] { ReadMotion(WriteTemporary("huge.mot", "endheader\ntime flex\n0 1\n0.1 1e307\n")); });
+  EXPECT_NE(e.find("line 4: column 'flex' holds 1e307, beyond the +-1e12"), std::string::npos) << e;
   const MotionTable extra = ReadMotion(WriteTemporary("x.mot", "endheader\ntime flex elbow\n0 1 2\n"));
-  e = ExpectInputError([&] { MapMotion(model, extra); });
+  MotionOptions strict;
+  strict.ignoreUnknownColumns = false;
+  e = ExpectInputError([&] { MapMotion(model, extra, strict); });
   EXPECT_NE(e.find("column 'elbow' names no coordinate"), std::string::npos) << e;
-  MotionOptions options;
-  options.ignoreUnknownColumns = true;
-  const CoordinateTrajectory t = MapMotion(model, extra, options);
+  const CoordinateTrajectory t = MapMotion(model, extra); // skipped by default, as OpenSim does
   EXPECT_NE(t.warnings[0].find("elbow"), std::string::npos);
+}
+
+TEST(OpenSimMotion, AMotionOfAnotherModelIsSaidToBeOne)
+{
+  const Model model = ParseModel(kSmallModel, "small.osim");
+  // Most of what the file moves names no coordinate of this model.
+  const MotionTable other = ReadMotion(
+    WriteTemporary("other.mot", "endheader\ntime flex elbow_flex wrist_dev pro_sup\n0 1 2 3 4\n0.1 2 3 4 5\n"));
+  const CoordinateTrajectory t = MapMotion(model, other);
+  std::string all;
+  for (const std::string& w : t.warnings)
+  {
+    all += w + "\n";
+  }
+  EXPECT_NE(all.find("does not look like a motion of model"), std::string::npos) << all;
+  EXPECT_NE(all.find("3 of the 4 columns whose values change name no coordinate"), std::string::npos) << all;
+  // Columns of another name that stay constant (the LHDL motions' six zero pelvis columns) move
+  // nothing: no such warning.
+  const MotionTable constant = ReadMotion(
+    WriteTemporary("constant.mot", "endheader\ntime xRotation yRotation zRotation flex\n0 0 0 0 1\n0.1 0 0 0 2\n"));
+  for (const std::string& w : MapMotion(model, constant).warnings)
+  {
+    EXPECT_EQ(w.find("does not look like"), std::string::npos) << w;
+  }
+  // A motion that covers the model: no such warning.
+  std::string header = "endheader\ntime", row = "0", next = "0.1";
+  for (const Coordinate& c : model.coordinates)
+  {
+    header += " " + c.name;
+    row += " 0";
+    next += " 0.1";
+  }
+  const CoordinateTrajectory own =
+    MapMotion(model, ReadMotion(WriteTemporary("own.mot", header + "\n" + row + "\n" + next + "\n")));
+  for (const std::string& w : own.warnings)
+  {
+    EXPECT_EQ(w.find("does not look like"), std::string::npos) << w;
+  }
 }
