@@ -41,16 +41,9 @@ SMALL_MODEL = """<?xml version="1.0"?>
     <TransformAxis name="translation1"><coordinates>angle</coordinates><axis>1 0 0</axis><SimmSpline name="function"><x>-2 0 1 2</x><y>0 0.1 0.2 0.1</y></SimmSpline></TransformAxis>
    </SpatialTransform></CustomJoint>
  </objects></JointSet>
- <ForceSet><objects><Thelen2003Muscle name="m"><GeometryPath name="path"><PathPointSet><objects>
-  <PathPoint name="a"><socket_parent_frame>/ground</socket_parent_frame><location>0 1 0</location></PathPoint>
-  <ConditionalPathPoint name="c"><socket_parent_frame>/bodyset/shank</socket_parent_frame><location>0.1 -0.5 0</location><socket_coordinate>/jointset/knee/angle</socket_coordinate><range>-1 1</range></ConditionalPathPoint>
-  <PathPoint name="b"><socket_parent_frame>/bodyset/shank</socket_parent_frame><location>0 -1 0</location></PathPoint>
- </objects></PathPointSet></GeometryPath></Thelen2003Muscle></objects></ForceSet>
-</Model></OpenSimDocument>
-"""
+""" + mdtesting.KNEE_MUSCLE
 MOTION = "knee\nversion=1\ninDegrees=yes\nendheader\ntime angle\n0 0\n0.5 45\n1 90\n"
-TETRAHEDRON = ("# vtk DataFile Version 3.0\ntetrahedron\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n"
-               "0 0 0 0.1 0 0 0 0.1 0 0 0 0.1\nPOLYGONS 4 16\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n")
+TETRAHEDRON = mdtesting.TETRAHEDRON
 
 
 def copy_tree(tree):

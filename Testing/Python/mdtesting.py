@@ -17,6 +17,18 @@ import numpy  # noqa: E402
 from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
 
 SKIPPED = 77  # ctest SKIP_RETURN_CODE
+# The end of the small knee models of the fuzz and the fault cases: one muscle from ground to the
+# shank over a conditional path point, then the model closed.
+KNEE_MUSCLE = """ <ForceSet><objects><Thelen2003Muscle name="m"><GeometryPath name="path"><PathPointSet><objects>
+  <PathPoint name="a"><socket_parent_frame>/ground</socket_parent_frame><location>0 1 0</location></PathPoint>
+  <ConditionalPathPoint name="c"><socket_parent_frame>/bodyset/shank</socket_parent_frame><location>0.1 -0.5 0</location><socket_coordinate>/jointset/knee/angle</socket_coordinate><range>-1 1</range></ConditionalPathPoint>
+  <PathPoint name="b"><socket_parent_frame>/bodyset/shank</socket_parent_frame><location>0 -1 0</location></PathPoint>
+ </objects></PathPointSet></GeometryPath></Thelen2003Muscle></objects></ForceSet>
+</Model></OpenSimDocument>
+"""
+# An ASCII legacy VTK tetrahedron (closed, outward), a body's mesh file.
+TETRAHEDRON = ("# vtk DataFile Version 3.0\ntetrahedron\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n"
+               "0 0 0 0.1 0 0 0 0.1 0 0 0 0.1\nPOLYGONS 4 16\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n")
 BASELINE_DIR = os.path.join(SOURCE_DIR, "Testing", "Baseline")
 
 
