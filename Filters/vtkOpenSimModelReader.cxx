@@ -461,10 +461,13 @@ int vtkOpenSimModelReader::RequestData(
   }
   int result = 1;
   std::ostringstream when;
-  when << (in.trajectory.times.empty() ? "at the rest pose" : "at time ");
-  if (!in.trajectory.times.empty())
+  if (in.trajectory.times.empty())
   {
-    when << time;
+    when << "at the rest pose";
+  }
+  else
+  {
+    when << "at time " << time;
   }
   if (!mdvtk::CallCore(
         this, "",
@@ -475,6 +478,14 @@ int vtkOpenSimModelReader::RequestData(
           this->WritePaths(q, poses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS), when.str());
           this->WritePaths(
             in.rest, in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS_REST), "at the rest pose");
+          for (int port : { BODIES, BODIES_REST })
+          {
+            mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, port), mdvtk::Role::Bone);
+          }
+          for (int port : { MUSCLE_PATHS, MUSCLE_PATHS_REST })
+          {
+            mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, port), mdvtk::Role::ActionLine);
+          }
           this->WriteWrapsAndTransforms(poses, q, time, outputVector);
         },
         result))
@@ -493,14 +504,6 @@ void vtkOpenSimModelReader::WriteWrapsAndTransforms(const std::vector<md::RigidT
   const std::vector<double>& q, double time, vtkInformationVector* outputVector) const
 {
   const Internals& in = *this->Internal;
-  for (int port : { BODIES, BODIES_REST })
-  {
-    mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, port), mdvtk::Role::Bone);
-  }
-  for (int port : { MUSCLE_PATHS, MUSCLE_PATHS_REST })
-  {
-    mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, port), mdvtk::Role::ActionLine);
-  }
   vtkMultiBlockDataSet* wraps = vtkMultiBlockDataSet::GetData(outputVector, WRAP_OBJECTS);
   for (size_t w = 0; w < in.model.wrapObjects.size(); ++w)
   {

@@ -2,6 +2,7 @@
 """The fuzz campaign of Testing/Python/fuzz_filters.py in the suite: seeded random malformed input
 through every filter, in a child pvpython so that a crash is caught and named, not fatal."""
 import os
+import resource
 import subprocess
 import sys
 import unittest
@@ -32,8 +33,6 @@ class Fuzz(unittest.TestCase):
         """Testing/Python/fault_cases.py in a child pvpython whose address space is capped at
         8 GiB: a mesh file that lies about its size, a model nested 20,000 deep, NaN and infinity
         through the OpenSim filters... each must be an error naming the input, or a correct result."""
-        import resource
-
         def cap():
             resource.setrlimit(resource.RLIMIT_AS, (8 << 30, 8 << 30))
         script = os.path.join(mdtesting.HERE, "fault_cases.py")

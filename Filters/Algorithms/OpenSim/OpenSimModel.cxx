@@ -57,6 +57,21 @@ const std::set<std::string> kJointTypes = { "CustomJoint", "PinJoint", "WeldJoin
 constexpr size_t kMaxElementDepth = 256;
 const std::set<std::string> kPointTypes = { "PathPoint", "ConditionalPathPoint", "MovingPathPoint" };
 
+/// Finds the first element nested deeper than kMaxElementDepth.
+struct DepthLimit : pugi::xml_tree_walker
+{
+  Node tooDeep;
+  bool for_each(Node& node) override
+  {
+    if (node.type() == pugi::node_element && static_cast<size_t>(this->depth()) >= kMaxElementDepth)
+    {
+      this->tooDeep = node;
+      return false;
+    }
+    return true;
+  }
+};
+
 /// Reads the document and says where things are for messages.
 class Reader
 {
@@ -1085,33 +1100,13 @@ Model ParseModel(const std::string& text, const std::string& fileName)
       "OpenSim model '" + fileName + "', line " + std::to_string(line) + ": malformed XML: " + parsed.description());
   }
   // The model is read by walks whose depth is the file's nesting: refuse a nesting no model has
-  // before any of them (a deep one would overflow the stack).
-  size_t depth = 0;
-  for (Node node = document.first_child(); node;)
+  // before any of them (a deep one would overflow the stack). pugixml's traversal is a loop.
+  DepthLimit limit;
+  document.traverse(limit);
+  if (limit.tooDeep)
   {
-    if (node.type() == pugi::node_element && ++depth > kMaxElementDepth)
-    {
-      reader.Fail(node,
-        "elements nested more than " + std::to_string(kMaxElementDepth) + " deep; no OpenSim model nests so deep");
-    }
-    if (node.type() == pugi::node_element && node.first_child())
-    {
-      node = node.first_child();
-      continue;
-    }
-    if (node.type() == pugi::node_element)
-    {
-      --depth;
-    }
-    while (node && !node.next_sibling())
-    {
-      node = node.parent();
-      if (node && node.type() == pugi::node_element)
-      {
-        --depth;
-      }
-    }
-    node = node ? node.next_sibling() : Node();
+    reader.Fail(limit.tooDeep,
+      "elements nested more than " + std::to_string(kMaxElementDepth) + " deep; no OpenSim model nests so deep");
   }
   Node root = document.child("OpenSimDocument");
   Model model;

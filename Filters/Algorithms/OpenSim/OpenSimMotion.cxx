@@ -202,6 +202,8 @@ CoordinateTrajectory MapMotion(const Model& model, const MotionTable& motion, co
       label = label.substr(label.rfind('/') + 1);
     }
     const int coordinate = model.FindCoordinate(label);
+    const bool moving = changes(i);
+    movingColumns += moving;
     if (coordinate < 0)
     {
       if (!options.ignoreUnknownColumns)
@@ -210,13 +212,9 @@ CoordinateTrajectory MapMotion(const Model& model, const MotionTable& motion, co
           "' names no coordinate of model '" + model.name + "' (to skip such columns, set IgnoreUnknownColumns)");
       }
       skipped += (skipped.empty() ? "" : ", ") + motion.labels[i];
-      const bool moving = changes(i);
-      movingColumns += moving;
       movingSkipped += moving;
       continue;
     }
-    const bool moving = changes(i);
-    movingColumns += moving;
     movingMatched += moving;
     columnCoordinate[i] = coordinate;
     covered[coordinate] = true;
