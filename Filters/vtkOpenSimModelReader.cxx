@@ -443,7 +443,8 @@ int vtkOpenSimModelReader::RequestData(
     port = port < 0 || port >= this->GetNumberOfOutputPorts() ? 0 : port;
     vtkInformation* info = outputVector->GetInformationObject(port);
     double requested = this->CurrentPoseTime;
-    if (this->PlayMotion && info->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
+    const bool asked = this->PlayMotion && info->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+    if (asked)
     {
       requested = info->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
     }
@@ -452,11 +453,13 @@ int vtkOpenSimModelReader::RequestData(
     time = in.trajectory.times[k];
     const double first = in.trajectory.times.front(), last = in.trajectory.times.back();
     const double slack = 1e-9 * (std::abs(first) + std::abs(last) + 1.0);
-    if (requested < first - slack || requested > last + slack)
+    // The default CurrentPoseTime, 0, stands for the first frame (a motion may start later).
+    const bool given = asked || this->CurrentPoseTime != kDefaultCurrentPoseTime;
+    if (given && (requested < first - slack || requested > last + slack))
     {
-      vtkWarningMacro(<< (this->PlayMotion ? "the time asked for, " : "CurrentPoseTime ") << requested
-                      << (this->PlayMotion ? "," : "") << " lies outside the motion's times (" << first << " to "
-                      << last << "): the nearest frame, at time " << time << ", is shown");
+      vtkWarningMacro(<< (asked ? "the time asked for, " : "CurrentPoseTime ") << requested << (asked ? "," : "")
+                      << " lies outside the motion's times (" << first << " to " << last
+                      << "): the nearest frame, at time " << time << ", is shown");
     }
   }
   int result = 1;

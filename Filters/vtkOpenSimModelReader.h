@@ -102,7 +102,8 @@ public:
 
   /// The motion time (seconds) of the current pose when the pipeline asks for no time: for
   /// filters that advertise time steps of their own, such as InterpolatedMuscleDeformation.
-  /// The frame nearest to it is used. Default 0 (the first frame).
+  /// The frame nearest to it is used, with a warning when it lies outside the motion's times.
+  /// Default 0: the first frame, also of a motion that starts later (no warning then).
   vtkSetMacro(CurrentPoseTime, double);
   vtkGetMacro(CurrentPoseTime, double);
 
@@ -139,7 +140,8 @@ protected:
   char* RestPoseFileName = nullptr;
   char* ReferenceBody = nullptr;
   double Scale = 1.0;
-  double CurrentPoseTime = 0.0;
+  static constexpr double kDefaultCurrentPoseTime = 0.0;
+  double CurrentPoseTime = kDefaultCurrentPoseTime;
   bool PlayMotion = true;
   int AngleUnit = ANGLES_AS_FILE_SAYS;
   bool IgnoreUnknownColumns = true;

@@ -216,7 +216,11 @@ def case_current_pose_time_outside_the_motion():
     """CurrentPoseTime beyond the motion: the nearest frame, and a warning."""
     motion = write("turn.mot", MOTION)
     _, text = read(model(), MotionFileName=motion, PlayMotion=0, CurrentPoseTime=5.0)
-    return warned(text, "CurrentPoseTime 5 lies outside the motion's times (0 to 1)")
+    problem = warned(text, "CurrentPoseTime 5 lies outside the motion's times (0 to 1)")
+    # The default, 0, is the first frame of a motion that starts later: no warning.
+    later = write("later.mot", MOTION.replace("\n0 0 0\n", "\n0.25 0 0\n"))
+    _, text = read(model(), MotionFileName=later, PlayMotion=0)
+    return problem or ("a warning for the default CurrentPoseTime: " + text if "lies outside" in text else "")
 
 
 # --- MoveWithBodies -------------------------------------------------------------------------
