@@ -205,6 +205,25 @@ MotionDeformation::MotionDeformation(const std::vector<Muscle>& muscles, const s
       in.frame.ToLocal(line);
     }
   }
+  std::vector<TriangleMesh> restBones;
+  for (const Bone& b : bones)
+  {
+    in.boneNames.push_back(b.name);
+    restBones.push_back(b.rest);
+    in.frame.ToLocal(restBones.back().points);
+  }
+  in.obstacles = BuildObstacles(in.boneNames, restBones);
+  in.fixed = FixedObstacles(in.obstacles);
+  // A muscle that lies in a bone (given as a bone too) is left out, as the interpolation method
+  // leaves it out (MostlyInAnObstacle).
+  for (size_t m = 0; m < muscles.size(); ++m)
+  {
+    if (in.failures[m].empty())
+    {
+      in.failures[m] =
+        MostlyInAnObstacle(local[m].muscle, muscles[m].name, 0, in.fixed, FindOverlaps({ local[m].muscle }, in.fixed));
+    }
+  }
   in.energies = ActiveEnergies(local, localLines, in.parameters.settle, kept, in.failures, in.active);
   for (size_t k = 0; k < in.active.size(); ++k)
   {
@@ -220,15 +239,6 @@ MotionDeformation::MotionDeformation(const std::vector<Muscle>& muscles, const s
     }
   }
 
-  std::vector<TriangleMesh> restBones;
-  for (const Bone& b : bones)
-  {
-    in.boneNames.push_back(b.name);
-    restBones.push_back(b.rest);
-    in.frame.ToLocal(restBones.back().points);
-  }
-  in.obstacles = BuildObstacles(in.boneNames, restBones);
-  in.fixed = FixedObstacles(in.obstacles);
   auto state = std::make_shared<State>();
   for (const MuscleMotion& m : in.muscles)
   {

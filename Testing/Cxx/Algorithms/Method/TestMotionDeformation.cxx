@@ -173,6 +173,30 @@ TEST(MotionDeformation, APoseThatDoesNotFitIsRefusedAndTheMotionStaysWhereItWas)
   EXPECT_EQ((a.points[0] - b.points[0]).cwiseAbs().maxCoeff(), 0.0);
 }
 
+TEST(MotionDeformation, AMuscleGivenAsABoneTooIsLeftOutAndTheOthersGoOn)
+{
+  // Every point of the muscle on the bone's surface: inside or out by rounding, so the answer
+  // would depend on where the input sits. The interpolation method leaves it out; so does a motion.
+  PhantomSweep sweep({ 10, 20 });
+  std::vector<md::MotionDeformation::Bone> bones = sweep.bones;
+  bones.push_back({ "MuscleBone", sweep.muscles[0].rest });
+  md::MotionDeformation motion(sweep.muscles, bones, md::InterpolationParameters{});
+  ASSERT_EQ(motion.Failures().size(), sweep.muscles.size());
+  EXPECT_NE(motion.Failures()[0].find("lies in bone 'MuscleBone' in the rest pose"), std::string::npos)
+    << motion.Failures()[0];
+  for (size_t m = 1; m < sweep.muscles.size(); ++m)
+  {
+    EXPECT_EQ(motion.Failures()[m], "") << m;
+  }
+  for (md::MotionPose pose : sweep.poses)
+  {
+    pose.bones.push_back(sweep.muscles[0].rest.points); // the muscle-bone stays where it was
+    const md::MotionFrameResult frame = motion.Advance(pose);
+    EXPECT_EQ(frame.points[0].rows(), 0);
+    EXPECT_GT(frame.points[1].rows(), 0);
+  }
+}
+
 TEST(MotionDeformation, OnTheHipEveryFrameOfBothMotionsIsSound)
 {
   for (const std::string motion : { "hip_flexion", "hip_adduction" })
