@@ -6,6 +6,7 @@
 #include "MDReport.h"
 #include "MDTime.h"
 #include "OpenSim/MeshFileCheck.h"
+#include "OpenSim/MomentArms.h"
 #include "OpenSim/OpenSimKinematics.h"
 #include "OpenSim/OpenSimMotion.h"
 
@@ -32,6 +33,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <sstream>
 
 vtkStandardNewMacro(vtkOpenSimModelReader);
@@ -227,14 +229,16 @@ struct vtkOpenSimModelReader::Internals
   std::vector<md::TriangleMesh> wraps;   ///< per wrap object, in its body's frame
   std::vector<double> rest;
   std::vector<RigidTransform> restPoses;
-  RigidTransform toOutput; ///< ground -> the reference body's rest frame, lengths not yet scaled
+  RigidTransform toOutput;     ///< ground -> the reference body's rest frame, lengths not yet scaled
+  vtkNew<vtkTable> momentArms; ///< output MOMENT_ARMS as last computed
+  std::string momentArmsKey;   ///< what it was computed from
 };
 
 vtkOpenSimModelReader::vtkOpenSimModelReader()
   : Internal(new Internals)
 {
   this->SetNumberOfInputPorts(0);
-  this->SetNumberOfOutputPorts(6);
+  this->SetNumberOfOutputPorts(7);
 }
 
 vtkOpenSimModelReader::~vtkOpenSimModelReader()
@@ -249,7 +253,8 @@ vtkOpenSimModelReader::~vtkOpenSimModelReader()
 
 int vtkOpenSimModelReader::FillOutputPortInformation(int port, vtkInformation* info)
 {
-  info->Set(vtkDataObject::DATA_TYPE_NAME(), port == BODY_TRANSFORMS ? "vtkTable" : "vtkMultiBlockDataSet");
+  info->Set(vtkDataObject::DATA_TYPE_NAME(),
+    port == BODY_TRANSFORMS || port == MOMENT_ARMS ? "vtkTable" : "vtkMultiBlockDataSet");
   return 1;
 }
 
@@ -490,6 +495,7 @@ int vtkOpenSimModelReader::RequestData(
             mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, port), mdvtk::Role::ActionLine);
           }
           this->WriteWrapsAndTransforms(poses, q, time, outputVector);
+          this->WriteMomentArms(vtkTable::GetData(outputVector, MOMENT_ARMS));
         },
         result))
   {
@@ -597,6 +603,71 @@ void vtkOpenSimModelReader::WritePaths(const std::vector<double>& coordinates,
     mdvtk::AddFieldValue(block->GetFieldData(), "PathLength", this->Scale * osim::PolylineLength(g.points));
     mdvtk::AddBlock(tree, path.name, block);
   }
+}
+
+void vtkOpenSimModelReader::WriteMomentArms(vtkTable* table)
+{
+  Internals& in = *this->Internal;
+  std::ostringstream key;
+  key << in.modelKey << "|" << in.motionKey << "|" << in.poseKey << "|" << this->Scale;
+  if (key.str() != in.momentArmsKey)
+  {
+    in.momentArms->Initialize();
+    in.momentArmsKey.clear();
+    const osim::Model& model = in.model;
+    const bool playing = !in.trajectory.times.empty();
+    std::vector<int> coordinates = osim::MovingCoordinates(in.trajectory);
+    if (!playing)
+    {
+      coordinates.resize(model.coordinates.size());
+      std::iota(coordinates.begin(), coordinates.end(), 0);
+    }
+    const std::vector<std::vector<double>> frames =
+      playing ? in.trajectory.frames : std::vector<std::vector<double>>{ in.rest };
+    const auto column = [&](const std::string& name) {
+      auto array = vtkSmartPointer<vtkDoubleArray>::New();
+      array->SetName(name.c_str());
+      array->SetNumberOfTuples(static_cast<vtkIdType>(frames.size()));
+      in.momentArms->AddColumn(array);
+      return array;
+    };
+    auto times = column(mdvtk::array::Time);
+    std::vector<vtkSmartPointer<vtkDoubleArray>> values, lengths;
+    std::vector<std::vector<vtkSmartPointer<vtkDoubleArray>>> arms(model.paths.size());
+    for (int c : coordinates)
+    {
+      values.push_back(column(model.coordinates[c].name));
+    }
+    for (size_t p = 0; p < model.paths.size(); ++p)
+    {
+      lengths.push_back(column("Length(" + model.paths[p].name + ")"));
+      for (int c : coordinates)
+      {
+        arms[p].push_back(column("MomentArm(" + model.paths[p].name + ", " + model.coordinates[c].name + ")"));
+      }
+    }
+    for (size_t k = 0; k < frames.size(); ++k)
+    {
+      const auto row = static_cast<vtkIdType>(k);
+      times->SetValue(row, playing ? in.trajectory.times[k] : 0.0);
+      for (size_t i = 0; i < coordinates.size(); ++i)
+      {
+        const bool rotational = model.coordinates[coordinates[i]].motionType == osim::MotionType::Rotational;
+        values[i]->SetValue(row, frames[k][coordinates[i]] * (rotational ? 180.0 / M_PI : 1.0));
+      }
+      const osim::PathMoments moments = osim::MomentsAt(model, frames[k], coordinates);
+      for (size_t p = 0; p < model.paths.size(); ++p)
+      {
+        lengths[p]->SetValue(row, this->Scale * moments.length[p]);
+        for (size_t i = 0; i < coordinates.size(); ++i)
+        {
+          arms[p][i]->SetValue(row, this->Scale * moments.momentArm[p][i]);
+        }
+      }
+    }
+    in.momentArmsKey = key.str();
+  }
+  table->ShallowCopy(in.momentArms);
 }
 
 void vtkOpenSimModelReader::WriteTransforms(const std::vector<md::RigidTransform>& poses,

@@ -13,7 +13,9 @@
  *   RestToCurrentTransform), 1 MusclePaths at the current time (one polyline per muscle; point
  *   data PathPointName, PathPointBody), 2 BodiesRest, 3 MusclePathsRest, 4 BodyTransforms (a
  *   vtkTable: each body's rigid transform from the rest pose to the current time, x_CP = R x_RP +
- *   t), 5 WrapObjects at the current time.
+ *   t), 5 WrapObjects at the current time, 6 MomentArms (a vtkTable, a row per frame of the
+ *   motion, or one at the rest pose: the time, the coordinates that move, each path's length and
+ *   its moment arm about each of them, r = -dL/dq, OpenSim's sign).
  *
  * Every output is in the frame that ReferenceBody has at the rest pose (ground when empty), in
  * the model's units times Scale (1000: millimetres for a model in metres), so that surfaces
@@ -49,7 +51,8 @@ public:
     BODIES_REST = 2,
     MUSCLE_PATHS_REST = 3,
     BODY_TRANSFORMS = 4,
-    WRAP_OBJECTS = 5
+    WRAP_OBJECTS = 5,
+    MOMENT_ARMS = 6
   };
 
   enum AngleUnits
@@ -171,6 +174,8 @@ private:
   /// Outputs WRAP_OBJECTS and BODY_TRANSFORMS at `poses`.
   void WriteWrapsAndTransforms(const std::vector<md::RigidTransform>& poses, const std::vector<double>& q, double time,
     vtkInformationVector* outputVector) const;
+  /// Output MOMENT_ARMS, computed once per model, motion and Scale.
+  void WriteMomentArms(vtkTable* table);
   /// Output BODY_TRANSFORMS: each body's rest-to-current motion; the time and coordinates as field data.
   void WriteTransforms(const std::vector<md::RigidTransform>& poses, const std::vector<double>& coordinates,
     double time, vtkTable* table) const;

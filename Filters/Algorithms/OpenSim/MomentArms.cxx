@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "OpenSim/MomentArms.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace md::osim
+{
+namespace
+{
+/// The pose with `coordinate` moved by `delta`, its dependants following.
+std::vector<double> Moved(const Model& model, std::vector<double> coordinates, int coordinate, double delta)
+{
+  coordinates[coordinate] += delta;
+  const bool dependent = std::any_of(model.couplers.begin(), model.couplers.end(),
+    [coordinate](const CoordinateCoupler& c) { return c.dependent == coordinate; });
+  if (!dependent)
+  {
+    ApplyCouplers(model, coordinates);
+  }
+  return coordinates;
+}
+
+/// -dL/dq from the path at q and at q -+ step: central, or one-sided where the active points
+/// differ from those at q on one side.
+double Excursion(const PathGeometry& here, const PathGeometry& low, const PathGeometry& high, double step)
+{
+  const bool lowSame = low.pointIndex == here.pointIndex, highSame = high.pointIndex == here.pointIndex;
+  if (lowSame == highSame) // the usual case; both differ only for a step wider than a range
+  {
+    return -(PolylineLength(high.points) - PolylineLength(low.points)) / (2.0 * step);
+  }
+  const double length = PolylineLength(here.points);
+  return highSame ? -(PolylineLength(high.points) - length) / step : -(length - PolylineLength(low.points)) / step;
+}
+}
+
+double PathLength(const Model& model, const Path& path, const std::vector<double>& coordinates)
+{
+  return PolylineLength(PathAt(model, path, coordinates, BodyPoses(model, coordinates)).points);
+}
+
+double MomentArm(
+  const Model& model, const Path& path, const std::vector<double>& coordinates, int coordinate, double step)
+{
+  const std::vector<double> below = Moved(model, coordinates, coordinate, -step);
+  const std::vector<double> above = Moved(model, coordinates, coordinate, step);
+  return Excursion(PathAt(model, path, coordinates, BodyPoses(model, coordinates)),
+    PathAt(model, path, below, BodyPoses(model, below)), PathAt(model, path, above, BodyPoses(model, above)), step);
+}
+
+std::vector<int> MovingCoordinates(const CoordinateTrajectory& trajectory)
+{
+  std::vector<int> moving;
+  if (trajectory.frames.empty())
+  {
+    return moving;
+  }
+  const std::vector<double>& first = trajectory.frames.front();
+  for (size_t c = 0; c < first.size(); ++c)
+  {
+    const double tolerance = 1e-12 * std::max(1.0, std::abs(first[c]));
+    if (std::any_of(trajectory.frames.begin(), trajectory.frames.end(),
+          [&](const std::vector<double>& frame) { return std::abs(frame[c] - first[c]) > tolerance; }))
+    {
+      moving.push_back(static_cast<int>(c));
+    }
+  }
+  return moving;
+}
+
+PathMoments MomentsAt(const Model& model, const std::vector<double>& pose, const std::vector<int>& coordinates)
+{
+  PathMoments moments;
+  const std::vector<RigidTransform> poses = BodyPoses(model, pose);
+  std::vector<PathGeometry> here;
+  for (const Path& path : model.paths)
+  {
+    here.push_back(PathAt(model, path, pose, poses));
+    moments.length.push_back(PolylineLength(here.back().points));
+  }
+  moments.momentArm.assign(model.paths.size(), std::vector<double>(coordinates.size()));
+  for (size_t k = 0; k < coordinates.size(); ++k)
+  {
+    const std::vector<double> below = Moved(model, pose, coordinates[k], -kMomentArmStep);
+    const std::vector<double> above = Moved(model, pose, coordinates[k], kMomentArmStep);
+    const std::vector<RigidTransform> belowPoses = BodyPoses(model, below), abovePoses = BodyPoses(model, above);
+    for (size_t p = 0; p < model.paths.size(); ++p)
+    {
+      const Path& path = model.paths[p];
+      moments.momentArm[p][k] = Excursion(
+        here[p], PathAt(model, path, below, belowPoses), PathAt(model, path, above, abovePoses), kMomentArmStep);
+    }
+  }
+  return moments;
+}
+}
