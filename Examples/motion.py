@@ -15,9 +15,18 @@ For each case it writes into <output>/<case>/: the deformed muscles and the bone
 series; a picture of every frame (frames/<case>_<k>.png) and, where this ParaView can write one,
 a movie (<case>.avi); plots of the measures over time (<case>_measures.png,
 <case>_smoothness.png); and figures.json (per-frame time through the filter, and every measure at
-every frame).
+every frame). For the LHDL hip, per muscle, a plot of its straight paths' moment arms (the
+reader's MomentArms table) against the joint angle beside Blemker & Delp 2005's range
+(<motion>_moment_arm_<muscle>.png), and in figures.json the share of poses inside that range.
+The LHDL paths' conditional points fade over 10 degrees (ConditionalPointFade), so
+the lines move continuously. The LHDL muscles are attached to their bones by the data set's own landmarks
+(attachment_areas_rp_mm.csv, AttachmentFileName); figures.json gives, per muscle, the largest slip
+at those landmarks over the motion (the muscle surface point next to each landmark against where
+the landmark's bone carries it), and the largest step of a muscle point between two frames
+against the median of those steps.
 """
 import argparse
+import csv
 import json
 import math
 import os
@@ -26,7 +35,9 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import mdexamples  # noqa: E402
+import numpy  # noqa: E402
 from paraview import servermanager, simple  # noqa: E402
+from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
 
 HIP_CENTRE = (143.48, 243.44, -432.67)
 
@@ -49,6 +60,9 @@ def lhdl_pipeline(data, motion_name):
     import lhdl
     folder = os.path.join(data, "lhdl_hip_r")
     reader = lhdl.model_reader(folder, motion_name, 0, play=True)
+    # The psoas's and the iliacus's via points go at 40 and 54 degrees of flexion: faded over 10
+    # degrees, their lines, and the muscles, move continuously instead of jumping there.
+    reader.ConditionalPointFade = CONDITIONAL_POINT_FADE
     bones = lhdl.producer(lhdl.named_blocks([(n, lhdl.read_surface(folder, n)) for n in lhdl.BONES]),
                           "LHDL bones (rest pose)")
     muscles = lhdl.producer(lhdl.named_blocks([(n, lhdl.read_surface(folder, n)) for n in lhdl.MUSCLES]),
@@ -59,10 +73,79 @@ def lhdl_pipeline(data, motion_name):
                                       Paths=simple.OutputPort(reader, 3), PathsCurrent=simple.OutputPort(reader, 1))
     motion = simple.MotionMuscleDeformation(registrationName="LHDL " + motion_name, Input=muscles, BonesRest=bones,
                                             BonesMotion=moved, ActionLinesRest=simple.OutputPort(lines, 0),
-                                            ActionLinesMotion=simple.OutputPort(lines, 1))
+                                            ActionLinesMotion=simple.OutputPort(lines, 1),
+                                            AttachmentFileName=os.path.join(folder, LANDMARKS))
     camera = {"direction": (-1.0, -0.55, 0.25), "up": (0.0, 0.0, 1.0),
               "focal": [HIP_CENTRE[0], HIP_CENTRE[1] - 120.0, HIP_CENTRE[2] - 120.0], "distance": 1500.0}
     return motion, camera
+
+
+LANDMARKS = "attachment_areas_rp_mm.csv"
+CONDITIONAL_POINT_FADE = 10.0  # degrees
+# The data set's names for the muscles and the bones its landmarks lie on (the iliotibial tract's,
+# on the tibia, is on no bone of the scan and left out).
+LANDMARK_MUSCLES = {"R_Glut_Max": "gluteus_maximus_r", "R_Glut_Med": "gluteus_medius_r", "R_Iliacus": "iliacus_r",
+                    "R_Psoas_maj": "psoas_r"}
+LANDMARK_BONES = {"pelvis": "iliac_r", "femur_r": "femur_r"}
+
+
+def leaf_points(data):
+    """{block name: its points as a numpy array} of a multiblock."""
+    from vtkmodules.vtkCommonDataModel import vtkCompositeDataSet
+    result = {}
+    iterator = data.NewIterator()
+    iterator.InitTraversal()
+    while not iterator.IsDoneWithTraversal():
+        name = iterator.GetCurrentMetaData().Get(vtkCompositeDataSet.NAME())
+        result[name] = vtk_to_numpy(iterator.GetCurrentDataObject().GetPoints().GetData()).astype(float)
+        iterator.GoToNextItem()
+    return result
+
+
+def rigid_fit(rest, now):
+    """R, t with now ~ R rest + t (least squares)."""
+    a, b = rest.mean(axis=0), now.mean(axis=0)
+    u, _, vt = numpy.linalg.svd((rest - a).T @ (now - b))
+    d = numpy.sign(numpy.linalg.det(vt.T @ u.T))
+    rotation = vt.T @ numpy.diag([1.0, 1.0, d]) @ u.T
+    return rotation, b - rotation @ a
+
+
+class LandmarkSlip:
+    """The slip at the data set's attachment landmarks, frame by frame: for each landmark, the rest
+    muscle point nearest it, against where the landmark's bone carries that point."""
+
+    def __init__(self, table, muscles_rest, bones_rest):
+        self.bones_rest = bones_rest
+        self.probes = []  # (muscle, point, bone)
+        with open(table) as f:
+            for row in csv.DictReader(f):
+                muscle, bone = LANDMARK_MUSCLES.get(row["muscle_group"]), LANDMARK_BONES.get(row["attached_to"])
+                if muscle not in muscles_rest or bone not in bones_rest:
+                    continue
+                mark = numpy.array([float(row[c]) for c in ("x_mm", "y_mm", "z_mm")])
+                point = int(numpy.argmin(((muscles_rest[muscle] - mark) ** 2).sum(axis=1)))
+                self.probes.append((muscle, point, bone))
+        self.muscles_rest = muscles_rest
+        self.worst = {}
+
+    def add_frame(self, muscles, bones):
+        carried = {b: rigid_fit(self.bones_rest[b], bones[b]) for b in set(p[2] for p in self.probes)}
+        for muscle, point, bone in self.probes:
+            rotation, translation = carried[bone]
+            expected = rotation @ self.muscles_rest[muscle][point] + translation
+            slip = float(numpy.linalg.norm(muscles[muscle][point] - expected))
+            self.worst[muscle] = max(self.worst.get(muscle, 0.0), slip)
+
+
+def step_ratios(frames):
+    """Per muscle: the largest step of any of its points between two frames against the median of
+    each transition's largest step."""
+    ratios = {}
+    for name in frames[0]:
+        steps = sorted(float(numpy.linalg.norm(b[name] - a[name], axis=1).max()) for a, b in zip(frames, frames[1:]))
+        ratios[name] = steps[-1] / steps[len(steps) // 2] if steps and steps[len(steps) // 2] > 0 else 0.0
+    return ratios
 
 
 def write_multiblock(source, port, path):
@@ -108,7 +191,79 @@ def plot(motion, path, pattern, title):
     return path
 
 
-def run_case(name, motion, camera, output, every):
+# The data set's muscles, the model's paths of each, and their names in the literature files.
+MUSCLE_PATHS = {"psoas_r": ["psoas_r"], "iliacus_r": ["iliacus_r"],
+                "gluteus_maximus_r": ["glut_max1_r", "glut_max2_r", "glut_max3_r"],
+                "gluteus_medius_r": ["glut_med1_r", "glut_med2_r", "glut_med3_r"]}
+
+
+def interpolated(curve, angle):
+    """A digitised curve [[angle, value], ...] (sorted) at `angle`; None outside it."""
+    if not curve or angle < curve[0][0] or angle > curve[-1][0]:
+        return None
+    for (a0, v0), (a1, v1) in zip(curve, curve[1:]):
+        if a0 <= angle <= a1:
+            return v0 if a1 == a0 else v0 + (angle - a0) / (a1 - a0) * (v1 - v0)
+    return curve[-1][1]
+
+
+def moment_arm_plots(reader, data, motion_name, folder):
+    """Per muscle, the moment arms of the model's straight paths (the reader's MomentArms table)
+    against the joint angle, beside Blemker & Delp 2005's range of fibre moment arms
+    (literature/blemker2005_envelopes.json); and the share of poses, inside the angles Blemker's
+    curves cover, where each path lies inside that range."""
+    from vtkmodules.vtkCommonCore import vtkDoubleArray
+    from vtkmodules.vtkCommonDataModel import vtkTable
+    envelopes = os.path.join(data, "literature", "blemker2005_envelopes.json")
+    if not os.path.isfile(envelopes):
+        print("no moment-arm plots: %s is absent" % envelopes)
+        return {}, []
+    with open(envelopes) as f:
+        blemker = json.load(f)["muscles"]
+    coordinate = {"hip_flexion": "hip_flexion_r", "hip_adduction": "hip_adduction_r"}[motion_name]
+    arms = table_columns(servermanager.Fetch(reader, idx=6))
+    angles = arms[coordinate]
+    inside, plots = {}, []
+    for muscle, paths in MUSCLE_PATHS.items():
+        band = blemker[muscle][coordinate]
+        upper = [interpolated(band["upper"], a) for a in angles]
+        lower = [interpolated(band["lower"], a) for a in angles]
+        table = vtkTable()
+        columns = {"%s (deg)" % coordinate: angles}
+        columns.update({"Blemker 2005 upper": [float("nan") if u is None else u for u in upper],
+                        "Blemker 2005 lower": [float("nan") if v is None else v for v in lower]})
+        for path in paths:
+            values = arms["MomentArm(%s, %s)" % (path, coordinate)]
+            columns[path] = values
+            covered = [(v, lo, up) for v, lo, up in zip(values, lower, upper) if lo is not None and up is not None]
+            inside[path] = 100.0 * sum(min(lo, up) <= v <= max(lo, up) for v, lo, up in covered) / max(1, len(covered))
+        for column_name, values in columns.items():
+            array = vtkDoubleArray()
+            array.SetName(column_name)
+            for v in values:
+                array.InsertNextValue(v)
+            table.AddColumn(array)
+        source = simple.PVTrivialProducer(registrationName="%s moment arms" % muscle)
+        source.GetClientSideObject().SetOutput(table)
+        view = simple.CreateView("XYChartView")
+        view.ViewSize = [700, 450]
+        view.ChartTitle = "%s, %s: straight paths, Blemker 2005's range" % (muscle, motion_name)
+        view.LeftAxisTitle = "moment arm (mm)"
+        view.BottomAxisTitle = "%s (deg)" % coordinate
+        display = simple.Show(source, view)
+        display.UseIndexForXAxis = 0
+        display.XArrayName = "%s (deg)" % coordinate
+        display.SeriesVisibility = [n for n in columns if n != "%s (deg)" % coordinate]
+        simple.Render(view)
+        path_png = os.path.join(folder, "%s_moment_arm_%s.png" % (motion_name, muscle))
+        simple.SaveScreenshot(path_png, view, ImageResolution=[700, 450])
+        simple.Delete(view)
+        simple.Delete(source)
+        plots.append(path_png)
+    return inside, plots
+
+
+def run_case(name, motion, camera, output, every, landmarks=None):
     folder = os.path.join(output, name)
     os.makedirs(os.path.join(folder, "frames"), exist_ok=True)
     times = list(motion.TimestepValues)
@@ -129,8 +284,16 @@ def run_case(name, motion, camera, output, every):
     mdexamples.set_camera(view, camera["direction"], camera["up"], focal=camera["focal"],
                           distance=camera["distance"])
     entries = []
+    slip = None
+    if landmarks:
+        slip = LandmarkSlip(landmarks, leaf_points(servermanager.Fetch(motion.Input)),
+                            leaf_points(servermanager.Fetch(motion.BonesRest)))
+    muscle_frames = []
     for k, t in enumerate(times):
         motion.UpdatePipeline(t)
+        muscle_frames.append(leaf_points(servermanager.Fetch(motion, idx=0)))
+        if slip:
+            slip.add_frame(muscle_frames[-1], leaf_points(servermanager.Fetch(motion, idx=1)))
         muscles_file = "%s_muscles_%03d.vtm" % (name, k)
         bones_file = "%s_bones_%03d.vtm" % (name, k)
         write_multiblock(motion, 0, os.path.join(folder, muscles_file))
@@ -167,7 +330,16 @@ def run_case(name, motion, camera, output, every):
         "frames_computed": motion.GetProperty("FramesComputed").GetData(),
         "cache_megabytes": motion.GetProperty("CacheMegabytes").GetData(),
         "movie": movie, "plots": plots, "measures": table,
+        "largest_step_against_median": step_ratios(muscle_frames),
     }
+    if slip:
+        figures["largest_landmark_slip_mm"] = slip.worst
+        figures["landmark_probes"] = len(slip.probes)
+        reader = simple.FindSource("LHDL_hip_r.osim")
+        data = os.path.dirname(os.path.dirname(landmarks))
+        inside, arm_plots = moment_arm_plots(reader, data, name[len("lhdl_"):], folder)
+        figures["straight_path_moment_arm_inside_blemker2005_percent"] = inside
+        figures["plots"] += arm_plots
     finite = lambda values: [v for v in values if not math.isnan(v)]  # noqa: E731
     worst = {
         "largest_abs_volume_change_percent": max(abs(v) for key, values in table.items()
@@ -188,6 +360,14 @@ def run_case(name, motion, camera, output, every):
              figures["per_frame_ms_max"], worst["largest_abs_volume_change_percent"],
              worst["largest_bone_penetration"], worst["largest_smoothness_ratio"], worst["every_frame_converged"],
              folder))
+    if slip:
+        print("  largest slip at the data set's %d attachment landmarks (mm): %s" % (
+            len(slip.probes), ", ".join("%s %.2f" % item for item in sorted(slip.worst.items()))))
+    if figures.get("straight_path_moment_arm_inside_blemker2005_percent"):
+        print("  the model's straight paths' moment arms inside Blemker 2005's range: %s (%% of poses)" % ", ".join(
+            "%s %.0f" % item for item in figures["straight_path_moment_arm_inside_blemker2005_percent"].items()))
+    print("  largest step of a muscle point between frames against its median: %s" % ", ".join(
+        "%s %.1fx" % item for item in sorted(figures["largest_step_against_median"].items())))
     return figures
 
 
@@ -211,7 +391,8 @@ def main(argv=None):
         if data is None:
             continue
         motion, camera = lhdl_pipeline(data, name)
-        results.append(run_case("lhdl_" + name, motion, camera, args.output, args.every))
+        results.append(run_case("lhdl_" + name, motion, camera, args.output, args.every,
+                                landmarks=os.path.join(data, "lhdl_hip_r", LANDMARKS)))
     return 0 if results else mdexamples.SKIPPED
 
 

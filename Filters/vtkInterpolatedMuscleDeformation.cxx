@@ -2,6 +2,7 @@
 #include "vtkInterpolatedMuscleDeformation.h"
 
 #include "Geometry/LocalFrame.h"
+#include "MDAttachments.h"
 #include "MDBlocks.h"
 #include "MDConvert.h"
 #include "MDReport.h"
@@ -54,7 +55,9 @@ struct vtkInterpolatedMuscleDeformation::Lines
 
 namespace
 {
-const char* const PortNames[] = { "Input", "BonesRest", "BonesCurrent", "ActionLinesRest", "ActionLinesCurrent" };
+const char* const PortNames[] = { "Input", "BonesRest", "BonesCurrent", "ActionLinesRest", "ActionLinesCurrent",
+  "Attachments" };
+constexpr int kAttachmentsPort = 5;
 
 /// Output 3: a row per muscle, a column per measure (NaN in the rows of the muscles that failed),
 /// then DeformationFailed.
@@ -114,7 +117,7 @@ vtkInterpolatedMuscleDeformation::vtkInterpolatedMuscleDeformation()
   : Computed(std::make_unique<Cache>())
   , KeptRest(std::make_unique<md::RestMappingCache>())
 {
-  this->SetNumberOfInputPorts(5);
+  this->SetNumberOfInputPorts(kPorts);
   this->SetNumberOfOutputPorts(4);
   const md::InterpolationParameters method;
   this->NumberOfSteps = method.numberOfSteps;
@@ -161,12 +164,25 @@ int vtkInterpolatedMuscleDeformation::RequestDataObject(
   return 1;
 }
 
-vtkInterpolatedMuscleDeformation::~vtkInterpolatedMuscleDeformation() = default;
-
-int vtkInterpolatedMuscleDeformation::FillInputPortInformation(int, vtkInformation* info)
+vtkInterpolatedMuscleDeformation::~vtkInterpolatedMuscleDeformation()
 {
+  this->SetAttachmentFileName(nullptr);
+}
+
+int vtkInterpolatedMuscleDeformation::FillInputPortInformation(int port, vtkInformation* info)
+{
+  if (port == kAttachmentsPort)
+  {
+    mdvtk::OptionalLandmarkInput(info);
+    return 1;
+  }
   mdvtk::AcceptPolyDataOrMultiBlock(info);
   return 1;
+}
+
+const char* vtkInterpolatedMuscleDeformation::GetAttachmentReport() const
+{
+  return this->AttachmentReport.c_str();
 }
 
 int vtkInterpolatedMuscleDeformation::RequestInformation(
@@ -197,16 +213,16 @@ int vtkInterpolatedMuscleDeformation::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   mdvtk::ClearOutputs(outputVector);
-  mdvtk::InputsAtTheirOwnTime(inputVector, 5); // our time is the interpolation step
+  mdvtk::InputsAtTheirOwnTime(inputVector, kPorts); // our time is the interpolation step
   return 1;
 }
 
 int vtkInterpolatedMuscleDeformation::RequestData(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkDataObject* inputs[5];
+  vtkDataObject* inputs[kPorts];
   vtkMTimeType inputsTime = 0;
-  for (int port = 0; port < 5; ++port)
+  for (int port = 0; port < kPorts; ++port)
   {
     inputs[port] = vtkDataObject::GetData(inputVector[port], 0);
     inputsTime = std::max(inputsTime, inputs[port] ? inputs[port]->GetMTime() : 0);
@@ -240,7 +256,8 @@ int vtkInterpolatedMuscleDeformation::RequestData(
   return 1;
 }
 
-int vtkInterpolatedMuscleDeformation::Deform(vtkDataObject* const inputs[5], const std::vector<mdvtk::Leaf>& muscles)
+int vtkInterpolatedMuscleDeformation::Deform(
+  vtkDataObject* const inputs[kPorts], const std::vector<mdvtk::Leaf>& muscles)
 {
   Cache& cache = *this->Computed;
   cache = Cache{};
@@ -313,6 +330,7 @@ int vtkInterpolatedMuscleDeformation::Deform(vtkDataObject* const inputs[5], con
   if (!mdvtk::CallCore(
         this, "",
         [&] {
+          this->Attach(inputs[kAttachmentsPort], frame, motions, bones);
           cache.result =
             md::DeformByInterpolation(motions, bones, parameters, mdvtk::ProgressOrCancel(this), this->KeptRest.get());
         },
@@ -340,6 +358,52 @@ int vtkInterpolatedMuscleDeformation::Deform(vtkDataObject* const inputs[5], con
     vtkWarningMacro(<< warning);
   }
   return 1;
+}
+
+void vtkInterpolatedMuscleDeformation::Attach(vtkDataObject* landmarks, const md::LocalFrame& frame,
+  std::vector<md::MuscleMotion>& motions, const std::vector<md::BoneMotion>& bones)
+{
+  std::vector<md::LandmarkSet> sets;
+  if (this->AttachmentAreas != mdvtk::ATTACHMENTS_OFF)
+  {
+    sets = mdvtk::ReadLandmarks(landmarks, this->AttachmentFileName ? this->AttachmentFileName : "");
+  }
+  for (md::LandmarkSet& set : sets)
+  {
+    frame.ToLocal(set.points); // the muscles and bones are in the local frame here
+  }
+  std::vector<std::string> muscleNames, boneNames;
+  std::vector<md::TriangleMesh> surfaces, boneSurfaces;
+  std::vector<std::vector<md::Points>> lines;
+  for (const md::MuscleMotion& m : motions)
+  {
+    muscleNames.push_back(m.name);
+    surfaces.push_back(m.muscle);
+    lines.emplace_back();
+    for (const md::MatchedLine& line : m.lines)
+    {
+      lines.back().push_back(line.rest);
+    }
+  }
+  for (const md::BoneMotion& b : bones)
+  {
+    boneNames.push_back(b.name);
+    boneSurfaces.push_back(b.rest);
+  }
+  std::vector<std::vector<md::Attachment>> areas;
+  this->AttachmentReport = mdvtk::AttachAndReport(this, "InterpolatedMuscleDeformation", this->AttachmentAreas, sets,
+    muscleNames, surfaces, lines, boneNames, boneSurfaces, areas);
+  bool attached = false;
+  for (size_t m = 0; m < motions.size(); ++m)
+  {
+    motions[m].attachments = areas[m];
+    attached = attached || !areas[m].empty();
+  }
+  if (attached && this->DeformationMesh == HULL)
+  {
+    vtkWarningMacro(<< "the attachment areas are honoured with DeformationMesh Muscle surface only: on the hull "
+                       "the muscles move with their action lines alone");
+  }
 }
 
 bool vtkInterpolatedMuscleDeformation::MatchLines(const std::vector<mdvtk::Leaf>& muscles, const Lines& lines,
@@ -565,6 +629,8 @@ void vtkInterpolatedMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "HullTargetNumberOfPoints: " << this->HullTargetNumberOfPoints << "\n";
   os << indent << "BoneContactWeight: " << this->BoneContactWeight << "\n";
   os << indent << "RefitRegularisation: " << this->RefitRegularisation << "\n";
+  os << indent << "AttachmentAreas: " << this->AttachmentAreas << "\n";
+  os << indent << "AttachmentFileName: " << (this->AttachmentFileName ? this->AttachmentFileName : "") << "\n";
   os << indent << "ResolvedNumberOfSteps: " << this->ResolvedNumberOfSteps << "\n";
   os << indent << "HullBuildCount: " << this->GetHullBuildCount() << "\n";
   os << indent << "SurfaceEnergyBuildCount: " << this->GetSurfaceEnergyBuildCount() << "\n";

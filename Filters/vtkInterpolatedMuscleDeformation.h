@@ -26,7 +26,8 @@
  * the bones in both poses (blocks paired by name, else by order; the same
  * points); 3 ActionLinesRest and 4 ActionLinesCurrent, the raw action lines
  * in both poses, one block per muscle (by name, else by order), polylines
- * paired by order inside a block and matched as ActionLineMatching does.
+ * paired by order inside a block and matched as ActionLineMatching does;
+ * 5 Attachments (optional), landmarks of the muscles' attachment areas (AttachmentAreas).
  *
  * Outputs 1 (Bones) and 2 (ActionLines): the bones and the matched action
  * lines at the same step, as the method moved them, in the structure of
@@ -59,6 +60,7 @@ namespace md
 {
 struct RestMappingCache;
 struct MuscleMotion;
+struct BoneMotion;
 struct LocalFrame;
 struct InterpolationParameters;
 }
@@ -78,6 +80,7 @@ public:
   void SetBonesCurrentConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(2, output); }
   void SetActionLinesRestConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(3, output); }
   void SetActionLinesCurrentConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(4, output); }
+  void SetAttachmentsConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(5, output); }
 
   enum InterpolationModes
   {
@@ -141,6 +144,20 @@ public:
   vtkSetClampMacro(RefitRegularisation, double, 1e-9, 1e3);
   vtkGetMacro(RefitRegularisation, double);
 
+  /// Where the muscles are attached to the bones (docs/DESIGN.md, "Attachment areas"): 0 off
+  /// (they move with their action lines only), 1 (default) the areas the landmarks mark (the
+  /// Attachments input and AttachmentFileName), and for a muscle with none, the areas at its
+  /// action lines' ends near a bone. An area moves rigidly with its bone. Honoured with
+  /// DeformationMesh MUSCLE_SURFACE (the hull-based pass moves with the action lines only).
+  vtkSetClampMacro(AttachmentAreas, int, 0, 1);
+  vtkGetMacro(AttachmentAreas, int);
+  /// A landmark table (CSV with a header: muscle, bone, x, y, z, optionally area; the LHDL data
+  /// set's attachment_areas_rp_mm.csv reads as it is). Empty: none.
+  vtkSetStringMacro(AttachmentFileName);
+  vtkGetStringMacro(AttachmentFileName);
+  /// How the areas were found, as the output messages said it at the last run.
+  const char* GetAttachmentReport() const;
+
   /// N as resolved by the last RequestInformation.
   vtkGetMacro(ResolvedNumberOfSteps, int);
 
@@ -180,6 +197,9 @@ protected:
   int HullTargetNumberOfPoints;
   double RefitRegularisation;
   int ResolvedNumberOfSteps;
+  int AttachmentAreas = 1;
+  char* AttachmentFileName = nullptr;
+  std::string AttachmentReport;
   int ShownNumberOfSteps = 0; // N and step of the last output, to say when N changes under a time
   int ShownStep = 0;
 
@@ -188,8 +208,12 @@ private:
   void operator=(const vtkInterpolatedMuscleDeformation&) = delete;
   struct Cache;
   struct Lines;
+  static constexpr int kPorts = 6;
   /// Reads the inputs and runs the method, into Computed: RequestData's result.
-  int Deform(vtkDataObject* const inputs[5], const std::vector<mdvtk::Leaf>& muscles);
+  int Deform(vtkDataObject* const inputs[kPorts], const std::vector<mdvtk::Leaf>& muscles);
+  /// The muscles' attachment areas (AttachmentAreas) in `frame`, said in the output messages.
+  void Attach(vtkDataObject* landmarks, const md::LocalFrame& frame, std::vector<md::MuscleMotion>& motions,
+    const std::vector<md::BoneMotion>& bones);
   /// Brings `motions` (the muscles read, at their blocks Computed->blockOf) into `frame` and
   /// matches their action lines; a muscle whose lines fail is left out, `kept` the indices of the
   /// others. False (with RequestData's `result`) when the user stopped the run.

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkMotionMuscleDeformation.h"
 
+#include "MDAttachments.h"
 #include "MDBlocks.h"
 #include "MDConvert.h"
 #include "MDReport.h"
@@ -32,6 +33,7 @@ namespace
 using SDDP = vtkStreamingDemandDrivenPipeline;
 const char* const PortNames[] = { "Input", "BonesRest", "BonesMotion", "ActionLinesRest", "ActionLinesMotion" };
 constexpr int kMotionPorts[] = { 2, 4 };
+constexpr int kAttachmentsPort = 5;
 }
 
 /// What the frames were computed from: when any of it changes, the motion starts again.
@@ -45,12 +47,14 @@ struct vtkMotionMuscleDeformation::Signature
   int interpolationMode = 0;
   double deformableShare = 0;
   bool preserveVolume = true;
+  int attachmentAreas = 1;
+  std::string attachmentFile;
   bool operator==(const Signature& o) const
   {
     return restInputs == o.restInputs && motionPipeline == o.motionPipeline && times == o.times &&
       numberOfSteps == o.numberOfSteps && maximumStepDisplacement == o.maximumStepDisplacement &&
       interpolationMode == o.interpolationMode && deformableShare == o.deformableShare &&
-      preserveVolume == o.preserveVolume;
+      preserveVolume == o.preserveVolume && attachmentAreas == o.attachmentAreas && attachmentFile == o.attachmentFile;
   }
 };
 
@@ -104,6 +108,7 @@ struct FrameMeasures
 struct vtkMotionMuscleDeformation::Internals
 {
   Signature signature;
+  std::string attachmentReport; ///< GetAttachmentReport
   std::unique_ptr<md::MotionDeformation> deformation;
   md::RestMappingCache kept;
   std::vector<size_t> blockOf;                    // muscle block of each muscle given to the core
@@ -242,7 +247,7 @@ struct vtkMotionMuscleDeformation::Internals
 vtkMotionMuscleDeformation::vtkMotionMuscleDeformation()
   : In(std::make_unique<Internals>())
 {
-  this->SetNumberOfInputPorts(5);
+  this->SetNumberOfInputPorts(6);
   this->SetNumberOfOutputPorts(4);
   const md::InterpolationParameters method;
   this->MaximumStepDisplacement = method.maximumStepDisplacement;
@@ -251,7 +256,15 @@ vtkMotionMuscleDeformation::vtkMotionMuscleDeformation()
   this->PreserveVolume = method.deformation.preserveVolume;
 }
 
-vtkMotionMuscleDeformation::~vtkMotionMuscleDeformation() = default;
+vtkMotionMuscleDeformation::~vtkMotionMuscleDeformation()
+{
+  this->SetAttachmentFileName(nullptr);
+}
+
+const char* vtkMotionMuscleDeformation::GetAttachmentReport() const
+{
+  return this->In->attachmentReport.c_str();
+}
 
 int vtkMotionMuscleDeformation::GetFramesComputed() const
 {
@@ -273,8 +286,13 @@ int vtkMotionMuscleDeformation::GetSurfaceEnergyBuildCount() const
   return this->In->kept.energyBuildCount;
 }
 
-int vtkMotionMuscleDeformation::FillInputPortInformation(int, vtkInformation* info)
+int vtkMotionMuscleDeformation::FillInputPortInformation(int port, vtkInformation* info)
 {
+  if (port == kAttachmentsPort)
+  {
+    mdvtk::OptionalLandmarkInput(info);
+    return 1;
+  }
   mdvtk::AcceptPolyDataOrMultiBlock(info);
   return 1;
 }
@@ -449,7 +467,7 @@ int vtkMotionMuscleDeformation::RequestData(
     }
   }
   int result = 1;
-  if (!in.deformation && !this->Start(leaves, result))
+  if (!in.deformation && !this->Start(leaves, vtkDataObject::GetData(inputVector[kAttachmentsPort], 0), result))
   {
     in.Restart();
     return this->Stop(request, result);
@@ -505,6 +523,10 @@ vtkMotionMuscleDeformation::Signature vtkMotionMuscleDeformation::SignatureOf(
   signature.interpolationMode = this->BoneInterpolationMode;
   signature.deformableShare = this->DeformableShare;
   signature.preserveVolume = this->PreserveVolume;
+  signature.attachmentAreas = this->AttachmentAreas;
+  signature.attachmentFile = this->AttachmentFileName ? this->AttachmentFileName : "";
+  signature.restInputs =
+    std::max(signature.restInputs, mdvtk::DataMTime(vtkDataObject::GetData(inputVector[kAttachmentsPort], 0)));
   return signature;
 }
 
@@ -523,7 +545,41 @@ int vtkMotionMuscleDeformation::GoOn(vtkInformation* request)
   return 1;
 }
 
-bool vtkMotionMuscleDeformation::Start(const Leaves& leaves, int& result)
+namespace
+{
+/// The muscles' attachment areas as `mode` (AttachmentAreas) says, said in the output messages;
+/// returns what was said.
+std::string Attach(vtkAlgorithm* self, int mode, const char* file, vtkDataObject* landmarks,
+  std::vector<md::MotionDeformation::Muscle>& muscles, const std::vector<md::MotionDeformation::Bone>& bones)
+{
+  std::vector<std::string> muscleNames, boneNames;
+  std::vector<md::TriangleMesh> surfaces, boneSurfaces;
+  std::vector<std::vector<md::Points>> lines;
+  for (const md::MotionDeformation::Muscle& m : muscles)
+  {
+    muscleNames.push_back(m.name);
+    surfaces.push_back(m.rest);
+    lines.push_back(m.restLines);
+  }
+  for (const md::MotionDeformation::Bone& b : bones)
+  {
+    boneNames.push_back(b.name);
+    boneSurfaces.push_back(b.rest);
+  }
+  const std::vector<md::LandmarkSet> sets =
+    mode == mdvtk::ATTACHMENTS_OFF ? std::vector<md::LandmarkSet>{} : mdvtk::ReadLandmarks(landmarks, file ? file : "");
+  std::vector<std::vector<md::Attachment>> areas;
+  const std::string report = mdvtk::AttachAndReport(
+    self, "MotionMuscleDeformation", mode, sets, muscleNames, surfaces, lines, boneNames, boneSurfaces, areas);
+  for (size_t m = 0; m < muscles.size(); ++m)
+  {
+    muscles[m].attachments = areas[m];
+  }
+  return report;
+}
+}
+
+bool vtkMotionMuscleDeformation::Start(const Leaves& leaves, vtkDataObject* landmarks, int& result)
 {
   // The rest pose: muscles, their action lines, bones. One muscle's fault leaves it out.
   Internals& in = *this->In;
@@ -594,7 +650,11 @@ bool vtkMotionMuscleDeformation::Start(const Leaves& leaves, int& result)
   parameters.deformation.preserveVolume = this->PreserveVolume;
   if (!mdvtk::CallCore(
         this, "",
-        [&] { in.deformation = std::make_unique<md::MotionDeformation>(muscles, bones, parameters, &in.kept); },
+        [&] {
+          in.attachmentReport =
+            Attach(this, this->AttachmentAreas, this->AttachmentFileName, landmarks, muscles, bones);
+          in.deformation = std::make_unique<md::MotionDeformation>(muscles, bones, parameters, &in.kept);
+        },
         result))
   {
     return false;
@@ -809,6 +869,8 @@ void vtkMotionMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "DeformableShare: " << this->DeformableShare << "\n";
   os << indent << "PreserveVolume: " << this->PreserveVolume << "\n";
   os << indent << "CacheMemoryLimit: " << this->CacheMemoryLimit << "\n";
+  os << indent << "AttachmentAreas: " << this->AttachmentAreas << "\n";
+  os << indent << "AttachmentFileName: " << (this->AttachmentFileName ? this->AttachmentFileName : "") << "\n";
   os << indent << "FramesComputed: " << this->GetFramesComputed() << "\n";
   os << indent << "FramesKept: " << this->GetFramesKept() << "\n";
 }

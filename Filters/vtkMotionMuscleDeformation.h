@@ -7,7 +7,8 @@
  * 2 BonesMotion, the same bones over time (a time-varying source: OpenSimModelReader with
  * PlayMotion and MoveWithBodies, or any source with time steps); 3 ActionLinesRest, the raw
  * action lines in the rest pose, one block per muscle; 4 ActionLinesMotion, the same lines over
- * time. Blocks pair by name, else by order, as in InterpolatedMuscleDeformation. Each frame's
+ * time; 5 Attachments (optional), landmarks of the muscles' attachment areas (AttachmentAreas).
+ * Blocks pair by name, else by order, as in InterpolatedMuscleDeformation. Each frame's
  * action line is taken at the rest line's points (the point at each rest point's normalised arc
  * length), so a path that gains or loses a point keeps its points.
  *
@@ -56,6 +57,7 @@ public:
   void SetBonesMotionConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(2, output); }
   void SetActionLinesRestConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(3, output); }
   void SetActionLinesMotionConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(4, output); }
+  void SetAttachmentsConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(5, output); }
 
   enum InterpolationModes
   {
@@ -86,6 +88,19 @@ public:
   vtkSetClampMacro(CacheMemoryLimit, double, 1.0, VTK_DOUBLE_MAX);
   vtkGetMacro(CacheMemoryLimit, double);
 
+  /// Where the muscles are attached to the bones (docs/DESIGN.md, "Attachment areas"): 0 off
+  /// (they move with their action lines only), 1 (default) the areas the landmarks mark (the
+  /// Attachments input and AttachmentFileName), and for a muscle with none, the areas at its
+  /// action lines' ends near a bone. An area moves rigidly with its bone.
+  vtkSetClampMacro(AttachmentAreas, int, 0, 1);
+  vtkGetMacro(AttachmentAreas, int);
+  /// A landmark table (CSV with a header: muscle, bone, x, y, z, optionally area; the LHDL data
+  /// set's attachment_areas_rp_mm.csv reads as it is). Empty: none.
+  vtkSetStringMacro(AttachmentFileName);
+  vtkGetStringMacro(AttachmentFileName);
+  /// How the areas were found, as the output messages said it at the last start.
+  const char* GetAttachmentReport() const;
+
   /// Frames computed so far (a frame shown again from the cache does not count).
   int GetFramesComputed() const;
   /// Frames kept, and the megabytes they take.
@@ -111,6 +126,8 @@ protected:
   double DeformableShare;
   bool PreserveVolume;
   double CacheMemoryLimit = 2048.0;
+  int AttachmentAreas = 1;
+  char* AttachmentFileName = nullptr;
 
 private:
   vtkMotionMuscleDeformation(const vtkMotionMuscleDeformation&) = delete;
@@ -124,7 +141,7 @@ private:
   int Stop(vtkInformation* request, int result);
   int GoOn(vtkInformation* request);
   /// Reads the rest pose and makes the motion's deformation; false with RequestData's `result`.
-  bool Start(const Leaves& leaves, int& result);
+  bool Start(const Leaves& leaves, vtkDataObject* landmarks, int& result);
   /// Reads the pose of frame In->gather (`motionBones`, the lines of `leaves`).
   bool ReadPose(vtkDataObject* motionBones, const Leaves& leaves, md::MotionPose& pose, int& result);
   /// Deforms the muscles to frame In->gather and keeps it.

@@ -211,6 +211,33 @@ osim::MotionOptions OptionsOf(int angleUnit, bool ignoreUnknownColumns)
   return options;
 }
 
+/// The paths of `model` with a conditional point that comes or goes over `trajectory`, each with
+/// the first time it does ("psoas_r (at 0.26 s), ..."); empty when none does.
+std::string JumpingPaths(const osim::Model& model, const osim::CoordinateTrajectory& trajectory)
+{
+  std::ostringstream said;
+  for (const osim::Path& path : model.paths)
+  {
+    for (const osim::PathPoint& point : path.points)
+    {
+      if (point.kind != osim::PathPointKind::Conditional || trajectory.frames.empty())
+      {
+        continue;
+      }
+      const bool first = osim::BeyondRange(point, trajectory.frames.front()[point.coordinate]) > 0.0;
+      const auto change = std::find_if(trajectory.frames.begin(), trajectory.frames.end(),
+        [&](const std::vector<double>& q) { return (osim::BeyondRange(point, q[point.coordinate]) > 0.0) != first; });
+      if (change != trajectory.frames.end())
+      {
+        said << (said.tellp() > 0 ? ", " : "") << path.name << " (at "
+             << trajectory.times[static_cast<size_t>(change - trajectory.frames.begin())] << " s)";
+        break;
+      }
+    }
+  }
+  return said.str();
+}
+
 vtkSmartPointer<vtkStringArray> Strings(const char* name)
 {
   auto array = vtkSmartPointer<vtkStringArray>::New();
@@ -379,6 +406,12 @@ void vtkOpenSimModelReader::LoadMotion(std::vector<std::string>& warnings)
     in.trajectory = osim::MapMotion(
       in.model, osim::ReadMotion(this->MotionFileName), OptionsOf(this->AngleUnit, this->IgnoreUnknownColumns));
     warnings.insert(warnings.end(), in.trajectory.warnings.begin(), in.trajectory.warnings.end());
+    if (const std::string jumping = JumpingPaths(in.model, in.trajectory); !jumping.empty())
+    {
+      warnings.push_back("the motion makes these paths gain or lose a conditional path point, where they jump "
+                         "(and muscles deformed along them with them): " +
+        jumping + "; ConditionalPointFade (degrees) spreads each jump over that much of its coordinate");
+    }
   }
   in.motionKey = motionKey;
 }
@@ -575,7 +608,8 @@ void vtkOpenSimModelReader::WritePaths(const std::vector<double>& coordinates,
   const osim::Model& model = in.model;
   for (const osim::Path& path : model.paths)
   {
-    const osim::PathGeometry g = osim::PathAt(model, path, coordinates, poses);
+    const osim::PathGeometry g =
+      osim::PathAt(model, path, coordinates, poses, this->ConditionalPointFade * M_PI / 180.0);
     md::Points points = g.points;
     for (Eigen::Index i = 0; i < points.rows(); ++i)
     {
@@ -722,4 +756,5 @@ void vtkOpenSimModelReader::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "AngleUnit: " << this->AngleUnit << "\n";
   os << indent << "IgnoreUnknownColumns: " << this->IgnoreUnknownColumns << "\n";
   os << indent << "LoadGeometry: " << this->LoadGeometry << "\n";
+  os << indent << "ConditionalPointFade: " << this->ConditionalPointFade << "\n";
 }

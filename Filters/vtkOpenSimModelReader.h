@@ -117,6 +117,14 @@ public:
   vtkGetMacro(PlayMotion, bool);
   vtkBooleanMacro(PlayMotion, bool);
 
+  /// Spreads the jump of a path where a conditional path point comes or goes (a via point
+  /// active over part of its coordinate's range) over this many degrees of the coordinate beyond
+  /// the point's range: the point fades onto the straight segment between its neighbours, so the
+  /// paths, and muscles deformed along them, move continuously. Paths are OpenSim's wherever
+  /// their points are active. Default 0: OpenSim's paths, which jump (a warning names them when
+  /// the motion makes them jump). The MomentArms table is always OpenSim's.
+  vtkSetClampMacro(ConditionalPointFade, double, 0.0, 180.0);
+  vtkGetMacro(ConditionalPointFade, double);
   /// Read the bodies' mesh files. Default on.
   vtkSetMacro(LoadGeometry, bool);
   vtkGetMacro(LoadGeometry, bool);
@@ -149,6 +157,7 @@ protected:
   int AngleUnit = ANGLES_AS_FILE_SAYS;
   bool IgnoreUnknownColumns = true;
   bool LoadGeometry = true;
+  double ConditionalPointFade = 0.0;
   int ModelReadCount = 0;
 
 private:

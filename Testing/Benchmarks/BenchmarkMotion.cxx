@@ -9,9 +9,14 @@
 // Prints figures; asserts nothing (see the tests). Last, a checksum of every frame's points and
 // measures: a change meant to leave the answer alone (a speed-up, a restructuring) must leave it
 // the same on the same machine and build. With a seed (LHDL), the same motion on the exact input
-// too, and the largest distance between the two runs' surfaces at any frame.
+// too, and the largest distance between the two runs' surfaces at any frame. The LHDL muscles'
+// slip at the data set's attachment landmarks and their largest step between frames against its
+// median (AnatomyMeasures.h), with the muscles attached as `attachments` says: by the data set's
+// landmarks, by their action lines' ends, or not at all.
 //
 //   BenchmarkMotion [data folder] [hip_flexion|hip_adduction|phantom] [seed: -1 none, 0 float, s > 0 noise]
+//                   [attachments: landmarks (default) | lines | none]
+#include "AnatomyMeasures.h"
 #include "Common/Fnv1a.h"
 #include "MotionFrames.h"
 #include "StepChecksum.h"
@@ -31,6 +36,51 @@ double LargestDistance(const md::Points& a, const md::Points& b)
 {
   return a.rows() == b.rows() && a.rows() > 0 ? (a - b).rowwise().norm().maxCoeff() : -1.0;
 }
+
+/// Attaches the muscles of `frames` as `mode` says: by `landmarks`, by their action lines' ends
+/// ("lines"), or not at all ("none"); prints how when `say`.
+void AttachMuscles(
+  MotionFrames& frames, const std::string& mode, const std::vector<md::LandmarkSet>& landmarks, bool say)
+{
+  if (mode == "none")
+  {
+    return;
+  }
+  std::vector<std::string> muscleNames, boneNames;
+  std::vector<md::TriangleMesh> muscles, bones;
+  std::vector<std::vector<md::Points>> lines;
+  for (const md::MotionDeformation::Muscle& m : frames.muscles)
+  {
+    muscleNames.push_back(m.name);
+    muscles.push_back(m.rest);
+    lines.push_back(m.restLines);
+  }
+  for (const md::MotionDeformation::Bone& b : frames.bones)
+  {
+    boneNames.push_back(b.name);
+    bones.push_back(b.rest);
+  }
+  const md::FoundAttachments found = md::FindAttachments(muscleNames, muscles, lines, boneNames, bones,
+    mode == "landmarks" ? landmarks : std::vector<md::LandmarkSet>{}, true);
+  for (size_t m = 0; m < frames.muscles.size(); ++m)
+  {
+    frames.muscles[m].attachments = found.areas[m];
+  }
+  for (const std::string& message : found.messages)
+  {
+    if (say)
+    {
+      std::printf("attachments: %s\n", message.c_str());
+    }
+  }
+  for (const std::string& warning : found.warnings)
+  {
+    if (say)
+    {
+      std::printf("attachments, warning: %s\n", warning.c_str());
+    }
+  }
+}
 }
 
 int main(int argc, char** argv)
@@ -38,6 +88,7 @@ int main(int argc, char** argv)
   const std::string folder = argc > 1 ? argv[1] : "";
   const std::string motion = argc > 2 ? argv[2] : "hip_flexion";
   const int seed = argc > 3 ? std::atoi(argv[3]) : -1;
+  const std::string attachments = argc > 4 ? argv[4] : "landmarks";
   MotionFrames frames;
   if (motion == "phantom")
   {
@@ -50,6 +101,24 @@ int main(int argc, char** argv)
   }
   std::printf("%s: %zu frames, %zu muscles, %zu bones, seed %d\n", frames.name.c_str(), frames.poses.size(),
     frames.muscles.size(), frames.bones.size(), seed);
+  const std::vector<md::LandmarkSet> landmarks =
+    motion == "phantom" ? std::vector<md::LandmarkSet>{} : LhdlLandmarks(folder);
+  AttachMuscles(frames, attachments, landmarks, true);
+  std::vector<std::string> muscleNames, boneNames;
+  std::vector<md::TriangleMesh> restMuscles;
+  std::vector<md::Points> boneRest;
+  for (const md::MotionDeformation::Muscle& m : frames.muscles)
+  {
+    muscleNames.push_back(m.name);
+    restMuscles.push_back(m.rest);
+  }
+  for (const md::MotionDeformation::Bone& b : frames.bones)
+  {
+    boneNames.push_back(b.name);
+    boneRest.push_back(b.rest.points);
+  }
+  const std::vector<SlipProbe> probes = LhdlSlipProbes(landmarks, muscleNames, restMuscles, boneNames);
+  std::vector<double> worstSlip(frames.muscles.size(), 0.0);
   md::InterpolationParameters parameters;
   parameters.numberOfSteps = 0; // the first frame from the rest pose: automatic
   const auto start = std::chrono::steady_clock::now();
@@ -71,6 +140,11 @@ int main(int argc, char** argv)
     }
     points.push_back(r.points);
     AddStepToChecksum(checksum, r.points, r.measures);
+    const std::vector<double> slips = Slips(probes, restMuscles, r.points, boneRest, frames.poses[k].bones);
+    for (size_t p = 0; p < probes.size(); ++p)
+    {
+      worstSlip[probes[p].muscleIndex] = std::max(worstSlip[probes[p].muscleIndex], slips[p]);
+    }
     int iterations = 0;
     double volume = 0, depth = 0;
     std::int64_t flips = 0, sharp = 0;
@@ -119,6 +193,15 @@ int main(int argc, char** argv)
               "penetration %.3f, smoothness ratio %.2f\n",
     total, frames.poses.size() > 1 ? 1000 * framesSeconds / (frames.poses.size() - 1) : 0.0, 1000 * median, worstVolume,
     worstDepth, worstRatio);
+  const std::vector<double> stepRatios = StepRatios(points);
+  std::printf("attachments '%s': %zu landmark probes; per muscle, the largest slip (mm) and the largest step between "
+              "frames against its median:",
+    attachments.c_str(), probes.size());
+  for (size_t m = 0; m < frames.muscles.size(); ++m)
+  {
+    std::printf(" %s %.2f / %.2fx;", frames.muscles[m].name.c_str(), worstSlip[m], stepRatios[m]);
+  }
+  std::printf("\n");
 
   // Perturbed input against the exact input: how far every frame's surfaces moved (issue 13's
   // measure, through the whole motion).
@@ -126,6 +209,7 @@ int main(int argc, char** argv)
   if (seed >= 0 && motion != "phantom" && LhdlFrames(folder, motion, -1, exactFrames) &&
     exactFrames.poses.size() == frames.poses.size())
   {
+    AttachMuscles(exactFrames, attachments, landmarks, false);
     md::MotionDeformation exact(exactFrames.muscles, exactFrames.bones, parameters);
     double largest = 0, worstRms = 0;
     size_t largestFrame = 0;

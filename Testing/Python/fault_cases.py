@@ -448,6 +448,60 @@ def case_muscle_given_as_its_own_bone():
     return "" if moved < 1e-6 else "the other muscles moved %g apart under translation" % moved
 
 
+# --- Attachment landmarks ------------------------------------------------------------------
+
+def landmarks(coordinates, arrays):
+    data = vtkPolyData()
+    points = vtkPoints()
+    for p in coordinates:
+        points.InsertNextPoint(*p)
+    data.SetPoints(points)
+    for name, value in arrays.items():
+        array = vtkStringArray()
+        array.SetName(name)
+        for _ in coordinates:
+            array.InsertNextValue(value)
+        data.GetPointData().AddArray(array)
+    return data
+
+
+def attached_method(**properties):
+    muscles, bones_rest, bones, lines_rest, lines = phantom_outputs()
+    return simple.InterpolatedMuscleDeformation(
+        Input=producer(muscles), BonesRest=producer(bones_rest), BonesCurrent=producer(bones),
+        ActionLinesRest=producer(lines_rest), ActionLinesCurrent=producer(lines), **properties)
+
+
+def case_landmarks_with_nan():
+    """A landmark at NaN: an error naming the Attachments input, no crash."""
+    marks = landmarks([(0, 0, 0), (float("nan"), 0, 0)], {"Muscle": "Iliopsoas", "Bone": "Femur"})
+    with mdtesting.CapturedMessages() as messages:
+        method = attached_method(Attachments=producer(marks))
+        method.UpdatePipeline()
+    return refused(messages.text, "Attachments has NaN or infinite coordinates")
+
+
+def case_landmark_table_without_its_columns():
+    """A CSV of another kind in AttachmentFileName: refused, naming the file and the columns."""
+    table = write("landmarks_other.csv", "name,value\nIliopsoas,3\n")
+    with mdtesting.CapturedMessages() as messages:
+        method = attached_method(AttachmentFileName=table)
+        method.UpdatePipeline()
+    return refused(messages.text, table, "must name the columns muscle")
+
+
+def case_landmarks_far_from_every_muscle():
+    """Landmarks a metre away: a warning that they mark nothing, and the muscles deformed."""
+    marks = landmarks([(1000, 1000, 1000), (1001, 1000, 1000)], {"Muscle": "Iliopsoas", "Bone": "Femur"})
+    with mdtesting.CapturedMessages() as messages:
+        method = attached_method(Attachments=producer(marks))
+        method.UpdatePipeline()
+    out = servermanager.Fetch(method)
+    if out.GetNumberOfBlocks() != 3 or not all(finite(out.GetBlock(b)) for b in range(3)):
+        return "the muscles were not all deformed"
+    return warned(messages.text, "mark no part of its surface and are not used")
+
+
 CASES = {name[len("case_"):]: function for name, function in sorted(globals().items()) if name.startswith("case_")}
 
 

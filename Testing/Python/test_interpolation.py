@@ -63,6 +63,13 @@ class Interpolation(unittest.TestCase):
         # The phantom's rectus femoris runs from a point fixed below the hip to the knee, so its
         # action line passes through the femur as the hip flexes: the one thing said, by name.
         said = [line for line in messages.text.splitlines() if line.strip() and not line.startswith("Warning: In ")]
+        # First, how the muscles are attached: the phantom gives no landmarks, and its muscles'
+        # ends lie clear of the bones, so none is attached (each said by name).
+        report = [line for line in said if "attachment area" in line]
+        self.assertEqual(report[0], "InterpolatedMuscleDeformation, attachment areas:")
+        for name in MUSCLES:
+            self.assertIn("  muscle '%s': no attachment area (it moves with its action lines only)" % name, report)
+        said = [line for line in said if line not in report]
         self.assertEqual(len(said), 1, messages.text)
         self.assertIn("muscle 'RectusFemoris' crosses bone 'Femur'", said[0])
         rest = servermanager.Fetch(simple.OutputPort(self.phantom, 0))

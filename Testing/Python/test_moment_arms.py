@@ -94,6 +94,48 @@ class StraightPathsAgainstOpenSim(unittest.TestCase):
             self.assertGreater(compared, 8 * (len(angles) - 4))
 
 
+@unittest.skipIf(DATA is None, "real data not found: set MUSCLEDEFORMATION_DATA_DIR to the folder holding lhdl_hip_r")
+class ConditionalPointFade(unittest.TestCase):
+    def test_the_psoas_path_jumps_by_default_and_fades_when_asked(self):
+        """OpenSim's psoas path jumps at 40 degrees of flexion, where its via point goes (and the
+        reader says so); with ConditionalPointFade 10 it moves continuously and is OpenSim's
+        wherever the point is active."""
+        output = mdtesting.output_dir("test_moment_arms")
+        angles = [30 + 0.5 * k for k in range(61)]  # 30 to 60 degrees
+        path = os.path.join(output, "flexion_30_60.mot")
+        write_motion(path, "hip_flexion_r", angles)
+        model = os.path.join(DATA, "lhdl_hip_r", "LHDL_hip_r.osim")
+        lengths = {}
+        for fade in (0.0, 10.0):
+            with mdtesting.CapturedMessages() as messages:
+                reader = simple.OpenSimModelReader(FileName=model, MotionFileName=path, LoadGeometry=0, Scale=1000,
+                                                   ConditionalPointFade=fade)
+                reader.UpdatePipelineInformation()
+                lengths[fade] = []
+                for t in reader.TimestepValues:
+                    reader.UpdatePipeline(t)
+                    paths = servermanager.Fetch(reader, idx=1)
+                    lengths[fade].append(mdtesting.block(paths, "psoas_r").GetFieldData().GetArray(
+                        "PathLength").GetValue(0))
+            self.assertIn("the motion makes these paths gain or lose a conditional path point", messages.text)
+            self.assertIn("psoas_r (at ", messages.text)
+            simple.Delete(reader)
+        # The largest change of length between two poses 0.5 degrees apart against the median change.
+        ratio = {}
+        for fade, values in lengths.items():
+            steps = sorted(abs(b - a) for a, b in zip(values, values[1:]))
+            ratio[fade] = steps[-1] / steps[len(steps) // 2]
+        print("[ measured ] the psoas path's largest change between poses 0.5 degrees apart against the median: "
+              "%.1f as OpenSim has it, %.1f faded over 10 degrees" % (ratio[0.0], ratio[10.0]))
+        self.assertGreater(ratio[0.0], 4.0)
+        self.assertLess(ratio[10.0], 2.0)
+        for angle, exact, faded in zip(angles, lengths[0.0], lengths[10.0]):
+            if angle <= 40.0:
+                self.assertAlmostEqual(exact, faded, places=9)
+            if angle >= 50.5:
+                self.assertAlmostEqual(exact, faded, places=6)
+
+
 class SmallModel(unittest.TestCase):
     """A pin joint about z through (0, 1, 0); the path from (0, 1.5, 0) on ground to (0, -0.5, 0)
     on the arm: 0.5 from the axis at each end."""

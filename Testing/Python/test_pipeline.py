@@ -52,7 +52,9 @@ class ServerManagerXML(unittest.TestCase):
                         optional.add("%s.%s" % (proxy.get("name"), prop.get("name")))
         self.assertEqual(optional, {"ActionLineGrouping.PathsCurrent",
                                     "MuscleDeformation.Obstacles", "MuscleDeformation.Hull",
-                                    "IntersectionResolve.InputRest", "IntersectionResolve.ObstaclesRest"})
+                                    "IntersectionResolve.InputRest", "IntersectionResolve.ObstaclesRest",
+                                    "InterpolatedMuscleDeformation.Attachments",
+                                    "MotionMuscleDeformation.Attachments"})
 
     def test_the_plugin_folder_offers_the_plugin_alone(self):
         # Tools > Manage Plugins > Load New... lists the shared libraries of the folder: a second

@@ -45,6 +45,23 @@ Eigen::Vector3d Barycentric(const TriangleMesh& mesh, Eigen::Index t, const Eige
 
 using RowEntries = SurfaceEnergy::Row;
 
+/// The rigid motion of `area`'s bone near the area from the rest pose to the pose `bones` are
+/// in (fitted at its anchors); none where the bone is not among them (a pose without bones).
+RigidTransform AttachmentMotion(const Attachment& area, const std::vector<FixedObstacle>& bones)
+{
+  if (area.boneIndex < 0 || area.boneIndex >= static_cast<Eigen::Index>(bones.size()) || area.anchors.empty())
+  {
+    return RigidTransform();
+  }
+  const Points& now = bones[static_cast<size_t>(area.boneIndex)].tree->Mesh().points;
+  Points anchors(static_cast<Eigen::Index>(area.anchors.size()), 3);
+  for (size_t k = 0; k < area.anchors.size(); ++k)
+  {
+    anchors.row(static_cast<Eigen::Index>(k)) = now.row(area.anchors[k]);
+  }
+  return FitRigidTransform(area.anchorsRest, anchors).transform;
+}
+
 /// The sample p (inside the surface) as a combination of surface points: along
 /// each axis the chord through p meets the surface at h+ (distance d+) and h-
 /// (d-), and p = (d- h+ + d+ h-) / (d+ + d-), each hit a combination of its
@@ -82,9 +99,10 @@ RowEntries ChordRow(const TriangleTree& tree, const Eigen::Vector3d& p, double r
 }
 }
 
-SurfaceEnergy::SurfaceEnergy(
-  const TriangleMesh& rest, const std::vector<Points>& restLines, const SettleParameters& parameters)
+SurfaceEnergy::SurfaceEnergy(const TriangleMesh& rest, const std::vector<Points>& restLines,
+  const SettleParameters& parameters, const std::vector<Attachment>& attachments)
   : RestPoints(rest.points)
+  , Attachments(attachments)
   , SamplesPerSegment(std::max(1, parameters.samplesPerSegment))
 {
   const Eigen::Index n = rest.points.rows();
@@ -98,6 +116,14 @@ SurfaceEnergy::SurfaceEnergy(
   if (used == 0)
   {
     throw InputError("the surface has no triangles");
+  }
+  for (const Attachment& area : attachments)
+  {
+    if (std::any_of(area.points.begin(), area.points.end(), [n](Eigen::Index i) { return i < 0 || i >= n; }) ||
+      static_cast<Eigen::Index>(area.anchors.size()) != area.anchorsRest.rows())
+    {
+      throw InputError("its attachment area on '" + area.bone + "' names points it does not have");
+    }
   }
   // The volume and the inside of the muscle need a closed surface (the hull-based pass needs
   // one too: its hull cannot enclose an open one). Scans' few edges shared by four triangles
@@ -140,6 +166,7 @@ SurfaceEnergy::SurfaceEnergy(
   this->ShapeWeight = std::sqrt(static_cast<double>(used) / balance);
   this->FollowWeight = std::max(0.0, parameters.followWeight) * std::sqrt(balance / static_cast<double>(used));
   this->BlendWidth = std::max(0.0, parameters.blendWidth);
+  this->AttachmentWeight = std::max(0.0, parameters.attachmentWeight) * this->ShapeWeight;
 
   std::vector<Eigen::Triplet<double>> entries;
   for (Eigen::Index i = 0; i < n; ++i)
@@ -180,10 +207,10 @@ SurfaceEnergy::SurfaceEnergy(
       this->Undriven += piece[i] >= 0 && !driven[static_cast<size_t>(piece[i])] ? 1 : 0;
     }
   }
+  const std::vector<double> followWeights = this->FollowWeights();
   for (Eigen::Index i = 0; i < n; ++i)
   {
-    // A point no triangle uses has nothing else to place it.
-    entries.emplace_back(followStart + i, i, this->PointUsed[i] ? this->FollowWeight : 1.0);
+    entries.emplace_back(followStart + i, i, followWeights[static_cast<size_t>(i)]);
   }
   this->Rows.resize(followStart + n, n);
   this->Rows.setFromTriplets(entries.begin(), entries.end());
@@ -570,18 +597,51 @@ std::vector<MatchedLine> StillLines(const std::vector<Points>& restLines)
   return still;
 }
 
+std::vector<double> SurfaceEnergy::FollowWeights() const
+{
+  std::vector<double> weights(this->PointUsed.size());
+  for (size_t i = 0; i < weights.size(); ++i)
+  {
+    weights[i] = this->PointUsed[i] ? this->FollowWeight : 1.0; // nothing else places an unused point
+  }
+  for (const Attachment& area : this->Attachments)
+  {
+    for (Eigen::Index i : area.points)
+    {
+      if (this->PointUsed[static_cast<size_t>(i)])
+      {
+        weights[static_cast<size_t>(i)] = this->AttachmentWeight;
+      }
+    }
+  }
+  return weights;
+}
+
 Points SurfaceEnergy::RightHandSide(
   const std::vector<MatchedLine>& lines, const std::vector<FixedObstacle>& bones) const
 {
   const Eigen::Index n = this->RestPoints.rows();
   Points targets(this->Rows.rows(), 3);
+  const std::vector<double> followWeights = this->FollowWeights();
   for (Eigen::Index i = 0; i < n; ++i)
   {
     const Eigen::Vector3d p = this->RestPoints.row(i).transpose();
     const BlendedSegments near(p, lines, this->BlendWidth * this->Span);
     targets.row(i) = this->ShapeWeight * (near.rotation * this->Delta.row(i).transpose()).transpose();
-    targets.row(n + this->SampleCount() + i) =
-      (this->PointUsed[i] ? this->FollowWeight : 1.0) * near.follow.transpose();
+    targets.row(n + this->SampleCount() + i) = followWeights[static_cast<size_t>(i)] * near.follow.transpose();
+  }
+  for (const Attachment& area : this->Attachments)
+  {
+    // The bone's rigid motion near the area, from its rest pose to this one.
+    const RigidTransform carried = AttachmentMotion(area, bones);
+    for (Eigen::Index i : area.points)
+    {
+      if (this->PointUsed[static_cast<size_t>(i)])
+      {
+        targets.row(n + this->SampleCount() + i) =
+          this->AttachmentWeight * carried.Apply(Eigen::Vector3d(this->RestPoints.row(i).transpose())).transpose();
+      }
+    }
   }
   Points restSamples, currentSamples;
   SampleMatchedLines(lines, this->SamplesPerSegment, restSamples, currentSamples);
@@ -1170,17 +1230,19 @@ std::vector<std::vector<double>> BoneClearancesAtEnd(const std::vector<TriangleM
 }
 }
 
-bool KeptSurfaceEnergy::Holds(
-  const TriangleMesh& muscle, const std::vector<Points>& lines, const SettleParameters& parameters) const
+bool KeptSurfaceEnergy::Holds(const TriangleMesh& muscle, const std::vector<Points>& lines,
+  const SettleParameters& parameters, const std::vector<Attachment>& areas) const
 {
   return this->energy && SameMesh(this->surface, muscle) && this->settle.SameEnergyAs(parameters) &&
+    this->attachments == areas &&
     std::equal(this->restLines.begin(), this->restLines.end(), lines.begin(), lines.end(),
       [](const Points& a, const Points& b) { return a.rows() == b.rows() && a == b; });
 }
 
 void KeptSurfaceEnergy::Keep(std::shared_ptr<const SurfaceEnergy> built, const TriangleMesh& muscle,
-  const std::vector<Points>& lines, const SettleParameters& parameters)
+  const std::vector<Points>& lines, const SettleParameters& parameters, const std::vector<Attachment>& areas)
 {
+  this->attachments = areas;
   this->energy = std::move(built);
   this->surface = muscle;
   this->restLines = lines;

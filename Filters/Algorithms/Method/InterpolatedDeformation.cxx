@@ -680,7 +680,7 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
   {
     current[m] = muscles[m].muscle;
   }
-  const OverlapMasks restOverlap = FindOverlaps(current, fixed);
+  OverlapMasks restOverlap = FindOverlaps(current, fixed);
   for (size_t m = 0; m < count; ++m)
   {
     if (const std::string problem = MostlyInAnObstacle(current[m], muscles[m].name, m, fixed, restOverlap);
@@ -689,6 +689,7 @@ InterpolationResult DeformInLocalFrame(const std::vector<MuscleMotion>& muscles,
       throw OfMuscle(InputError(problem), m);
     }
   }
+  FuseAttachments(restOverlap, muscles);
   const std::vector<NewSharpEdges> sharpEdges = MuscleSharpEdges(muscles);
   std::vector<std::string> names;
   for (const MuscleMotion& m : muscles)
@@ -780,6 +781,10 @@ InterpolationResult DeformEveryMuscle(const std::vector<MuscleMotion>& muscles, 
     {
       frame.ToLocal(line.rest);
       frame.ToLocal(line.current);
+    }
+    for (Attachment& area : m.attachments)
+    {
+      frame.ToLocal(area.anchorsRest);
     }
   }
   std::vector<BoneMotion> localBones = bones;

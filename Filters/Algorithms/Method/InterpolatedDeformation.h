@@ -16,6 +16,7 @@
 // (HullMode::Rebuild, kept for comparison).
 #pragma once
 
+#include "Common/Attachment.h"
 #include "Deformation/MuscleDeformer.h"
 #include "Geometry/LocalFrame.h"
 #include "Geometry/MeanValueCoordinates.h"
@@ -64,6 +65,9 @@ struct MuscleMotion
   std::string name;
   TriangleMesh muscle;
   std::vector<MatchedLine> lines;
+  /// Where it is attached to the bones (their boneIndex: the bones' order); honoured on the
+  /// surface (settleOnSurface), not by the hull-based pass.
+  std::vector<Attachment> attachments;
 };
 
 /// One bone: the same points in the rest pose and the current pose.

@@ -199,6 +199,11 @@ MotionDeformation::MotionDeformation(const std::vector<Muscle>& muscles, const s
     local[m].name = muscles[m].name;
     local[m].muscle = muscles[m].rest;
     in.frame.ToLocal(local[m].muscle.points);
+    local[m].attachments = muscles[m].attachments;
+    for (Attachment& area : local[m].attachments)
+    {
+      in.frame.ToLocal(area.anchorsRest);
+    }
     localLines[m] = muscles[m].restLines;
     for (Points& line : localLines[m])
     {
@@ -245,6 +250,7 @@ MotionDeformation::MotionDeformation(const std::vector<Muscle>& muscles, const s
     state->current.push_back(m.muscle);
   }
   in.restOverlap = FindOverlaps(state->current, in.fixed);
+  FuseAttachments(in.restOverlap, in.muscles);
   in.sharpEdges = MuscleSharpEdges(in.muscles);
   state->settle = StartMotion(state->current, in.energyPointers, in.restLines, in.fixed);
   state->settle.carryContacts = true; // a frame's contacts are the last frame's, moved on

@@ -63,8 +63,9 @@ public:
   struct Muscle
   {
     std::string name;
-    TriangleMesh rest;             ///< its surface in the rest pose
-    std::vector<Points> restLines; ///< its action lines in the rest pose
+    TriangleMesh rest;                   ///< its surface in the rest pose
+    std::vector<Points> restLines;       ///< its action lines in the rest pose
+    std::vector<Attachment> attachments; ///< where it is attached (boneIndex: the bones' order)
   };
   struct Bone
   {

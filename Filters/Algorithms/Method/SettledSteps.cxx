@@ -270,6 +270,25 @@ std::vector<NewSharpEdges> MuscleSharpEdges(const std::vector<MuscleMotion>& mus
   return edges;
 }
 
+void FuseAttachments(OverlapMasks& masks, const std::vector<MuscleMotion>& muscles)
+{
+  for (size_t m = 0; m < muscles.size() && m < masks.size(); ++m)
+  {
+    for (const Attachment& area : muscles[m].attachments)
+    {
+      const auto bone = static_cast<size_t>(area.boneIndex);
+      if (area.boneIndex < 0 || bone >= masks[m].size() || masks[m][bone].empty())
+      {
+        continue;
+      }
+      for (Eigen::Index i : area.points)
+      {
+        masks[m][bone][static_cast<size_t>(i)] = 1;
+      }
+    }
+  }
+}
+
 std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vector<MuscleMotion>& muscles,
   const std::vector<std::vector<Points>>& restLines, const SettleParameters& parameters, RestMappingCache* kept,
   std::vector<double>& seconds)
@@ -283,7 +302,7 @@ std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vecto
   for (size_t m = 0; m < count; ++m)
   {
     const KeptSurfaceEnergy& entry = rest.muscles[m].surfaceEnergy;
-    if (entry.Holds(muscles[m].muscle, restLines[m], parameters))
+    if (entry.Holds(muscles[m].muscle, restLines[m], parameters, muscles[m].attachments))
     {
       energies[m] = entry.energy;
     }
@@ -299,7 +318,8 @@ std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vecto
     const auto energyStart = std::chrono::steady_clock::now();
     try
     {
-      energies[m] = std::make_shared<const SurfaceEnergy>(muscles[m].muscle, restLines[m], parameters);
+      energies[m] =
+        std::make_shared<const SurfaceEnergy>(muscles[m].muscle, restLines[m], parameters, muscles[m].attachments);
     }
     catch (const InputError& e)
     {
@@ -321,7 +341,7 @@ std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vecto
     KeptSurfaceEnergy& entry = rest.muscles[m].surfaceEnergy;
     if (energies[m] && energies[m] != entry.energy)
     {
-      entry.Keep(energies[m], muscles[m].muscle, restLines[m], parameters);
+      entry.Keep(energies[m], muscles[m].muscle, restLines[m], parameters, muscles[m].attachments);
       ++rest.energyBuildCount;
     }
   }

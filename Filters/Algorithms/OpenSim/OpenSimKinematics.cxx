@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace md::osim
 {
@@ -49,20 +50,54 @@ std::vector<RigidTransform> BodyPoses(const Model& model, const std::vector<doub
   return poses;
 }
 
+double BeyondRange(const PathPoint& point, double value)
+{
+  constexpr double kSlack = 1e-5; // OpenSim's
+  if (!std::isfinite(value))
+  {
+    return std::numeric_limits<double>::infinity();
+  }
+  return std::max({ 0.0, point.rangeMin - kSlack - value, value - point.rangeMax - kSlack });
+}
+
+namespace
+{
+/// A conditional point's weight at `value`: 1 within its range, falling smoothly (C1) to 0 over
+/// `fade` beyond it.
+double FadeWeight(const PathPoint& point, double value, double fade)
+{
+  const double beyond = BeyondRange(point, value);
+  if (beyond <= 0.0)
+  {
+    return 1.0;
+  }
+  if (beyond >= fade)
+  {
+    return 0.0;
+  }
+  const double t = beyond / fade;
+  return 1.0 - t * t * (3.0 - 2.0 * t);
+}
+}
+
 PathGeometry PathAt(const Model& model, const Path& path, const std::vector<double>& coordinates,
-  const std::vector<RigidTransform>& bodyPoses)
+  const std::vector<RigidTransform>& bodyPoses, double conditionalFade)
 {
   PathGeometry geometry;
   std::vector<Eigen::Vector3d> points;
+  std::vector<double> weight; // per point kept: 1, or a fading conditional point's weight
   points.reserve(path.points.size());
   for (size_t k = 0; k < path.points.size(); ++k)
   {
     const PathPoint& p = path.points[k];
     Eigen::Vector3d local = p.location;
+    double w = 1.0;
     if (p.kind == PathPointKind::Conditional)
     {
       const double value = coordinates[p.coordinate];
-      if (!(value >= p.rangeMin - 1e-5 && value <= p.rangeMax + 1e-5))
+      const bool fades = conditionalFade > 0.0 && model.coordinates[p.coordinate].motionType == MotionType::Rotational;
+      w = fades ? FadeWeight(p, value, conditionalFade) : (BeyondRange(p, value) > 0.0 ? 0.0 : 1.0);
+      if (w == 0.0 && !fades)
       {
         continue;
       }
@@ -82,7 +117,34 @@ PathGeometry PathAt(const Model& model, const Path& path, const std::vector<doub
     }
     const RigidTransform& body = bodyPoses[p.body];
     points.push_back(body.Apply(p.frame.Apply(local)));
+    weight.push_back(w);
     geometry.pointIndex.push_back(static_cast<int>(k));
+  }
+  // Fading points move onto the segment between their nearest steady neighbours.
+  for (size_t i = 0; i < points.size(); ++i)
+  {
+    if (weight[i] >= 1.0)
+    {
+      continue;
+    }
+    size_t before = i, after = i;
+    while (before > 0 && path.points[geometry.pointIndex[before]].kind == PathPointKind::Conditional)
+    {
+      --before;
+    }
+    while (after + 1 < points.size() && path.points[geometry.pointIndex[after]].kind == PathPointKind::Conditional)
+    {
+      ++after;
+    }
+    if (before == i || after == i)
+    {
+      continue; // an end of the path stays where it is
+    }
+    const Eigen::Vector3d a = points[before], b = points[after];
+    const double span = (b - a).squaredNorm();
+    const double t = span > 0.0 ? std::clamp((points[i] - a).dot(b - a) / span, 0.0, 1.0) : 0.0;
+    const Eigen::Vector3d onSegment = a + t * (b - a);
+    points[i] = onSegment + weight[i] * (points[i] - onSegment);
   }
   geometry.points.resize(static_cast<Eigen::Index>(points.size()), 3);
   for (size_t i = 0; i < points.size(); ++i)

@@ -28,8 +28,18 @@ struct PathGeometry
 /// The active points of `path` in ground. Conditional points are active while their coordinate
 /// is within their range (+-1e-5, as OpenSim); moving points evaluate their functions at their
 /// coordinates clamped to the coordinates' ranges (as OpenSim).
+///
+/// With `conditionalFade` > 0 (radians), a conditional point of a rotational coordinate is never
+/// dropped: beyond its range it fades, over that much of its coordinate, onto the straight segment
+/// between the nearest points on either side that are not conditional (to where its own position
+/// projects on it), and it lies there farther out. The path is then a continuous function of the
+/// coordinates, where OpenSim's jumps as the point goes, and it is OpenSim's wherever the point
+/// is active (docs/DESIGN.md, "Conditional path points"). Translational coordinates keep the jump.
 PathGeometry PathAt(const Model& model, const Path& path, const std::vector<double>& coordinates,
-  const std::vector<RigidTransform>& bodyPoses);
+  const std::vector<RigidTransform>& bodyPoses, double conditionalFade = 0.0);
+
+/// How far out of its range a conditional point is, along its coordinate (0 within it).
+double BeyondRange(const PathPoint& point, double value);
 
 /// Length of a polyline (sum of its segments).
 double PolylineLength(const Points& points);

@@ -100,3 +100,31 @@ TEST(MomentArms, OnlyTheCoordinatesThatMoveAreMoving)
   EXPECT_EQ(MovingCoordinates(trajectory), (std::vector<int>{ 1, 2 }));
   EXPECT_TRUE(MovingCoordinates(CoordinateTrajectory{}).empty());
 }
+
+TEST(MomentArms, AFadingConditionalPointMakesThePathContinuous)
+{
+  // The via point is active for q in [0, 1]. Faded over 0.2 rad, the path is OpenSim's wherever
+  // the point is active, the straight path 0.2 beyond its range, and continuous in between.
+  const Model model = ParseModel(PinModel("0.1 -0.15 0"), "pin.osim");
+  const int flex = model.FindCoordinate("flex");
+  auto length = [&](double q, double fade) {
+    std::vector<double> pose = DefaultCoordinates(model);
+    pose[flex] = q;
+    const PathGeometry g = PathAt(model, model.paths[0], pose, BodyPoses(model, pose), fade);
+    return std::make_pair(PolylineLength(g.points), g.points.rows());
+  };
+  EXPECT_EQ(length(0.5, 0.2), length(0.5, 0.0));
+  EXPECT_EQ(length(0.5, 0.2).second, 3);
+  EXPECT_EQ(length(-0.5, 0.0).second, 2);
+  EXPECT_EQ(length(-0.5, 0.2).second, 3); // the point kept, on the straight segment
+  EXPECT_NEAR(length(-0.5, 0.2).first, length(-0.5, 0.0).first, 1e-12);
+  EXPECT_NEAR(length(-0.21, 0.2).first, length(-0.21, 0.0).first, 1e-12);
+  // OpenSim's length jumps at the range's end; the faded one moves by no more than its slope says.
+  EXPECT_GT(std::abs(length(-0.011, 0.0).first - length(0.0, 0.0).first), 0.01);
+  double largestStep = 0;
+  for (double q = -0.3; q < 0.1; q += 0.001)
+  {
+    largestStep = std::max(largestStep, std::abs(length(q + 0.001, 0.2).first - length(q, 0.2).first));
+  }
+  EXPECT_LT(largestStep, 0.001);
+}

@@ -1,0 +1,418 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "Anatomy/AttachmentAreas.h"
+
+#include "Geometry/TriangleTree.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace md
+{
+namespace
+{
+std::string Lower(std::string text)
+{
+  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
+  return text;
+}
+
+std::string Trimmed(const std::string& text)
+{
+  const size_t first = text.find_first_not_of(" \t\r\"");
+  const size_t last = text.find_last_not_of(" \t\r\"");
+  return first == std::string::npos ? "" : text.substr(first, last - first + 1);
+}
+
+std::vector<std::string> Fields(const std::string& line)
+{
+  std::vector<std::string> fields;
+  std::stringstream stream(line);
+  std::string field;
+  while (std::getline(stream, field, ','))
+  {
+    fields.push_back(Trimmed(field));
+  }
+  return fields;
+}
+
+/// The index of the first of `names` among `header`, -1 when none.
+int ColumnOf(const std::vector<std::string>& header, std::initializer_list<const char*> names)
+{
+  for (const char* name : names)
+  {
+    const auto found = std::find(header.begin(), header.end(), name);
+    if (found != header.end())
+    {
+      return static_cast<int>(found - header.begin());
+    }
+  }
+  return -1;
+}
+
+double Size(const Points& points)
+{
+  return points.rows() == 0 ? 0.0 : (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
+}
+
+double Median(std::vector<double> values)
+{
+  if (values.empty())
+  {
+    return 0.0;
+  }
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+/// Each of `points`' distance from the surface of `tree` (0 inside it).
+std::vector<double> Distances(const TriangleTree& tree, const Points& points)
+{
+  std::vector<double> distances;
+  for (Eigen::Index i = 0; i < points.rows(); ++i)
+  {
+    const Eigen::Vector3d p = points.row(i).transpose();
+    distances.push_back(tree.InBounds(p) && tree.Inside(p) ? 0.0 : tree.ClosestPoint(p).distance);
+  }
+  return distances;
+}
+
+/// The index among `names` of the name equal to `name` (ignoring case), -1 when none.
+int Named(const std::vector<std::string>& names, const std::string& name)
+{
+  for (size_t k = 0; k < names.size(); ++k)
+  {
+    if (Lower(names[k]) == Lower(name))
+    {
+      return static_cast<int>(k);
+    }
+  }
+  return -1;
+}
+
+/// The points of `bone` nearest to `marks` (at least `count`, and each mark's nearest): the
+/// bone's rigid motion there carries the area.
+void Anchor(const TriangleMesh& bone, const Points& marks, int count, Attachment& area)
+{
+  const Eigen::Index n = bone.points.rows();
+  std::vector<std::pair<double, Eigen::Index>> nearest(static_cast<size_t>(n));
+  std::vector<Eigen::Index> chosen;
+  for (Eigen::Index j = 0; j < marks.rows(); ++j)
+  {
+    Eigen::Index best = 0;
+    (bone.points.rowwise() - marks.row(j)).rowwise().squaredNorm().minCoeff(&best);
+    chosen.push_back(best);
+  }
+  for (Eigen::Index i = 0; i < n; ++i)
+  {
+    nearest[static_cast<size_t>(i)] = { (marks.rowwise() - bone.points.row(i)).rowwise().squaredNorm().minCoeff(), i };
+  }
+  const size_t take = std::min(nearest.size(), static_cast<size_t>(std::max(count, 4)));
+  std::partial_sort(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(take), nearest.end());
+  for (size_t k = 0; k < take; ++k)
+  {
+    chosen.push_back(nearest[k].second);
+  }
+  std::sort(chosen.begin(), chosen.end());
+  chosen.erase(std::unique(chosen.begin(), chosen.end()), chosen.end());
+  area.anchors = chosen;
+  area.anchorsRest.resize(static_cast<Eigen::Index>(chosen.size()), 3);
+  for (size_t k = 0; k < chosen.size(); ++k)
+  {
+    area.anchorsRest.row(static_cast<Eigen::Index>(k)) = bone.points.row(chosen[k]);
+  }
+}
+
+/// The muscle's points within `reach[j]` of mark j, for any j.
+std::vector<Eigen::Index> PointsNear(const TriangleMesh& muscle, const Points& marks, const std::vector<double>& reach)
+{
+  std::vector<Eigen::Index> points;
+  for (Eigen::Index i = 0; i < muscle.points.rows(); ++i)
+  {
+    for (Eigen::Index j = 0; j < marks.rows(); ++j)
+    {
+      if ((muscle.points.row(i) - marks.row(j)).norm() <= reach[static_cast<size_t>(j)])
+      {
+        points.push_back(i);
+        break;
+      }
+    }
+  }
+  return points;
+}
+
+std::string Distance(double value)
+{
+  std::ostringstream text;
+  text.precision(value < 10 ? 2 : 3);
+  text << value;
+  return text.str();
+}
+}
+
+std::vector<LandmarkSet> ParseLandmarkTable(const std::string& text, const std::string& source)
+{
+  std::stringstream stream(text);
+  std::string line;
+  int lineNumber = 0;
+  std::vector<std::string> header;
+  while (header.empty() && std::getline(stream, line))
+  {
+    ++lineNumber;
+    if (!Trimmed(line).empty())
+    {
+      header = Fields(Lower(line));
+    }
+  }
+  const int muscle = ColumnOf(header, { "muscle", "muscle_group" }), bone = ColumnOf(header, { "bone", "attached_to" }),
+            area = ColumnOf(header, { "area", "cloud" }), x = ColumnOf(header, { "x", "x_mm" }),
+            y = ColumnOf(header, { "y", "y_mm" }), z = ColumnOf(header, { "z", "z_mm" });
+  if (muscle < 0 || bone < 0 || x < 0 || y < 0 || z < 0)
+  {
+    throw InputError("landmark table '" + source +
+      "': its first row must name the columns muscle (or muscle_group), bone (or attached_to), x, y and z "
+      "(or x_mm, y_mm, z_mm)");
+  }
+  const int widest = std::max({ muscle, bone, area, x, y, z });
+  std::vector<LandmarkSet> sets;
+  std::map<std::string, size_t> setOf;
+  std::vector<std::vector<Eigen::Vector3d>> marks;
+  while (std::getline(stream, line))
+  {
+    ++lineNumber;
+    if (Trimmed(line).empty())
+    {
+      continue;
+    }
+    const std::vector<std::string> fields = Fields(line);
+    const std::string where = "landmark table '" + source + "', line " + std::to_string(lineNumber);
+    if (static_cast<int>(fields.size()) <= widest)
+    {
+      throw InputError(where + ": " + std::to_string(fields.size()) + " values where the header names " +
+        std::to_string(header.size()));
+    }
+    Eigen::Vector3d p;
+    for (int k = 0; k < 3; ++k)
+    {
+      const std::string& value = fields[static_cast<size_t>(k == 0 ? x : k == 1 ? y : z)];
+      char* end = nullptr;
+      p[k] = std::strtod(value.c_str(), &end);
+      if (value.empty() || *end != '\0' || !std::isfinite(p[k]))
+      {
+        throw InputError(where + ": '" + value + "' is not a finite number");
+      }
+    }
+    const std::string key = fields[static_cast<size_t>(muscle)] + "\n" +
+      (area >= 0 ? fields[static_cast<size_t>(area)] : "") + "\n" + fields[static_cast<size_t>(bone)];
+    auto found = setOf.find(key);
+    if (found == setOf.end())
+    {
+      found = setOf.emplace(key, sets.size()).first;
+      sets.push_back({ fields[static_cast<size_t>(muscle)], fields[static_cast<size_t>(bone)],
+        area >= 0 ? fields[static_cast<size_t>(area)] : "", Points() });
+      marks.emplace_back();
+    }
+    marks[found->second].push_back(p);
+  }
+  for (size_t s = 0; s < sets.size(); ++s)
+  {
+    sets[s].points.resize(static_cast<Eigen::Index>(marks[s].size()), 3);
+    for (size_t k = 0; k < marks[s].size(); ++k)
+    {
+      sets[s].points.row(static_cast<Eigen::Index>(k)) = marks[s][k].transpose();
+    }
+  }
+  return sets;
+}
+
+FoundAttachments FindAttachments(const std::vector<std::string>& muscleNames, const std::vector<TriangleMesh>& muscles,
+  const std::vector<std::vector<Points>>& restLines, const std::vector<std::string>& boneNames,
+  const std::vector<TriangleMesh>& bones, const std::vector<LandmarkSet>& landmarks, bool fromLineEnds,
+  const AttachmentParameters& parameters)
+{
+  FoundAttachments found;
+  found.areas.resize(muscles.size());
+  if (muscles.empty() || bones.empty())
+  {
+    return found;
+  }
+  std::vector<TriangleTree> muscleTrees, boneTrees;
+  std::vector<double> sizes;
+  for (const TriangleMesh& m : muscles)
+  {
+    muscleTrees.emplace_back(m);
+    sizes.push_back(Size(m.points));
+  }
+  for (const TriangleMesh& b : bones)
+  {
+    boneTrees.emplace_back(b);
+  }
+  // The muscle of each named group: by name, else the nearest to all its landmarks together.
+  std::map<std::string, int> muscleOfGroup;
+  std::vector<std::string> described(muscles.size());
+  for (const LandmarkSet& set : landmarks)
+  {
+    if (muscleOfGroup.count(set.muscle))
+    {
+      continue;
+    }
+    int m = Named(muscleNames, set.muscle);
+    if (m < 0)
+    {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (size_t k = 0; k < muscles.size(); ++k)
+      {
+        std::vector<double> all;
+        for (const LandmarkSet& other : landmarks)
+        {
+          if (other.muscle == set.muscle)
+          {
+            const std::vector<double> d = Distances(muscleTrees[k], other.points);
+            all.insert(all.end(), d.begin(), d.end());
+          }
+        }
+        if (Median(all) < nearest)
+        {
+          nearest = Median(all);
+          m = static_cast<int>(k);
+        }
+      }
+      found.messages.push_back("landmarks '" + set.muscle + "' belong to muscle '" + muscleNames[m] +
+        "', the nearest to them (at a median distance of " + Distance(nearest) + " from its surface)");
+    }
+    muscleOfGroup[set.muscle] = m;
+  }
+  for (const LandmarkSet& set : landmarks)
+  {
+    const size_t m = static_cast<size_t>(muscleOfGroup[set.muscle]);
+    const std::string label = set.area.empty() ? set.muscle + " on " + set.bone : set.area;
+    if (set.points.rows() == 0)
+    {
+      continue;
+    }
+    const std::vector<double> fromMuscle = Distances(muscleTrees[m], set.points);
+    if (Median(fromMuscle) > parameters.farthestLandmarks * sizes[m])
+    {
+      found.warnings.push_back("landmarks '" + label + "' lie " + Distance(Median(fromMuscle)) + " from muscle '" +
+        muscleNames[m] +
+        "' (median), beyond a quarter of its size: they mark no part of its "
+        "surface and are not used");
+      continue;
+    }
+    int b = Named(boneNames, set.bone);
+    std::string boneHow;
+    if (b < 0)
+    {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (size_t k = 0; k < bones.size(); ++k)
+      {
+        const double d = Median(Distances(boneTrees[k], set.points));
+        if (d < nearest)
+        {
+          nearest = d;
+          b = static_cast<int>(k);
+        }
+      }
+      boneHow = " ('" + set.bone + "' names no bone: the nearest, at a median distance of " + Distance(nearest) + ")";
+    }
+    // The landmarks' spacing: how far apart the marks of the area's outline are.
+    std::vector<double> spacing;
+    for (Eigen::Index j = 0; j < set.points.rows(); ++j)
+    {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (Eigen::Index k = 0; k < set.points.rows(); ++k)
+      {
+        if (k != j)
+        {
+          nearest = std::min(nearest, (set.points.row(j) - set.points.row(k)).norm());
+        }
+      }
+      spacing.push_back(nearest);
+    }
+    const double gap = set.points.rows() > 1 ? Median(spacing) : parameters.lineEndRadius * sizes[m];
+    std::vector<double> reach;
+    for (double d : fromMuscle)
+    {
+      reach.push_back(d + gap);
+    }
+    Attachment area;
+    area.bone = boneNames[static_cast<size_t>(b)];
+    area.boneIndex = b;
+    area.points = PointsNear(muscles[m], set.points, reach);
+    area.source = "landmarks '" + label + "'";
+    Anchor(bones[static_cast<size_t>(b)], set.points, parameters.anchorCount, area);
+    described[m] += (described[m].empty() ? "" : ", ") + area.source + " on '" + area.bone + "'" + boneHow + " (" +
+      std::to_string(area.points.size()) + " points)";
+    found.areas[m].push_back(std::move(area));
+  }
+  for (size_t m = 0; m < muscles.size(); ++m)
+  {
+    if (!found.areas[m].empty() || !fromLineEnds)
+    {
+      continue;
+    }
+    // No landmarks: each action line's two ends, where a bone is near.
+    for (size_t l = 0; l < restLines[m].size(); ++l)
+    {
+      const Points& line = restLines[m][l];
+      for (Eigen::Index end : { Eigen::Index(0), line.rows() - 1 })
+      {
+        if (line.rows() < 2)
+        {
+          continue;
+        }
+        const Points mark = line.row(end);
+        double nearest = std::numeric_limits<double>::infinity();
+        int b = -1;
+        for (size_t k = 0; k < bones.size(); ++k)
+        {
+          const double d = Distances(boneTrees[k], mark)[0];
+          if (d < nearest)
+          {
+            nearest = d;
+            b = static_cast<int>(k);
+          }
+        }
+        if (b < 0 || nearest > parameters.farthestBone * sizes[m])
+        {
+          continue;
+        }
+        Attachment area;
+        area.bone = boneNames[static_cast<size_t>(b)];
+        area.boneIndex = b;
+        // The surface next to the bone there: near the line's end and near the bone.
+        const std::vector<Eigen::Index> near =
+          PointsNear(muscles[m], mark, { Distances(muscleTrees[m], mark)[0] + parameters.lineEndRadius * sizes[m] });
+        const double gap = parameters.boneGap * sizes[m];
+        for (Eigen::Index i : near)
+        {
+          if (Distances(boneTrees[static_cast<size_t>(b)], muscles[m].points.row(i))[0] <= gap)
+          {
+            area.points.push_back(i);
+          }
+        }
+        area.source =
+          std::string(end == 0 ? "the first" : "the last") + " point of action line " + std::to_string(l + 1);
+        if (area.points.empty())
+        {
+          continue;
+        }
+        Anchor(bones[static_cast<size_t>(b)], mark, parameters.anchorCount, area);
+        described[m] += (described[m].empty() ? "" : ", ") + area.source + " on '" + area.bone + "' (" +
+          std::to_string(area.points.size()) + " points)";
+        found.areas[m].push_back(std::move(area));
+      }
+    }
+  }
+  for (size_t m = 0; m < muscles.size(); ++m)
+  {
+    found.messages.push_back("muscle '" + muscleNames[m] + "': " +
+      (described[m].empty() ? std::string("no attachment area (it moves with its action lines only)")
+                            : "attached by " + described[m]));
+  }
+  return found;
+}
+}
