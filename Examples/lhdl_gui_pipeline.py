@@ -40,7 +40,8 @@ def build(folder):
                                       PathsCurrent=simple.OutputPort(model, 1))
     method = simple.InterpolatedMuscleDeformation(registrationName="Method", Input=muscles, BonesRest=bones,
                                                   BonesCurrent=moved, ActionLinesRest=simple.OutputPort(lines, 0),
-                                                  ActionLinesCurrent=simple.OutputPort(lines, 1), NumberOfSteps=4)
+                                                  ActionLinesCurrent=simple.OutputPort(lines, 1), NumberOfSteps=4,
+                                                  AttachmentFileName=os.path.join(folder, "attachment_areas_rp_mm.csv"))
     return {"model": model, "bones": bones, "muscles": muscles, "moved": moved, "lines": lines, "method": method}
 
 

@@ -54,6 +54,8 @@ def main(argv=None):
     frame = inputs.pop("frame")
     inputs.pop("model")
     pipeline = mdexamples.interpolation_pipeline(inputs, args.steps, args.mode)
+    # The muscles' origins and insertions held on their bones by the data set's own landmarks.
+    pipeline["interpolated"].AttachmentFileName = os.path.join(data, "lhdl_hip_r", "attachment_areas_rp_mm.csv")
     view = mdexamples.make_view()
     images, figures = mdexamples.run(pipeline, view, lateral_camera, args.output, "lhdl")
     mdexamples.close_view(view)

@@ -194,7 +194,8 @@ def interpolation_pipeline(inputs, steps=4, mode="Rigid"):
                          ActionLinesCurrent=inputs["lines_current"], BoneInterpolationMode=mode)
     pipeline["interpolated"] = simple.InterpolatedMuscleDeformation(NumberOfSteps=steps, **method_inputs)
     pipeline["one_pass"] = simple.InterpolatedMuscleDeformation(NumberOfSteps=1, DeformationMesh="Hull (paper)",
-                                                                BoneContactWeight=0.0, **method_inputs)
+                                                                BoneContactWeight=0.0, AttachmentAreas="Off",
+                                                                **method_inputs)
     pipeline["hulls"] = simple.HullDecimation(Input=inputs["muscles"])
     # One pass RP -> CP (the paper's original method), every muscle together, bones in the CP.
     pipeline["deformation"] = simple.MuscleDeformation(Input=inputs["muscles"],

@@ -98,15 +98,17 @@ std::string AttachAndReport(vtkAlgorithm* filter, const std::string& filterName,
   const std::vector<md::LandmarkSet>& landmarks, const std::vector<std::string>& muscleNames,
   const std::vector<md::TriangleMesh>& muscles, const std::vector<std::vector<md::Points>>& restLines,
   const std::vector<std::string>& boneNames, const std::vector<md::TriangleMesh>& bones,
-  std::vector<std::vector<md::Attachment>>& areas)
+  std::vector<std::vector<md::Attachment>>& areas, double messageUnit)
 {
   areas.assign(muscles.size(), {});
   if (mode == ATTACHMENTS_OFF)
   {
     return "";
   }
+  md::AttachmentParameters parameters;
+  parameters.messageUnit = messageUnit;
   const md::FoundAttachments found =
-    md::FindAttachments(muscleNames, muscles, restLines, boneNames, bones, landmarks, true);
+    md::FindAttachments(muscleNames, muscles, restLines, boneNames, bones, landmarks, true, parameters);
   areas = found.areas;
   std::string report = filterName + ", attachment areas:";
   for (const std::string& line : found.messages)

@@ -33,10 +33,11 @@ void OptionalLandmarkInput(vtkInformation* info);
 
 /// The areas of `muscles` on `bones` for `mode` (ATTACHMENTS_OFF: none), and says how each
 /// muscle's were found in the output messages (one text for all, `filterName` first) and warns of
-/// landmarks not used. Returns the report's text.
+/// landmarks not used, its distances in `messageUnit`s of the coordinates given (the data's
+/// length of a local frame's unit). Returns the report's text.
 std::string AttachAndReport(vtkAlgorithm* filter, const std::string& filterName, int mode,
   const std::vector<md::LandmarkSet>& landmarks, const std::vector<std::string>& muscleNames,
   const std::vector<md::TriangleMesh>& muscles, const std::vector<std::vector<md::Points>>& restLines,
   const std::vector<std::string>& boneNames, const std::vector<md::TriangleMesh>& bones,
-  std::vector<std::vector<md::Attachment>>& areas);
+  std::vector<std::vector<md::Attachment>>& areas, double messageUnit = 1.0);
 }

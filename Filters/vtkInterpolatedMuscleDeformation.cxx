@@ -392,7 +392,7 @@ void vtkInterpolatedMuscleDeformation::Attach(vtkDataObject* landmarks, const md
   }
   std::vector<std::vector<md::Attachment>> areas;
   this->AttachmentReport = mdvtk::AttachAndReport(this, "InterpolatedMuscleDeformation", this->AttachmentAreas, sets,
-    muscleNames, surfaces, lines, boneNames, boneSurfaces, areas);
+    muscleNames, surfaces, lines, boneNames, boneSurfaces, areas, frame.LengthToWorld(1.0));
   bool attached = false;
   for (size_t m = 0; m < motions.size(); ++m)
   {

@@ -395,8 +395,13 @@ class LhdlFromItsOpenSimFiles(unittest.TestCase):
         state = os.path.join(mdtesting.SOURCE_DIR, "Examples", "LHDL_hip.pvsm")
         simple.LoadState(state, data_directory=os.path.join(DATA, "lhdl_hip_r"))
         method = simple.FindSource("Method")
+        self.assertEqual(os.path.realpath(method.AttachmentFileName),
+                         os.path.realpath(os.path.join(DATA, "lhdl_hip_r", "attachment_areas_rp_mm.csv")))
         self.assertEqual(list(method.TimestepValues), [0.0, 1.0, 2.0, 3.0, 4.0])
-        method.UpdatePipeline(4)
+        with mdtesting.CapturedMessages() as messages:
+            method.UpdatePipeline(4)
+        for muscle in ("gluteus_maximus_r", "gluteus_medius_r", "iliacus_r", "psoas_r"):
+            self.assertIn("muscle '%s.vtk': attached by landmarks" % muscle, messages.text)
         result = servermanager.Fetch(method)
         self.assertEqual({result.GetMetaData(i).Get(result.NAME()) for i in range(result.GetNumberOfBlocks())},
                          {m + ".vtk" for m in ("gluteus_maximus_r", "gluteus_medius_r", "iliacus_r", "psoas_r")})

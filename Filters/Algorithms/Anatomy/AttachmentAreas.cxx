@@ -80,12 +80,21 @@ std::vector<double> Distances(const TriangleTree& tree, const Points& points)
   return distances;
 }
 
-/// The index among `names` of the name equal to `name` (ignoring case), -1 when none.
+/// `name` in lower case without a file extension ("Femur_r.vtk" -> "femur_r"): blocks read from
+/// files are often named after them.
+std::string Plain(const std::string& name)
+{
+  const size_t dot = name.rfind('.');
+  return Lower(dot == std::string::npos || dot == 0 ? name : name.substr(0, dot));
+}
+
+/// The index among `names` of the name equal to `name` (ignoring case and file extensions), -1
+/// when none.
 int Named(const std::vector<std::string>& names, const std::string& name)
 {
   for (size_t k = 0; k < names.size(); ++k)
   {
-    if (Lower(names[k]) == Lower(name))
+    if (Plain(names[k]) == Plain(name))
     {
       return static_cast<int>(k);
     }
@@ -281,7 +290,8 @@ FoundAttachments FindAttachments(const std::vector<std::string>& muscleNames, co
         }
       }
       found.messages.push_back("landmarks '" + set.muscle + "' belong to muscle '" + muscleNames[m] +
-        "', the nearest to them (at a median distance of " + Distance(nearest) + " from its surface)");
+        "', the nearest to them (at a median distance of " + Distance(parameters.messageUnit * nearest) +
+        " from its surface)");
     }
     muscleOfGroup[set.muscle] = m;
   }
@@ -296,8 +306,8 @@ FoundAttachments FindAttachments(const std::vector<std::string>& muscleNames, co
     const std::vector<double> fromMuscle = Distances(muscleTrees[m], set.points);
     if (Median(fromMuscle) > parameters.farthestLandmarks * sizes[m])
     {
-      found.warnings.push_back("landmarks '" + label + "' lie " + Distance(Median(fromMuscle)) + " from muscle '" +
-        muscleNames[m] +
+      found.warnings.push_back("landmarks '" + label + "' lie " +
+        Distance(parameters.messageUnit * Median(fromMuscle)) + " from muscle '" + muscleNames[m] +
         "' (median), beyond a quarter of its size: they mark no part of its "
         "surface and are not used");
       continue;
@@ -316,7 +326,8 @@ FoundAttachments FindAttachments(const std::vector<std::string>& muscleNames, co
           b = static_cast<int>(k);
         }
       }
-      boneHow = " ('" + set.bone + "' names no bone: the nearest, at a median distance of " + Distance(nearest) + ")";
+      boneHow = " ('" + set.bone + "' names no bone: the nearest, at a median distance of " +
+        Distance(parameters.messageUnit * nearest) + ")";
     }
     // The landmarks' spacing: how far apart the marks of the area's outline are.
     std::vector<double> spacing;

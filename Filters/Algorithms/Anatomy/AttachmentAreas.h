@@ -52,10 +52,14 @@ struct AttachmentParameters
   double farthestBone = 0.1;
   /// Bone points near an area whose rigid motion carries it (at least).
   int anchorCount = 32;
+  /// The data's length of one unit of the coordinates given, for the distances the messages
+  /// give (a filter working in a local frame gives its unit).
+  double messageUnit = 1.0;
 };
 
 /// The areas of `muscles` (in the rest pose, named `muscleNames`) on `bones` (rest pose, named
-/// `boneNames`; boneIndex the bones' order). A landmark set belongs to the muscle it names, else
+/// `boneNames`; boneIndex the bones' order). Names match ignoring case and a file extension
+/// ("femur_r" is block "femur_r.vtk"). A landmark set belongs to the muscle it names, else
 /// (all the sets naming one muscle together) to the muscle nearest to them, and to the bone it
 /// names, else to the nearest bone; its area is the surface facing its landmarks: every point
 /// within a landmark's distance from the surface plus the landmarks' spacing of it. A muscle no

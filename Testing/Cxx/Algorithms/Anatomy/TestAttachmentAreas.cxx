@@ -112,6 +112,19 @@ TEST(AttachmentAreas, LandmarksMarkTheSurfaceFacingThemOnTheBoneTheyName)
     << found.messages.back();
 }
 
+TEST(AttachmentAreas, NamesMatchIgnoringCaseAndFileExtensions)
+{
+  Case c;
+  c.boneNames = { "Pelvis_Bone.vtk", "femur.stl" };
+  const std::vector<md::LandmarkSet> marks{ Marks("MUSCLE", "femur", { { 5, 5, 14.8 }, { 6, 5, 14.8 } }) };
+  const md::FoundAttachments found =
+    md::FindAttachments(c.muscleNames, c.muscles, c.lines, c.boneNames, c.bones, marks, false);
+  ASSERT_EQ(found.areas[0].size(), 1u);
+  EXPECT_EQ(found.areas[0][0].boneIndex, 1);
+  EXPECT_EQ(found.messages.size(), 1u); // nothing taken as the nearest
+  EXPECT_EQ(found.messages[0].find("names no bone"), std::string::npos) << found.messages[0];
+}
+
 TEST(AttachmentAreas, NamesThatMatchNothingTakeTheNearestAndSaySo)
 {
   const Case c;
