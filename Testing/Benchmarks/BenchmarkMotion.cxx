@@ -46,26 +46,8 @@ void AttachMuscles(
   {
     return;
   }
-  std::vector<std::string> muscleNames, boneNames;
-  std::vector<md::TriangleMesh> muscles, bones;
-  std::vector<std::vector<md::Points>> lines;
-  for (const md::MotionDeformation::Muscle& m : frames.muscles)
-  {
-    muscleNames.push_back(m.name);
-    muscles.push_back(m.rest);
-    lines.push_back(m.restLines);
-  }
-  for (const md::MotionDeformation::Bone& b : frames.bones)
-  {
-    boneNames.push_back(b.name);
-    bones.push_back(b.rest);
-  }
-  const md::FoundAttachments found = md::FindAttachments(muscleNames, muscles, lines, boneNames, bones,
-    mode == "landmarks" ? landmarks : std::vector<md::LandmarkSet>{}, true);
-  for (size_t m = 0; m < frames.muscles.size(); ++m)
-  {
-    frames.muscles[m].attachments = found.areas[m];
-  }
+  const md::FoundAttachments found =
+    AttachMotionMuscles(frames, mode == "landmarks" ? landmarks : std::vector<md::LandmarkSet>{}, true);
   for (const std::string& message : found.messages)
   {
     if (say)

@@ -7,6 +7,7 @@
 
 #include "Anatomy/AttachmentAreas.h"
 #include "Geometry/RigidMotion.h"
+#include "MotionFrames.h"
 #include "RealData.h"
 
 #include <algorithm>
@@ -28,6 +29,34 @@ inline std::vector<md::LandmarkSet> LhdlLandmarks(const std::string& folder = ""
   std::stringstream text;
   text << file.rdbuf();
   return md::ParseLandmarkTable(text.str(), path);
+}
+
+/// FindAttachments for the muscles of `frames` (rest surfaces and lines) on its bones, by
+/// `landmarks`, else, with `fromLineEnds`, at their lines' ends; each muscle's areas set.
+inline md::FoundAttachments AttachMotionMuscles(
+  MotionFrames& frames, const std::vector<md::LandmarkSet>& landmarks, bool fromLineEnds)
+{
+  std::vector<std::string> muscleNames, boneNames;
+  std::vector<md::TriangleMesh> muscles, bones;
+  std::vector<std::vector<md::Points>> lines;
+  for (const md::MotionDeformation::Muscle& m : frames.muscles)
+  {
+    muscleNames.push_back(m.name);
+    muscles.push_back(m.rest);
+    lines.push_back(m.restLines);
+  }
+  for (const md::MotionDeformation::Bone& b : frames.bones)
+  {
+    boneNames.push_back(b.name);
+    bones.push_back(b.rest);
+  }
+  md::FoundAttachments found =
+    md::FindAttachments(muscleNames, muscles, lines, boneNames, bones, landmarks, fromLineEnds);
+  for (size_t m = 0; m < frames.muscles.size(); ++m)
+  {
+    frames.muscles[m].attachments = found.areas[m];
+  }
+  return found;
 }
 
 /// One landmark's probe: the rest muscle point nearest to it, and the bone that carries it.

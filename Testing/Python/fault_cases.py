@@ -450,21 +450,6 @@ def case_muscle_given_as_its_own_bone():
 
 # --- Attachment landmarks ------------------------------------------------------------------
 
-def landmarks(coordinates, arrays):
-    data = vtkPolyData()
-    points = vtkPoints()
-    for p in coordinates:
-        points.InsertNextPoint(*p)
-    data.SetPoints(points)
-    for name, value in arrays.items():
-        array = vtkStringArray()
-        array.SetName(name)
-        for _ in coordinates:
-            array.InsertNextValue(value)
-        data.GetPointData().AddArray(array)
-    return data
-
-
 def attached_method(**properties):
     muscles, bones_rest, bones, lines_rest, lines = phantom_outputs()
     return simple.InterpolatedMuscleDeformation(
@@ -474,7 +459,7 @@ def attached_method(**properties):
 
 def case_landmarks_with_nan():
     """A landmark at NaN: an error naming the Attachments input, no crash."""
-    marks = landmarks([(0, 0, 0), (float("nan"), 0, 0)], {"Muscle": "Iliopsoas", "Bone": "Femur"})
+    marks = mdtesting.landmarks([(0, 0, 0), (float("nan"), 0, 0)], {"Muscle": "Iliopsoas", "Bone": "Femur"})
     with mdtesting.CapturedMessages() as messages:
         method = attached_method(Attachments=producer(marks))
         method.UpdatePipeline()
@@ -492,7 +477,7 @@ def case_landmark_table_without_its_columns():
 
 def case_landmarks_far_from_every_muscle():
     """Landmarks a metre away: a warning that they mark nothing, and the muscles deformed."""
-    marks = landmarks([(1000, 1000, 1000), (1001, 1000, 1000)], {"Muscle": "Iliopsoas", "Bone": "Femur"})
+    marks = mdtesting.landmarks([(1000, 1000, 1000), (1001, 1000, 1000)], {"Muscle": "Iliopsoas", "Bone": "Femur"})
     with mdtesting.CapturedMessages() as messages:
         method = attached_method(Attachments=producer(marks))
         method.UpdatePipeline()

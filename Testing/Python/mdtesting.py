@@ -68,6 +68,25 @@ def assert_matches_baseline(test, fresh, name, output):
                      "%s differs from its baseline; see %s" % (name, output))
 
 
+def landmarks(coordinates, arrays):
+    """Landmarks as the deformation filters' Attachments input takes them: a vtkPolyData of
+    `coordinates` with a string point array per item of `arrays` (name: the value of every point)."""
+    from vtkmodules.vtkCommonCore import vtkPoints, vtkStringArray
+    from vtkmodules.vtkCommonDataModel import vtkPolyData
+    data = vtkPolyData()
+    points = vtkPoints()
+    for p in coordinates:
+        points.InsertNextPoint(*p)
+    data.SetPoints(points)
+    for name, value in arrays.items():
+        array = vtkStringArray()
+        array.SetName(name)
+        for _ in coordinates:
+            array.InsertNextValue(value)
+        data.GetPointData().AddArray(array)
+    return data
+
+
 def load_plugin():
     return mdexamples.load_plugin(explicit=os.environ.get("MUSCLEDEFORMATION_PLUGIN"))
 

@@ -7,22 +7,13 @@ import unittest
 
 import numpy
 import mdtesting
+from motion import rigid_fit  # Examples/motion.py, the main job's slip measure
 from paraview import servermanager, simple
-from vtkmodules.vtkCommonCore import vtkPoints, vtkStringArray
-from vtkmodules.vtkCommonDataModel import vtkPolyData
 from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter
 
 mdtesting.load_plugin()
 points = mdtesting.points
 block = mdtesting.block
-
-
-def rigid_fit(rest, now):
-    a, b = rest.mean(axis=0), now.mean(axis=0)
-    u, _, vt = numpy.linalg.svd((rest - a).T @ (now - b))
-    d = numpy.sign(numpy.linalg.det(vt.T @ u.T))
-    rotation = vt.T @ numpy.diag([1.0, 1.0, d]) @ u.T
-    return rotation, b - rotation @ a
 
 
 class Attachments(unittest.TestCase):
@@ -50,20 +41,9 @@ class Attachments(unittest.TestCase):
 
     @staticmethod
     def write_landmarks(path, coordinates, names):
-        data = vtkPolyData()
-        pts = vtkPoints()
-        for p in coordinates:
-            pts.InsertNextPoint(*p)
-        data.SetPoints(pts)
-        for name, value in names.items():
-            array = vtkStringArray()
-            array.SetName(name)
-            for _ in coordinates:
-                array.InsertNextValue(value)
-            data.GetPointData().AddArray(array)
         writer = vtkXMLPolyDataWriter()
         writer.SetFileName(path)
-        writer.SetInputData(data)
+        writer.SetInputData(mdtesting.landmarks(coordinates, names))
         writer.Write()
 
     def method(self, **properties):

@@ -1,24 +1,22 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Anatomy/AttachmentAreas.h"
 
+#include "Common/Names.h"
+#include "Geometry/MeshChecks.h"
 #include "Geometry/TriangleTree.h"
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <sstream>
+#include <tuple>
 
 namespace md
 {
 namespace
 {
-std::string Lower(std::string text)
-{
-  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
-  return text;
-}
-
 std::string Trimmed(const std::string& text)
 {
   const size_t first = text.find_first_not_of(" \t\r\"");
@@ -52,11 +50,6 @@ int ColumnOf(const std::vector<std::string>& header, std::initializer_list<const
   return -1;
 }
 
-double Size(const Points& points)
-{
-  return points.rows() == 0 ? 0.0 : (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
-}
-
 double Median(std::vector<double> values)
 {
   if (values.empty())
@@ -68,24 +61,43 @@ double Median(std::vector<double> values)
   return *middle;
 }
 
-/// Each of `points`' distance from the surface of `tree` (0 inside it).
+/// The distance of `p` from the surface of `tree` (0 inside it).
+double DistanceFrom(const TriangleTree& tree, const Eigen::Vector3d& p)
+{
+  return tree.InBounds(p) && tree.Inside(p) ? 0.0 : tree.ClosestPoint(p).distance;
+}
+
+/// Each of `points`' DistanceFrom `tree`.
 std::vector<double> Distances(const TriangleTree& tree, const Points& points)
 {
   std::vector<double> distances;
   for (Eigen::Index i = 0; i < points.rows(); ++i)
   {
-    const Eigen::Vector3d p = points.row(i).transpose();
-    distances.push_back(tree.InBounds(p) && tree.Inside(p) ? 0.0 : tree.ClosestPoint(p).distance);
+    distances.push_back(DistanceFrom(tree, points.row(i).transpose()));
   }
   return distances;
+}
+
+/// The one of `trees` nearest to `points` (the least median distance), and that distance.
+std::pair<int, double> Nearest(const std::vector<TriangleTree>& trees, const Points& points)
+{
+  std::pair<int, double> nearest{ -1, std::numeric_limits<double>::infinity() };
+  for (size_t k = 0; k < trees.size(); ++k)
+  {
+    const double d = Median(Distances(trees[k], points));
+    if (d < nearest.second)
+    {
+      nearest = { static_cast<int>(k), d };
+    }
+  }
+  return nearest;
 }
 
 /// `name` in lower case without a file extension ("Femur_r.vtk" -> "femur_r"): blocks read from
 /// files are often named after them.
 std::string Plain(const std::string& name)
 {
-  const size_t dot = name.rfind('.');
-  return Lower(dot == std::string::npos || dot == 0 ? name : name.substr(0, dot));
+  return Lower(WithoutExtension(name));
 }
 
 /// The index among `names` of the name equal to `name` (ignoring case and file extensions), -1
@@ -253,7 +265,7 @@ FoundAttachments FindAttachments(const std::vector<std::string>& muscleNames, co
   for (const TriangleMesh& m : muscles)
   {
     muscleTrees.emplace_back(m);
-    sizes.push_back(Size(m.points));
+    sizes.push_back(BoxDiagonal(m.points));
   }
   for (const TriangleMesh& b : bones)
   {
@@ -271,24 +283,21 @@ FoundAttachments FindAttachments(const std::vector<std::string>& muscleNames, co
     int m = Named(muscleNames, set.muscle);
     if (m < 0)
     {
-      double nearest = std::numeric_limits<double>::infinity();
-      for (size_t k = 0; k < muscles.size(); ++k)
+      std::vector<Eigen::Vector3d> group; // every landmark naming this muscle
+      for (const LandmarkSet& other : landmarks)
       {
-        std::vector<double> all;
-        for (const LandmarkSet& other : landmarks)
+        for (Eigen::Index j = 0; other.muscle == set.muscle && j < other.points.rows(); ++j)
         {
-          if (other.muscle == set.muscle)
-          {
-            const std::vector<double> d = Distances(muscleTrees[k], other.points);
-            all.insert(all.end(), d.begin(), d.end());
-          }
-        }
-        if (Median(all) < nearest)
-        {
-          nearest = Median(all);
-          m = static_cast<int>(k);
+          group.push_back(other.points.row(j).transpose());
         }
       }
+      Points all(static_cast<Eigen::Index>(group.size()), 3);
+      for (size_t j = 0; j < group.size(); ++j)
+      {
+        all.row(static_cast<Eigen::Index>(j)) = group[j].transpose();
+      }
+      double nearest = 0;
+      std::tie(m, nearest) = Nearest(muscleTrees, all);
       found.messages.push_back("landmarks '" + set.muscle + "' belong to muscle '" + muscleNames[m] +
         "', the nearest to them (at a median distance of " + Distance(parameters.messageUnit * nearest) +
         " from its surface)");
@@ -316,16 +325,8 @@ FoundAttachments FindAttachments(const std::vector<std::string>& muscleNames, co
     std::string boneHow;
     if (b < 0)
     {
-      double nearest = std::numeric_limits<double>::infinity();
-      for (size_t k = 0; k < bones.size(); ++k)
-      {
-        const double d = Median(Distances(boneTrees[k], set.points));
-        if (d < nearest)
-        {
-          nearest = d;
-          b = static_cast<int>(k);
-        }
-      }
+      double nearest = 0;
+      std::tie(b, nearest) = Nearest(boneTrees, set.points);
       boneHow = " ('" + set.bone + "' names no bone: the nearest, at a median distance of " +
         Distance(parameters.messageUnit * nearest) + ")";
     }
@@ -376,17 +377,7 @@ FoundAttachments FindAttachments(const std::vector<std::string>& muscleNames, co
           continue;
         }
         const Points mark = line.row(end);
-        double nearest = std::numeric_limits<double>::infinity();
-        int b = -1;
-        for (size_t k = 0; k < bones.size(); ++k)
-        {
-          const double d = Distances(boneTrees[k], mark)[0];
-          if (d < nearest)
-          {
-            nearest = d;
-            b = static_cast<int>(k);
-          }
-        }
+        const auto [b, nearest] = Nearest(boneTrees, mark);
         if (b < 0 || nearest > parameters.farthestBone * sizes[m])
         {
           continue;
@@ -395,12 +386,12 @@ FoundAttachments FindAttachments(const std::vector<std::string>& muscleNames, co
         area.bone = boneNames[static_cast<size_t>(b)];
         area.boneIndex = b;
         // The surface next to the bone there: near the line's end and near the bone.
-        const std::vector<Eigen::Index> near =
-          PointsNear(muscles[m], mark, { Distances(muscleTrees[m], mark)[0] + parameters.lineEndRadius * sizes[m] });
+        const std::vector<Eigen::Index> near = PointsNear(muscles[m], mark,
+          { DistanceFrom(muscleTrees[m], mark.row(0).transpose()) + parameters.lineEndRadius * sizes[m] });
         const double gap = parameters.boneGap * sizes[m];
         for (Eigen::Index i : near)
         {
-          if (Distances(boneTrees[static_cast<size_t>(b)], muscles[m].points.row(i))[0] <= gap)
+          if (DistanceFrom(boneTrees[static_cast<size_t>(b)], muscles[m].points.row(i).transpose()) <= gap)
           {
             area.points.push_back(i);
           }

@@ -102,8 +102,8 @@ RowEntries ChordRow(const TriangleTree& tree, const Eigen::Vector3d& p, double r
 SurfaceEnergy::SurfaceEnergy(const TriangleMesh& rest, const std::vector<Points>& restLines,
   const SettleParameters& parameters, const std::vector<Attachment>& attachments)
   : RestPoints(rest.points)
-  , Attachments(attachments)
   , SamplesPerSegment(std::max(1, parameters.samplesPerSegment))
+  , Attachments(attachments)
 {
   const Eigen::Index n = rest.points.rows();
   std::vector<std::int64_t> representative;
@@ -207,10 +207,10 @@ SurfaceEnergy::SurfaceEnergy(const TriangleMesh& rest, const std::vector<Points>
       this->Undriven += piece[i] >= 0 && !driven[static_cast<size_t>(piece[i])] ? 1 : 0;
     }
   }
-  const std::vector<double> followWeights = this->FollowWeights();
+  this->FollowRowWeights = this->FollowWeights();
   for (Eigen::Index i = 0; i < n; ++i)
   {
-    entries.emplace_back(followStart + i, i, followWeights[static_cast<size_t>(i)]);
+    entries.emplace_back(followStart + i, i, this->FollowRowWeights[static_cast<size_t>(i)]);
   }
   this->Rows.resize(followStart + n, n);
   this->Rows.setFromTriplets(entries.begin(), entries.end());
@@ -622,13 +622,12 @@ Points SurfaceEnergy::RightHandSide(
 {
   const Eigen::Index n = this->RestPoints.rows();
   Points targets(this->Rows.rows(), 3);
-  const std::vector<double> followWeights = this->FollowWeights();
   for (Eigen::Index i = 0; i < n; ++i)
   {
     const Eigen::Vector3d p = this->RestPoints.row(i).transpose();
     const BlendedSegments near(p, lines, this->BlendWidth * this->Span);
     targets.row(i) = this->ShapeWeight * (near.rotation * this->Delta.row(i).transpose()).transpose();
-    targets.row(n + this->SampleCount() + i) = followWeights[static_cast<size_t>(i)] * near.follow.transpose();
+    targets.row(n + this->SampleCount() + i) = this->FollowRowWeights[static_cast<size_t>(i)] * near.follow.transpose();
   }
   for (const Attachment& area : this->Attachments)
   {

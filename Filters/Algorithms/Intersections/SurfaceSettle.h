@@ -250,6 +250,7 @@ private:
   double FollowWeight = 0;
   std::vector<Attachment> Attachments;
   double AttachmentWeight = 0;           ///< the rows of the attachment areas' points
+  std::vector<double> FollowRowWeights;  ///< each point's follow row's weight (FollowWeights)
   double BlendWidth = 0;                 ///< SettleParameters::blendWidth
   std::vector<Eigen::Index> SampleIndex; // samples (SampleMatchedLines order) inside the rest muscle
   std::vector<double> SampleClearance;   // their distances from the rest surface

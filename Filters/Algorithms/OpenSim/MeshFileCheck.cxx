@@ -2,6 +2,7 @@
 #include "OpenSim/MeshFileCheck.h"
 
 #include "Common/MeshTypes.h"
+#include "Common/Names.h"
 
 #include <algorithm>
 #include <cctype>
@@ -18,12 +19,6 @@ namespace
 /// How many values an XML file's compressed data may expand to per byte of the file: zlib
 /// gives at most about 1000 on runs of zeros; a mesh's coordinates compress 2-4 times.
 constexpr double kXmlValuesPerByte = 64.0;
-
-std::string Lower(std::string text)
-{
-  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
-  return text;
-}
 
 /// A count as a whole number ("6000000000").
 std::string Count(double value)

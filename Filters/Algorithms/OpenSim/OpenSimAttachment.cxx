@@ -52,19 +52,6 @@ std::vector<std::pair<std::string, std::vector<std::string>>> ParseAssignments(c
   return result;
 }
 
-std::string WithoutExtension(const std::string& name)
-{
-  const size_t dot = name.rfind('.');
-  if (dot == std::string::npos || dot == 0)
-  {
-    return name;
-  }
-  const std::string extension = name.substr(dot + 1);
-  const bool looksLikeExtension = !extension.empty() && extension.size() <= 4 &&
-    std::all_of(extension.begin(), extension.end(), [](unsigned char c) { return std::isalpha(c); });
-  return looksLikeExtension ? name.substr(0, dot) : name;
-}
-
 int BodyOfSurface(const std::string& surfaceName, const std::vector<std::string>& bodyNames,
   const std::vector<std::pair<std::string, std::vector<std::string>>>& assignments)
 {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "Common/MeshTypes.h"
+#include "Common/Names.h"
 
 #include <string>
 #include <utility>
@@ -15,8 +16,7 @@ namespace md::osim
 /// (name, values) pairs. Throws InputError for an item without '='.
 std::vector<std::pair<std::string, std::vector<std::string>>> ParseAssignments(const std::string& text);
 
-/// The name without a trailing file extension ("femur_r.vtk" -> "femur_r").
-std::string WithoutExtension(const std::string& name);
+using md::WithoutExtension; // "femur_r.vtk" -> "femur_r" (Common/Names.h)
 
 /// The body a surface named `surfaceName` moves with: the one `assignments` gives it (by its
 /// name with or without extension), else the body named as the surface (without extension), else

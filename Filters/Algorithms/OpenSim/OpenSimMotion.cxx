@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "OpenSim/OpenSimMotion.h"
 
+#include "Common/Names.h"
 #include "OpenSim/OpenSimKinematics.h"
 
 #include <algorithm>
@@ -21,15 +22,6 @@ std::string Trim(const std::string& s)
   }
   const size_t end = s.find_last_not_of(" \t\r\n");
   return s.substr(begin, end - begin + 1);
-}
-
-std::string Lower(std::string s)
-{
-  for (char& c : s)
-  {
-    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  }
-  return s;
 }
 
 bool EndsWith(const std::string& s, const std::string& tail)

@@ -421,29 +421,21 @@ TEST(MotionDeformation, OnTheHipTheMusclesStayOnTheirLandmarks)
     {
       GTEST_SKIP() << "the LHDL data (lhdl_hip_r) was not found";
     }
+    const md::FoundAttachments found = AttachMotionMuscles(frames, landmarks, true);
+    ASSERT_EQ(found.warnings.size(), 1u); // the iliotibial tract's, on no bone of the case
     std::vector<std::string> muscleNames, boneNames;
-    std::vector<md::TriangleMesh> muscles, bones;
-    std::vector<std::vector<md::Points>> lines;
+    std::vector<md::TriangleMesh> muscles;
     std::vector<md::Points> boneRest;
     for (const md::MotionDeformation::Muscle& m : frames.muscles)
     {
+      ASSERT_FALSE(m.attachments.empty()) << m.name;
       muscleNames.push_back(m.name);
       muscles.push_back(m.rest);
-      lines.push_back(m.restLines);
     }
     for (const md::MotionDeformation::Bone& b : frames.bones)
     {
       boneNames.push_back(b.name);
-      bones.push_back(b.rest);
       boneRest.push_back(b.rest.points);
-    }
-    const md::FoundAttachments found =
-      md::FindAttachments(muscleNames, muscles, lines, boneNames, bones, landmarks, true);
-    ASSERT_EQ(found.warnings.size(), 1u); // the iliotibial tract's, on no bone of the case
-    for (size_t m = 0; m < frames.muscles.size(); ++m)
-    {
-      ASSERT_FALSE(found.areas[m].empty()) << muscleNames[m];
-      frames.muscles[m].attachments = found.areas[m];
     }
     const std::vector<SlipProbe> probes = LhdlSlipProbes(landmarks, muscleNames, muscles, boneNames);
     ASSERT_EQ(probes.size(), 189u);
