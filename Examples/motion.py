@@ -207,36 +207,68 @@ def interpolated(curve, angle):
     return curve[-1][1]
 
 
-def moment_arm_plots(reader, data, motion_name, folder):
-    """Per muscle, the moment arms of the model's straight paths (the reader's MomentArms table)
-    against the joint angle, beside Blemker & Delp 2005's range of fibre moment arms
-    (literature/blemker2005_envelopes.json); and the share of poses, inside the angles Blemker's
-    curves cover, where each path lies inside that range."""
+def share_inside(values, lower, upper):
+    """Percent of the poses where Blemker's range is defined and the value known that lie inside it."""
+    covered = [(v, lo, up) for v, lo, up in zip(values, lower, upper)
+               if lo is not None and up is not None and v is not None and not math.isnan(v)]
+    return 100.0 * sum(min(lo, up) <= v <= max(lo, up) for v, lo, up in covered) / max(1, len(covered))
+
+
+def moment_arm_plots(motion, reader, data, motion_name, folder):
+    """Per muscle, against the joint angle: the moment arms of its fibres (the motion filter's
+    MomentArms table: median and range over the fibres), of Modenese & Kohout 2020's 100-fibre
+    model of the same cadaver (literature/lhpbuilder_fibres_*.json) and of the model's straight
+    paths (the reader's MomentArms table), beside Blemker & Delp 2005's range of fibre moment arms
+    (literature/blemker2005_envelopes.json); and for each, the share of poses, inside the angles
+    Blemker's curves cover, where it lies inside that range."""
     from vtkmodules.vtkCommonCore import vtkDoubleArray
     from vtkmodules.vtkCommonDataModel import vtkTable
-    envelopes = os.path.join(data, "literature", "blemker2005_envelopes.json")
+    literature = os.path.join(data, "literature")
+    envelopes = os.path.join(literature, "blemker2005_envelopes.json")
     if not os.path.isfile(envelopes):
         print("no moment-arm plots: %s is absent" % envelopes)
         return {}, []
     with open(envelopes) as f:
         blemker = json.load(f)["muscles"]
+    others_file = os.path.join(literature, "lhpbuilder_fibres_%s.json" % motion_name)
+    others = None
+    if os.path.isfile(others_file):
+        with open(others_file) as f:
+            others = json.load(f)
     coordinate = {"hip_flexion": "hip_flexion_r", "hip_adduction": "hip_adduction_r"}[motion_name]
-    arms = table_columns(servermanager.Fetch(reader, idx=6))
-    angles = arms[coordinate]
-    inside, plots = {}, []
-    for muscle, paths in MUSCLE_PATHS.items():
+    paths = table_columns(servermanager.Fetch(reader, idx=6))
+    fibres = table_columns(servermanager.Fetch(motion, idx=5))
+    angles = fibres[coordinate]
+    path_angles = paths[coordinate]
+    inside = {"fibres": {}, "modenese_kohout_2020_fibres": {}, "straight_paths": {}}
+    plots = []
+    for muscle, muscle_paths in MUSCLE_PATHS.items():
         band = blemker[muscle][coordinate]
         upper = [interpolated(band["upper"], a) for a in angles]
         lower = [interpolated(band["lower"], a) for a in angles]
+        columns = {"%s (deg)" % coordinate: angles,
+                   "Blemker 2005 upper": [float("nan") if u is None else u for u in upper],
+                   "Blemker 2005 lower": [float("nan") if v is None else v for v in lower]}
+        median = fibres.get("FibreMomentArm(%s, %s)" % (muscle, coordinate))
+        if median:
+            columns["fibres, median"] = median
+            columns["fibres, min"] = fibres["FibreMomentArmMin(%s, %s)" % (muscle, coordinate)]
+            columns["fibres, max"] = fibres["FibreMomentArmMax(%s, %s)" % (muscle, coordinate)]
+            inside["fibres"][muscle] = share_inside(median, lower, upper)
+        if others:
+            theirs = others["muscles"][muscle]["moment_arm_mm_central_difference"]["median"]
+            curve = [[a, v] for a, v in zip(others["angle_deg"], theirs) if v is not None]
+            at = [interpolated(curve, a) for a in angles]
+            columns["Modenese & Kohout 2020 fibres, median"] = [float("nan") if v is None else v for v in at]
+            inside["modenese_kohout_2020_fibres"][muscle] = share_inside(at, lower, upper)
+        shares = []
+        for path in muscle_paths:
+            curve = list(zip(path_angles, paths["MomentArm(%s, %s)" % (path, coordinate)]))
+            at = [interpolated(curve, a) for a in angles]
+            columns["%s (straight path)" % path] = [float("nan") if v is None else v for v in at]
+            shares.append(share_inside(at, lower, upper))
+        inside["straight_paths"][muscle] = sum(shares) / len(shares)
         table = vtkTable()
-        columns = {"%s (deg)" % coordinate: angles}
-        columns.update({"Blemker 2005 upper": [float("nan") if u is None else u for u in upper],
-                        "Blemker 2005 lower": [float("nan") if v is None else v for v in lower]})
-        for path in paths:
-            values = arms["MomentArm(%s, %s)" % (path, coordinate)]
-            columns[path] = values
-            covered = [(v, lo, up) for v, lo, up in zip(values, lower, upper) if lo is not None and up is not None]
-            inside[path] = 100.0 * sum(min(lo, up) <= v <= max(lo, up) for v, lo, up in covered) / max(1, len(covered))
         for column_name, values in columns.items():
             array = vtkDoubleArray()
             array.SetName(column_name)
@@ -247,7 +279,7 @@ def moment_arm_plots(reader, data, motion_name, folder):
         source.GetClientSideObject().SetOutput(table)
         view = simple.CreateView("XYChartView")
         view.ViewSize = [700, 450]
-        view.ChartTitle = "%s, %s: straight paths, Blemker 2005's range" % (muscle, motion_name)
+        view.ChartTitle = "%s, %s: moment arms against Blemker 2005's range" % (muscle, motion_name)
         view.LeftAxisTitle = "moment arm (mm)"
         view.BottomAxisTitle = "%s (deg)" % coordinate
         display = simple.Show(source, view)
@@ -261,6 +293,51 @@ def moment_arm_plots(reader, data, motion_name, folder):
         simple.Delete(source)
         plots.append(path_png)
     return inside, plots
+
+
+def fibre_length_figures(table):
+    """Per muscle: the median fibre length at the first and the last frame, and the largest change
+    of the median between two frames against its median change."""
+    columns = table_columns(table)
+    result = {}
+    for key, values in columns.items():
+        if not key.startswith("FibreLength("):
+            continue
+        steps = sorted(abs(b - a) for a, b in zip(values, values[1:]))
+        median = steps[len(steps) // 2] if steps else 0.0
+        result[key[len("FibreLength("):-1]] = {"first_mm": values[0], "last_mm": values[-1],
+                                               "largest_step_against_median": steps[-1] / median if median else 0.0}
+    return result
+
+
+def fibre_check(fibres, muscles, bones):
+    """Fibre points outside their muscle and inside a bone at one frame, by VTK's own test
+    (vtkSelectEnclosedPoints), apart from the plugin's."""
+    from vtkmodules.vtkCommonDataModel import vtkCompositeDataSet
+    from vtkmodules.vtkFiltersModeling import vtkSelectEnclosedPoints
+
+    def leaves(data):
+        result, iterator = {}, data.NewIterator()
+        iterator.InitTraversal()
+        while not iterator.IsDoneWithTraversal():
+            result[iterator.GetCurrentMetaData().Get(vtkCompositeDataSet.NAME())] = iterator.GetCurrentDataObject()
+            iterator.GoToNextItem()
+        return result
+
+    def inside(points, surface):
+        select = vtkSelectEnclosedPoints()
+        select.SetInputData(points)
+        select.SetSurfaceData(surface)
+        select.SetTolerance(1e-9)
+        select.Update()
+        return vtk_to_numpy(select.GetOutput().GetPointData().GetArray("SelectedPoints")).astype(bool)
+
+    outside, in_bone = {}, {}
+    muscle_leaves, bone_leaves = leaves(muscles), leaves(bones)
+    for name, polylines in leaves(fibres).items():
+        outside[name] = int((~inside(polylines, muscle_leaves[name])).sum())
+        in_bone[name] = int(sum(inside(polylines, bone).sum() for bone in bone_leaves.values()))
+    return outside, in_bone
 
 
 def run_case(name, motion, camera, output, every, landmarks=None):
@@ -289,16 +366,25 @@ def run_case(name, motion, camera, output, every, landmarks=None):
         slip = LandmarkSlip(landmarks, leaf_points(servermanager.Fetch(motion.Input)),
                             leaf_points(servermanager.Fetch(motion.BonesRest)))
     muscle_frames = []
+    fibres_outside, fibres_in_bone = {}, {}
     for k, t in enumerate(times):
         motion.UpdatePipeline(t)
-        muscle_frames.append(leaf_points(servermanager.Fetch(motion, idx=0)))
+        muscles = servermanager.Fetch(motion, idx=0)
+        bones = servermanager.Fetch(motion, idx=1)
+        muscle_frames.append(leaf_points(muscles))
         if slip:
-            slip.add_frame(muscle_frames[-1], leaf_points(servermanager.Fetch(motion, idx=1)))
+            slip.add_frame(muscle_frames[-1], leaf_points(bones))
+        outside, in_bone = fibre_check(servermanager.Fetch(motion, idx=4), muscles, bones)
+        for muscle in outside:
+            fibres_outside[muscle] = fibres_outside.get(muscle, 0) + outside[muscle]
+            fibres_in_bone[muscle] = fibres_in_bone.get(muscle, 0) + in_bone[muscle]
         muscles_file = "%s_muscles_%03d.vtm" % (name, k)
         bones_file = "%s_bones_%03d.vtm" % (name, k)
+        fibres_file = "%s_fibres_%03d.vtm" % (name, k)
         write_multiblock(motion, 0, os.path.join(folder, muscles_file))
         write_multiblock(motion, 1, os.path.join(folder, bones_file))
-        entries += [(t, 0, muscles_file), (t, 1, bones_file)]
+        write_multiblock(motion, 4, os.path.join(folder, fibres_file))
+        entries += [(t, 0, muscles_file), (t, 1, bones_file), (t, 2, fibres_file)]
         if k % every == 0 or k == len(times) - 1:
             mdexamples.screenshot(view, os.path.join(folder, "frames", "%s_%03d.png" % (name, k)), t)
     write_pvd(os.path.join(folder, name + ".pvd"), entries)
@@ -331,14 +417,17 @@ def run_case(name, motion, camera, output, every, landmarks=None):
         "cache_megabytes": motion.GetProperty("CacheMegabytes").GetData(),
         "movie": movie, "plots": plots, "measures": table,
         "largest_step_against_median": step_ratios(muscle_frames),
+        "fibre_points_outside_muscle": fibres_outside,
+        "fibre_points_inside_bone": fibres_in_bone,
+        "fibre_lengths": fibre_length_figures(servermanager.Fetch(motion, idx=5)),
     }
     if slip:
         figures["largest_landmark_slip_mm"] = slip.worst
         figures["landmark_probes"] = len(slip.probes)
         reader = simple.FindSource("LHDL_hip_r.osim")
         data = os.path.dirname(os.path.dirname(landmarks))
-        inside, arm_plots = moment_arm_plots(reader, data, name[len("lhdl_"):], folder)
-        figures["straight_path_moment_arm_inside_blemker2005_percent"] = inside
+        inside, arm_plots = moment_arm_plots(motion, reader, data, name[len("lhdl_"):], folder)
+        figures["moment_arm_inside_blemker2005_percent"] = inside
         figures["plots"] += arm_plots
     finite = lambda values: [v for v in values if not math.isnan(v)]  # noqa: E731
     worst = {
@@ -363,9 +452,11 @@ def run_case(name, motion, camera, output, every, landmarks=None):
     if slip:
         print("  largest slip at the data set's %d attachment landmarks (mm): %s" % (
             len(slip.probes), ", ".join("%s %.2f" % item for item in sorted(slip.worst.items()))))
-    if figures.get("straight_path_moment_arm_inside_blemker2005_percent"):
-        print("  the model's straight paths' moment arms inside Blemker 2005's range: %s (%% of poses)" % ", ".join(
-            "%s %.0f" % item for item in figures["straight_path_moment_arm_inside_blemker2005_percent"].items()))
+    print("  fibre points outside their muscle / inside a bone over every frame (vtkSelectEnclosedPoints): %s" % (
+        ", ".join("%s %d / %d" % (m, fibres_outside[m], fibres_in_bone[m]) for m in sorted(fibres_outside))))
+    for who, shares in figures.get("moment_arm_inside_blemker2005_percent", {}).items():
+        print("  moment arms inside Blemker 2005's range, %s: %s (%% of poses; mean %.0f)" % (
+            who, ", ".join("%s %.0f" % item for item in shares.items()), sum(shares.values()) / max(1, len(shares))))
     print("  largest step of a muscle point between frames against its median: %s" % ", ".join(
         "%s %.1fx" % item for item in sorted(figures["largest_step_against_median"].items())))
     return figures

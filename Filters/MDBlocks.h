@@ -128,6 +128,11 @@ constexpr const char* Frame = "Frame";
 constexpr const char* Time = "Time";
 constexpr const char* ActionLineName = "ActionLineName";
 constexpr const char* Body = "Body"; ///< a body's name: BodyTransforms' first column, MoveWithBodies' field data
+/// BodyTransforms' field data (and MoveWithBodies' output's): the names of the rotational
+/// coordinates among the pose's coordinate values (in degrees; the others in the model's unit).
+constexpr const char* RotationalCoordinates = "RotationalCoordinates";
+/// The motion filter's fibres (a cell array of output Fibres) and its MomentArms table's columns.
+constexpr const char* FibreLength = "FibreLength";
 /// BodyTransforms' other columns (OpenSimModelReader writes them, MoveWithBodies reads them): each
 /// body's rest-to-current rotation, row by row, then its translation.
 constexpr const char* TransformColumns[12] = { "R00", "R01", "R02", "R10", "R11", "R12", "R20", "R21", "R22", "Tx",

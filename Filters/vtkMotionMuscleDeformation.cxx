@@ -6,6 +6,9 @@
 #include "MDConvert.h"
 #include "MDReport.h"
 #include "MDTime.h"
+#include "Anatomy/MuscleFibres.h"
+#include "Anatomy/TendonExcursion.h"
+#include "MDFibres.h"
 #include "Method/InterpolatedDeformation.h"
 #include "Method/MotionDeformation.h"
 
@@ -14,7 +17,9 @@
 #include <vtkExecutive.h>
 #include <vtkFieldData.h>
 #include <vtkInformation.h>
+#include <vtkCompositeDataSet.h>
 #include <vtkInformationVector.h>
+#include <vtkMultiBlockDataSet.h>
 #include <vtkObjectFactory.h>
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
@@ -34,6 +39,7 @@ using SDDP = vtkStreamingDemandDrivenPipeline;
 const char* const PortNames[] = { "Input", "BonesRest", "BonesMotion", "ActionLinesRest", "ActionLinesMotion" };
 constexpr int kMotionPorts[] = { 2, 4 };
 constexpr int kAttachmentsPort = 5;
+constexpr int kTablePort = 3, kFibresPort = 4, kMomentArmsPort = 5;
 }
 
 /// What the frames were computed from: when any of it changes, the motion starts again.
@@ -49,12 +55,14 @@ struct vtkMotionMuscleDeformation::Signature
   bool preserveVolume = true;
   int attachmentAreas = 1;
   std::string attachmentFile;
+  int numberOfFibres = 0;
   bool operator==(const Signature& o) const
   {
     return restInputs == o.restInputs && motionPipeline == o.motionPipeline && times == o.times &&
       numberOfSteps == o.numberOfSteps && maximumStepDisplacement == o.maximumStepDisplacement &&
       interpolationMode == o.interpolationMode && deformableShare == o.deformableShare &&
-      preserveVolume == o.preserveVolume && attachmentAreas == o.attachmentAreas && attachmentFile == o.attachmentFile;
+      preserveVolume == o.preserveVolume && attachmentAreas == o.attachmentAreas && attachmentFile == o.attachmentFile &&
+      numberOfFibres == o.numberOfFibres;
   }
 };
 
@@ -81,6 +89,7 @@ double Bytes(const md::Points& p)
 struct FrameKept
 {
   std::vector<md::Points> points; ///< [muscle given to the core]
+  std::vector<md::Points> fibres; ///< [muscle given]: its fibres' points (empty: none)
   md::MotionPose pose;            ///< in the data's coordinates
   std::shared_ptr<const md::MotionDeformation::State> state;
   double bytes = 0;
@@ -94,6 +103,9 @@ struct FrameMeasures
   std::vector<double> smoothnessRatio;
   int steps = 0;
   double seconds = 0;
+  std::vector<std::vector<double>> fibreLengths; ///< [muscle given][fibre]
+  std::vector<std::vector<double>> lineLengths;  ///< [muscle given][action line]
+  std::vector<double> coordinates;               ///< the pose's (Internals::coordinates), radians or as given
 
   /// Muscle `m`'s measures, as written to its field data.
   std::vector<mdvtk::Measure> Of(size_t m) const
@@ -116,6 +128,9 @@ struct vtkMotionMuscleDeformation::Internals
   std::vector<size_t> boneLeaf;                   // BonesRest leaf of each bone
   std::vector<md::Points> restPoints;             // [muscle given]: as given, in the data's coordinates
   std::vector<std::vector<md::Points>> restLines; // [muscle given]
+  std::vector<std::unique_ptr<md::MuscleFibres>> fibres; // [muscle given]; null: none
+  std::vector<md::TriangleTree> boneTrees;               // the bones', refitted to each frame's
+  mdvtk::PoseCoordinates coordinates;                    // named at the first frame
   std::map<int, FrameKept> frames;
   std::map<int, FrameMeasures> measures;
   int gather = -1;      ///< the frame the time-varying inputs are asked for; -1: none
@@ -134,6 +149,9 @@ struct vtkMotionMuscleDeformation::Internals
     this->boneLeaf.clear();
     this->restPoints.clear();
     this->restLines.clear();
+    this->fibres.clear();
+    this->boneTrees.clear();
+    this->coordinates = {};
     this->frames.clear();
     this->measures.clear();
   }
@@ -185,7 +203,7 @@ struct vtkMotionMuscleDeformation::Internals
   /// Keeps frame `k`: the muscles where `advanced` left them, the pose that drove them, where the
   /// motion stands, and the frame's measures, with how smoothly the muscles follow what drives
   /// them over the last three frames.
-  void Keep(int k, md::MotionPose pose, const md::MotionFrameResult& advanced)
+  void Keep(int k, md::MotionPose pose, std::vector<double> coordinates, const md::MotionFrameResult& advanced)
   {
     FrameKept kept;
     kept.state = this->deformation->Save();
@@ -193,6 +211,8 @@ struct vtkMotionMuscleDeformation::Internals
     FrameMeasures measures;
     measures.steps = advanced.steps;
     measures.seconds = advanced.seconds;
+    measures.coordinates = std::move(coordinates);
+    this->CarryFibres(pose, advanced.points, kept, measures);
     const auto before = this->frames.find(k - 1);
     const auto older = this->frames.find(k - 2);
     const bool threeFrames = k >= 2 && before != this->frames.end() && older != this->frames.end();
@@ -232,6 +252,34 @@ struct vtkMotionMuscleDeformation::Internals
     this->frames[k] = std::move(kept);
     this->measures[k] = std::move(measures);
   }
+  /// The fibres where the frame's muscles are (kept inside them and out of the bones), their
+  /// lengths, and the action lines' lengths.
+  void CarryFibres(const md::MotionPose& pose, const std::vector<md::Points>& points, FrameKept& kept,
+    FrameMeasures& measures)
+  {
+    std::vector<const md::TriangleTree*> obstacles;
+    for (size_t b = 0; b < this->boneTrees.size(); ++b)
+    {
+      this->boneTrees[b].Refit(pose.bones[b]);
+      obstacles.push_back(&this->boneTrees[b]);
+    }
+    kept.fibres.resize(this->blockOf.size());
+    measures.fibreLengths.resize(this->blockOf.size());
+    measures.lineLengths.resize(this->blockOf.size());
+    for (size_t m = 0; m < this->blockOf.size(); ++m)
+    {
+      for (const md::Points& line : pose.lines[m])
+      {
+        measures.lineLengths[m].push_back(mdvtk::PolylineLength(line));
+      }
+      if (this->fibres[m] && points[m].rows() > 0)
+      {
+        kept.fibres[m] = this->fibres[m]->At(points[m], obstacles);
+        measures.fibreLengths[m] = this->fibres[m]->Lengths(kept.fibres[m]);
+        kept.bytes += Bytes(kept.fibres[m]);
+      }
+    }
+  }
   /// The frame to compute first for `target`: after the last one kept before it.
   int FirstMissing(int target) const
   {
@@ -248,7 +296,7 @@ vtkMotionMuscleDeformation::vtkMotionMuscleDeformation()
   : In(std::make_unique<Internals>())
 {
   this->SetNumberOfInputPorts(6);
-  this->SetNumberOfOutputPorts(4);
+  this->SetNumberOfOutputPorts(6);
   const md::InterpolationParameters method;
   this->MaximumStepDisplacement = method.maximumStepDisplacement;
   this->BoneInterpolationMode = static_cast<int>(method.interpolationMode);
@@ -299,9 +347,14 @@ int vtkMotionMuscleDeformation::FillInputPortInformation(int port, vtkInformatio
 
 int vtkMotionMuscleDeformation::FillOutputPortInformation(int port, vtkInformation* info)
 {
-  if (port == 3)
+  if (port == kTablePort || port == kMomentArmsPort)
   {
     info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkTable");
+    return 1;
+  }
+  if (port == kFibresPort)
+  {
+    info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkMultiBlockDataSet");
     return 1;
   }
   return this->Superclass::FillOutputPortInformation(port, info);
@@ -311,7 +364,17 @@ int vtkMotionMuscleDeformation::RequestDataObject(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   // Each output has the type of the input it follows: muscles, bones, action lines; then the table.
-  mdvtk::OutputsFollowInputs(inputVector, outputVector, { 0, 1, 3 }, 3);
+  mdvtk::OutputsFollowInputs(inputVector, outputVector, { 0, 1, 3 }, kTablePort);
+  if (!vtkMultiBlockDataSet::GetData(outputVector, kFibresPort))
+  {
+    vtkNew<vtkMultiBlockDataSet> fibres;
+    outputVector->GetInformationObject(kFibresPort)->Set(vtkDataObject::DATA_OBJECT(), fibres);
+  }
+  if (!vtkTable::GetData(outputVector, kMomentArmsPort))
+  {
+    vtkNew<vtkTable> table;
+    outputVector->GetInformationObject(kMomentArmsPort)->Set(vtkDataObject::DATA_OBJECT(), table);
+  }
   return 1;
 }
 
@@ -495,7 +558,9 @@ int vtkMotionMuscleDeformation::RequestData(
   in.Evict(this->CacheMemoryLimit, in.target);
   this->WriteMuscles(inputs[0], leaves, vtkDataObject::GetData(outputVector, 0));
   this->WriteBonesAndLines(inputs, leaves, outputVector);
-  this->WriteTable(leaves, vtkTable::GetData(outputVector, 3));
+  this->WriteTable(leaves, vtkTable::GetData(outputVector, kTablePort));
+  this->WriteFibres(leaves, vtkMultiBlockDataSet::GetData(outputVector, kFibresPort));
+  this->WriteMomentArms(leaves, vtkTable::GetData(outputVector, kMomentArmsPort));
   mdvtk::SetDataTime(outputVector, in.signature.times[in.target]);
   this->UpdateProgress(1.0);
   return 1;
@@ -525,6 +590,7 @@ vtkMotionMuscleDeformation::Signature vtkMotionMuscleDeformation::SignatureOf(
   signature.preserveVolume = this->PreserveVolume;
   signature.attachmentAreas = this->AttachmentAreas;
   signature.attachmentFile = this->AttachmentFileName ? this->AttachmentFileName : "";
+  signature.numberOfFibres = this->NumberOfFibres;
   signature.restInputs =
     std::max(signature.restInputs, mdvtk::DataMTime(vtkDataObject::GetData(inputVector[kAttachmentsPort], 0)));
   return signature;
@@ -659,12 +725,19 @@ bool vtkMotionMuscleDeformation::Start(const Leaves& leaves, vtkDataObject* land
   {
     return false;
   }
+  std::vector<char> failed(muscles.size(), 0);
   for (size_t m = 0; m < muscles.size(); ++m)
   {
     if (const std::string& failure = in.deformation->Failures()[m]; !failure.empty())
     {
       mdvtk::FailBlock(this, in.failedBlocks, in.blockOf[m], leaves.muscles[in.blockOf[m]].label + ": " + failure);
+      failed[m] = 1;
     }
+  }
+  in.fibres = mdvtk::MakeFibres(this, "MotionMuscleDeformation", this->NumberOfFibres, muscles, bones, failed);
+  for (const md::MotionDeformation::Bone& bone : bones)
+  {
+    in.boneTrees.emplace_back(bone.rest);
   }
   for (const std::string& warning : in.deformation->Warnings())
   {
@@ -768,7 +841,8 @@ bool vtkMotionMuscleDeformation::ComputeFrame(vtkDataObject* motionBones, const 
   {
     vtkWarningMacro(<< "at time " << in.signature.times[k] << ": " << warning);
   }
-  in.Keep(k, std::move(pose), advanced);
+  std::vector<double> coordinates = mdvtk::ReadCoordinates(motionBones, in.coordinates);
+  in.Keep(k, std::move(pose), std::move(coordinates), advanced);
   in.Evict(this->CacheMemoryLimit, k);
   return true;
 }
@@ -860,6 +934,63 @@ void vtkMotionMuscleDeformation::WriteTable(const Leaves& leaves, vtkTable* tabl
   }
 }
 
+void vtkMotionMuscleDeformation::WriteFibres(const Leaves& leaves, vtkMultiBlockDataSet* output)
+{
+  // Output 4: each muscle's fibres at the frame asked for, a block per muscle with fibres.
+  const Internals& in = *this->In;
+  output->Initialize();
+  const FrameKept& frame = in.frames.at(in.target);
+  const FrameMeasures& measures = in.measures.at(in.target);
+  for (const auto& [b, m] : in.MuscleOfBlock())
+  {
+    if (in.fibres[m] && frame.fibres[m].rows() > 0)
+    {
+      const unsigned block = output->GetNumberOfBlocks();
+      output->SetBlock(
+        block, mdvtk::FibrePolylines(frame.fibres[m], in.fibres[m]->PointsPerFibre(), measures.fibreLengths[m]));
+      output->GetMetaData(block)->Set(vtkCompositeDataSet::NAME(), mdvtk::NameOf(leaves.muscles[b]).c_str());
+    }
+  }
+}
+
+void vtkMotionMuscleDeformation::WriteMomentArms(const Leaves& leaves, vtkTable* table)
+{
+  // Output 5: lengths and moment arms of every frame computed so far (consecutive from frame 0).
+  const Internals& in = *this->In;
+  table->Initialize();
+  std::vector<mdvtk::FrameLengths> frames;
+  for (const auto& [k, measures] : in.measures)
+  {
+    if (k != static_cast<int>(frames.size()))
+    {
+      break;
+    }
+    frames.push_back({ in.signature.times[k], measures.coordinates, measures.fibreLengths, measures.lineLengths });
+  }
+  std::vector<std::string> muscleNames;
+  std::vector<std::vector<std::string>> lineNames;
+  for (size_t m = 0; m < in.blockOf.size(); ++m)
+  {
+    const std::string muscle = mdvtk::NameOf(leaves.muscles[in.blockOf[m]]);
+    muscleNames.push_back(in.deformation->Failures()[m].empty() ? muscle : std::string());
+    lineNames.push_back(mdvtk::LineNames(leaves.restLines[leaves.restLinesOf[in.blockOf[m]]].data, muscle,
+      in.restLines[m].size()));
+  }
+  // Failed muscles: no columns.
+  for (size_t m = 0; m < muscleNames.size(); ++m)
+  {
+    if (muscleNames[m].empty())
+    {
+      lineNames[m].clear();
+      for (mdvtk::FrameLengths& f : frames)
+      {
+        f.fibreLengths[m].clear();
+      }
+    }
+  }
+  mdvtk::WriteMomentArms(frames, in.coordinates, muscleNames, lineNames, table);
+}
+
 void vtkMotionMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
@@ -871,6 +1002,7 @@ void vtkMotionMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "CacheMemoryLimit: " << this->CacheMemoryLimit << "\n";
   os << indent << "AttachmentAreas: " << this->AttachmentAreas << "\n";
   os << indent << "AttachmentFileName: " << (this->AttachmentFileName ? this->AttachmentFileName : "") << "\n";
+  os << indent << "NumberOfFibres: " << this->NumberOfFibres << "\n";
   os << indent << "FramesComputed: " << this->GetFramesComputed() << "\n";
   os << indent << "FramesKept: " << this->GetFramesKept() << "\n";
 }

@@ -40,6 +40,7 @@
 
 #include <memory>
 
+class vtkMultiBlockDataSet;
 class vtkTable;
 namespace md
 {
@@ -98,6 +99,10 @@ public:
   /// set's attachment_areas_rp_mm.csv reads as it is). Empty: none.
   vtkSetStringMacro(AttachmentFileName);
   vtkGetStringMacro(AttachmentFileName);
+  /// Fibres per muscle, made in the rest pose and carried to every frame (docs/DESIGN.md,
+  /// "Fibres"); 0: none. Default 100.
+  vtkSetClampMacro(NumberOfFibres, int, 0, 10000);
+  vtkGetMacro(NumberOfFibres, int);
   /// How the areas were found, as the output messages said it at the last start.
   const char* GetAttachmentReport() const;
 
@@ -128,6 +133,7 @@ protected:
   double CacheMemoryLimit = 2048.0;
   int AttachmentAreas = 1;
   char* AttachmentFileName = nullptr;
+  int NumberOfFibres = 100;
 
 private:
   vtkMotionMuscleDeformation(const vtkMotionMuscleDeformation&) = delete;
@@ -150,5 +156,7 @@ private:
   void WriteMuscles(vtkDataObject* input, const Leaves& leaves, vtkDataObject* output);
   void WriteBonesAndLines(vtkDataObject* const inputs[5], const Leaves& leaves, vtkInformationVector* outputVector);
   void WriteTable(const Leaves& leaves, vtkTable* table);
+  void WriteFibres(const Leaves& leaves, vtkMultiBlockDataSet* output);
+  void WriteMomentArms(const Leaves& leaves, vtkTable* table);
   std::unique_ptr<Internals> In;
 };

@@ -160,6 +160,16 @@ int vtkMoveWithBodies::RequestData(
     results[i] = moved;
   }
   mdvtk::AssignLeaves(input, output, results, mdvtk::Role::AsGiven); // moves whatever it is given
+  // The pose's coordinates (BodyTransforms' field data: Time, each coordinate's value,
+  // RotationalCoordinates) go with the moved surfaces, for the motion filter's moment arms.
+  // A new field data: the output's may be the input's, shared.
+  vtkNew<vtkFieldData> pose;
+  pose->ShallowCopy(output->GetFieldData());
+  for (int a = 0; a < table->GetFieldData()->GetNumberOfArrays(); ++a)
+  {
+    pose->AddArray(table->GetFieldData()->GetAbstractArray(a));
+  }
+  output->SetFieldData(pose);
   return 1;
 }
 

@@ -733,12 +733,18 @@ void vtkOpenSimModelReader::WriteTransforms(const std::vector<md::RigidTransform
     }
   }
   mdvtk::AddFieldValue(table->GetFieldData(), mdvtk::array::Time, time);
+  auto rotationalNames = Strings(mdvtk::array::RotationalCoordinates);
   for (size_t c = 0; c < model.coordinates.size(); ++c)
   {
     const bool rotational = model.coordinates[c].motionType == osim::MotionType::Rotational;
     mdvtk::AddFieldValue(table->GetFieldData(), model.coordinates[c].name.c_str(),
       rotational ? coordinates[c] * 180.0 / M_PI : coordinates[c]);
+    if (rotational)
+    {
+      rotationalNames->InsertNextValue(model.coordinates[c].name);
+    }
   }
+  table->GetFieldData()->AddArray(rotationalNames);
 }
 
 void vtkOpenSimModelReader::PrintSelf(ostream& os, vtkIndent indent)

@@ -16,8 +16,11 @@
 //
 //   BenchmarkMotion [data folder] [hip_flexion|hip_adduction|phantom] [seed: -1 none, 0 float, s > 0 noise]
 //                   [attachments: landmarks (default) | lines | none]
+#include "Anatomy/MuscleFibres.h"
 #include "AnatomyMeasures.h"
 #include "Common/Fnv1a.h"
+#include "Geometry/MeshChecks.h"
+#include "Geometry/TriangleTree.h"
 #include "MotionFrames.h"
 #include "StepChecksum.h"
 
@@ -27,11 +30,108 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace
 {
+/// The fibres over a motion: their cost a frame, points outside their muscle or inside a bone,
+/// and the largest change of a fibre's length between frames against its median.
+struct FibreMeasures
+{
+  explicit FibreMeasures(size_t muscles)
+    : outside(muscles, 0)
+    , inBone(muscles, 0)
+    , lengths(muscles)
+  {
+  }
+  std::vector<std::int64_t> outside, inBone;
+  std::vector<std::vector<std::vector<double>>> lengths; ///< [muscle][frame][fibre]
+  std::vector<double> seconds;                           ///< carrying and lengths, a frame
+  long long moved = 0, stuck = 0;                        ///< fibre points kept in, over the motion
+
+  void Add(const std::vector<std::unique_ptr<md::MuscleFibres>>& fibres, const std::vector<md::Points>& muscles,
+    const std::vector<md::Points>& bonesNow, const std::vector<md::MotionDeformation::Bone>& bones)
+  {
+    std::vector<md::TriangleTree> boneTrees;
+    std::vector<const md::TriangleTree*> obstacles;
+    for (size_t b = 0; b < bones.size(); ++b)
+    {
+      boneTrees.emplace_back(md::TriangleMesh{ bonesNow[b], bones[b].rest.triangles });
+    }
+    for (const md::TriangleTree& t : boneTrees)
+    {
+      obstacles.push_back(&t);
+    }
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<md::Points> carried;
+    for (size_t m = 0; m < fibres.size(); ++m)
+    {
+      std::pair<int, int> kept;
+      carried.push_back(fibres[m]->At(muscles[m], obstacles, &kept));
+      lengths[m].push_back(fibres[m]->Lengths(carried.back()));
+      moved += kept.first;
+      stuck += kept.second;
+    }
+    seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    // Outside the muscle: by the winding number (a muscle folded over itself encloses its fold
+    // twice); inside a bone: by the parity of rays.
+    for (size_t m = 0; m < fibres.size(); ++m)
+    {
+      outside[m] += md::CountOutside(md::TriangleMesh{ muscles[m], fibres[m]->SurfaceTriangles() }, carried[m], 0.0);
+      for (Eigen::Index p = 0; p < carried[m].rows(); ++p)
+      {
+        const Eigen::Vector3d x = carried[m].row(p).transpose();
+        for (const md::TriangleTree& bone : boneTrees)
+        {
+          inBone[m] += bone.InBounds(x) && bone.Inside(x);
+        }
+      }
+    }
+  }
+
+  void Print(const std::vector<md::MotionDeformation::Muscle>& muscles) const
+  {
+    std::vector<double> sorted = seconds;
+    std::sort(sorted.begin(), sorted.end());
+    std::printf("fibres: carried and measured in %.2f ms a frame (median; all muscles); %lld points kept in, %lld "
+                "could not be\n",
+      sorted.empty() ? 0.0 : 1000 * sorted[sorted.size() / 2], moved, stuck);
+    for (size_t m = 0; m < muscles.size(); ++m)
+    {
+      // Per fibre, the largest change of length between frames against the median change.
+      double worst = 0;
+      const auto& l = lengths[m];
+      for (size_t f = 0; l.size() > 2 && f < l[0].size(); ++f)
+      {
+        std::vector<double> steps;
+        for (size_t k = 1; k < l.size(); ++k)
+        {
+          steps.push_back(std::abs(l[k][f] - l[k - 1][f]));
+        }
+        std::sort(steps.begin(), steps.end());
+        const double median = steps[steps.size() / 2];
+        worst = std::max(worst, median > 0 ? steps.back() / median : 0.0);
+      }
+      const md::Spread first = md::SpreadOf(l.front()), last = md::SpreadOf(l.back());
+      std::printf("  %s: %lld fibre points outside the muscle, %lld inside a bone over the motion; length (mm) "
+                  "%.1f [%.1f, %.1f] at the first frame, %.1f [%.1f, %.1f] at the last; largest step of a fibre's "
+                  "length against its median %.2fx\n",
+        muscles[m].name.c_str(), static_cast<long long>(outside[m]), static_cast<long long>(inBone[m]), first.median,
+        first.low, first.high, last.median, last.low, last.high, worst);
+    }
+  }
+};
+
+md::FibreParameters FibreSettings()
+{
+  md::FibreParameters p;
+  if (const char* share = std::getenv("FIBRE_SHARE")) p.keptWeightShare = std::atof(share);
+  if (const char* n = std::getenv("FIBRE_POINTS")) p.pointsPerFibre = std::atoi(n);
+  return p;
+}
+
 double LargestDistance(const md::Points& a, const md::Points& b)
 {
   return a.rows() == b.rows() && a.rows() > 0 ? (a - b).rowwise().norm().maxCoeff() : -1.0;
@@ -101,6 +201,24 @@ int main(int argc, char** argv)
   }
   const std::vector<SlipProbe> probes = LhdlSlipProbes(landmarks, muscleNames, restMuscles, boneNames);
   std::vector<double> worstSlip(frames.muscles.size(), 0.0);
+  // The fibres of each muscle (MuscleFibres.h), made at rest, carried to every frame.
+  std::vector<std::unique_ptr<md::MuscleFibres>> fibres;
+  std::vector<const md::TriangleMesh*> restBones;
+  for (const md::MotionDeformation::Bone& b : frames.bones)
+  {
+    restBones.push_back(&b.rest);
+  }
+  for (const md::MotionDeformation::Muscle& m : frames.muscles)
+  {
+    const auto made = std::chrono::steady_clock::now();
+    const md::FibreEnds ends = md::FindFibreEnds(m.rest, m.attachments, m.restLines);
+    fibres.push_back(std::make_unique<md::MuscleFibres>(m.rest, ends, FibreSettings(), restBones));
+    std::printf("fibres of %s: %d from %s to %s, %.1f weights a point, made in %.2f s\n", m.name.c_str(),
+      fibres.back()->Count(), ends.originSource.c_str(), ends.insertionSource.c_str(),
+      fibres.back()->MeanWeightsPerPoint(),
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - made).count());
+  }
+  FibreMeasures fibreMeasures(frames.muscles.size());
   md::InterpolationParameters parameters;
   parameters.numberOfSteps = 0; // the first frame from the rest pose: automatic
   const auto start = std::chrono::steady_clock::now();
@@ -122,6 +240,7 @@ int main(int argc, char** argv)
     }
     points.push_back(r.points);
     AddStepToChecksum(checksum, r.points, r.measures);
+    fibreMeasures.Add(fibres, r.points, frames.poses[k].bones, frames.bones);
     const std::vector<double> slips = Slips(probes, restMuscles, r.points, boneRest, frames.poses[k].bones);
     for (size_t p = 0; p < probes.size(); ++p)
     {
@@ -184,6 +303,8 @@ int main(int argc, char** argv)
     std::printf(" %s %.2f / %.2fx;", frames.muscles[m].name.c_str(), worstSlip[m], stepRatios[m]);
   }
   std::printf("\n");
+
+  fibreMeasures.Print(frames.muscles);
 
   // Perturbed input against the exact input: how far every frame's surfaces moved (issue 13's
   // measure, through the whole motion).

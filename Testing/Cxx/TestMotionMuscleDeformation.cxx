@@ -3,12 +3,15 @@
 // lines made time-varying by BoneInterpolation (times 0 ... N, the rest pose to 30 degrees of
 // flexion), every frame deformed from the one before.
 #include "FilterTestUtilities.h"
+#include "Geometry/MeshChecks.h"
+#include "MDConvert.h"
 
 #include "vtkBoneInterpolation.h"
 #include "vtkMotionMuscleDeformation.h"
 #include "vtkMusculoskeletalPhantom.h"
 
 #include <vtkCallbackCommand.h>
+#include <vtkCellData.h>
 #include <vtkCommand.h>
 #include <vtkDataArray.h>
 #include <vtkFieldData.h>
@@ -369,4 +372,52 @@ TEST(MotionMuscleDeformation, FramesComputedAgainAfterTheCacheDroppedThemKeepThe
     }
   }
   EXPECT_GT(scrubbed.motion->GetFramesComputed(), 13); // frames were computed again
+}
+
+TEST(MotionMuscleDeformation, FibresRunInsideEachMuscleAtEveryFrameWithTheirLengths)
+{
+  PhantomMotionPipeline p(30, 4);
+  p.motion->SetNumberOfFibres(40);
+  for (int k = 0; k <= 4; ++k)
+  {
+    ASSERT_EQ(p.At(k), 1);
+    auto* muscles = vtkMultiBlockDataSet::SafeDownCast(p.motion->GetOutputDataObject(0));
+    auto* fibres = vtkMultiBlockDataSet::SafeDownCast(p.motion->GetOutputDataObject(4));
+    ASSERT_NE(fibres, nullptr);
+    ASSERT_EQ(fibres->GetNumberOfBlocks(), muscles->GetNumberOfBlocks());
+    for (unsigned int b = 0; b < fibres->GetNumberOfBlocks(); ++b)
+    {
+      auto* lines = vtkPolyData::SafeDownCast(fibres->GetBlock(b));
+      ASSERT_NE(lines, nullptr);
+      EXPECT_EQ(BlockName(fibres, b), BlockName(muscles, b));
+      EXPECT_EQ(lines->GetNumberOfLines(), 40);
+      vtkDataArray* lengths = lines->GetCellData()->GetArray("FibreLength");
+      ASSERT_NE(lengths, nullptr);
+      EXPECT_GT(lengths->GetRange()[0], 0.0);
+      // Every fibre point inside its muscle (winding number).
+      md::TriangleMesh surface;
+      mdvtk::ReadTriangles(vtkPolyData::SafeDownCast(muscles->GetBlock(b)), surface);
+      EXPECT_EQ(md::CountOutside(surface, mdvtk::ToPoints(lines->GetPoints()), 0.0), 0)
+        << BlockName(fibres, b) << " frame " << k;
+    }
+  }
+  // The lengths of every frame, in order; no moment arms where BonesMotion names no coordinates.
+  auto* arms = vtkTable::SafeDownCast(p.motion->GetOutputDataObject(5));
+  ASSERT_NE(arms, nullptr);
+  EXPECT_EQ(arms->GetNumberOfRows(), 5);
+  const std::string muscle = BlockName(vtkMultiBlockDataSet::SafeDownCast(p.motion->GetOutputDataObject(0)), 0);
+  EXPECT_NE(arms->GetColumnByName(("FibreLength(" + muscle + ")").c_str()), nullptr);
+  EXPECT_NE(arms->GetColumnByName(("FibreLengthMax(" + muscle + ")").c_str()), nullptr);
+  for (vtkIdType c = 0; c < arms->GetNumberOfColumns(); ++c)
+  {
+    EXPECT_EQ(std::string(arms->GetColumnName(c)).find("MomentArm"), std::string::npos) << arms->GetColumnName(c);
+  }
+  // None asked for: none made, the muscles the same to the bit.
+  vtkNew<vtkPoints> with;
+  with->SetDataTypeToDouble();
+  with->DeepCopy(p.Muscle(0)->GetPoints());
+  p.motion->SetNumberOfFibres(0);
+  ASSERT_EQ(p.At(4), 1);
+  EXPECT_EQ(vtkMultiBlockDataSet::SafeDownCast(p.motion->GetOutputDataObject(4))->GetNumberOfBlocks(), 0u);
+  EXPECT_EQ(LargestDifference(p.Muscle(0)->GetPoints(), with), 0.0);
 }

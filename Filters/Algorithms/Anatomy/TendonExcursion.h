@@ -1,0 +1,22 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Moment arms by tendon excursion along a motion: r = -dL/dq from the lengths at its frames.
+#pragma once
+
+#include <vector>
+
+namespace md
+{
+/// A coordinate moves between two frames when it changes by more than this (radians, or the
+/// coordinate's unit) and the others by no more.
+constexpr double kCoordinateMoves = 1e-9;
+
+/// The moment arm about each coordinate at every frame of a motion, r = -dL/dq (OpenSim's sign:
+/// positive where increasing q shortens the length), from `lengths[k]` and `coordinates[k][c]`
+/// (radians for a rotational coordinate) at frames k = 0, 1, ...: a central difference over
+/// frames k - 1 and k + 1 where exactly one coordinate moves between them, else a one-sided
+/// difference with frame k - 1 or k + 1 where exactly one moves between that frame and k. About
+/// a coordinate that does not move there, or where several move at once (the difference cannot
+/// tell them apart), NaN. Exact for a length linear in q; O(dq^2) central.
+std::vector<std::vector<double>> MomentArmsAlongMotion(
+  const std::vector<std::vector<double>>& coordinates, const std::vector<double>& lengths);
+}

@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// What the deformation filters share about fibres and moment arms (Anatomy/MuscleFibres.h,
+// Anatomy/TendonExcursion.h): the fibres made and reported, written as polylines, the pose's
+// coordinates read from the bones' field data, and the MomentArms table. Not part of the public
+// API.
+#pragma once
+
+#include "Anatomy/MuscleFibres.h"
+#include "Method/MotionDeformation.h"
+
+#include <vtkSmartPointer.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+class vtkAlgorithm;
+class vtkDataObject;
+class vtkPolyData;
+class vtkTable;
+
+namespace mdvtk
+{
+/// The coordinates of a motion's poses, as the bones over time carry them in their field data
+/// (MoveWithBodies passes OpenSimModelReader's BodyTransforms' on): every single number but Time,
+/// the rotational ones (in degrees there) listed in RotationalCoordinates.
+struct PoseCoordinates
+{
+  std::vector<std::string> names;
+  std::vector<char> rotational;
+};
+
+/// The pose's values of `names`' coordinates in `bones`' field data (radians for a rotational
+/// one), NaN for one it lacks; with `names` empty, names them first (none: no coordinates).
+std::vector<double> ReadCoordinates(vtkDataObject* bones, PoseCoordinates& names);
+
+/// The length of a polyline.
+double PolylineLength(const md::Points& line);
+
+/// Each muscle's fibres (`count` of them; 0: none), made in the rest pose between its attachment
+/// areas (or its ends along its lines) and out of the bones; a muscle whose fibres cannot be made
+/// gets none and a warning naming it. Says in the output messages what was made (`filterName`
+/// first). `unit`: the data's length of the coordinates' unit (a local frame's), for messages.
+std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, const std::string& filterName,
+  int count, const std::vector<md::MotionDeformation::Muscle>& muscles,
+  const std::vector<md::MotionDeformation::Bone>& bones, const std::vector<char>& failed);
+
+/// The names of `lines`' polylines (cell data ActionLineName), else "<muscle>" for one line and
+/// "<muscle> line <i>" for several; `count` names.
+std::vector<std::string> LineNames(vtkPolyData* lines, const std::string& muscle, size_t count);
+
+/// A muscle's fibres as polylines: cell data FibreLength (`lengths`).
+vtkSmartPointer<vtkPolyData> FibrePolylines(const md::Points& points, int perFibre, const std::vector<double>& lengths);
+
+/// One frame of a motion, for the MomentArms table.
+struct FrameLengths
+{
+  double time = 0;
+  std::vector<double> coordinates;               ///< PoseCoordinates' order
+  std::vector<std::vector<double>> fibreLengths; ///< [muscle][fibre]
+  std::vector<std::vector<double>> lineLengths;  ///< [muscle][line]
+};
+
+/// The MomentArms table of a motion's frames (in order, consecutive): per frame Time, the
+/// coordinates that move (degrees where rotational), and for each muscle its fibres' median,
+/// smallest and largest length and moment arm about each of those coordinates, then each
+/// action line's length and moment arm (md::MomentArmsAlongMotion; per fibre, then over fibres).
+void WriteMomentArms(const std::vector<FrameLengths>& frames, const PoseCoordinates& coordinates,
+  const std::vector<std::string>& muscleNames, const std::vector<std::vector<std::string>>& lineNames,
+  vtkTable* table);
+}
