@@ -285,7 +285,22 @@ def moment_arm_plots(motion, reader, data, motion_name, folder):
         display = simple.Show(source, view)
         display.UseIndexForXAxis = 0
         display.XArrayName = "%s (deg)" % coordinate
-        display.SeriesVisibility = [n for n in columns if n != "%s (deg)" % coordinate]
+        series = [n for n in columns if n != "%s (deg)" % coordinate]
+        display.SeriesVisibility = series
+        # Blemker's range grey, the fibres green (their range dashed), Modenese & Kohout's blue,
+        # the straight paths orange to brown.
+        style = {"Blemker 2005 upper": ((0.45, 0.45, 0.45), 2, "1"), "Blemker 2005 lower": ((0.45, 0.45, 0.45), 2, "1"),
+                 "fibres, median": ((0.1, 0.6, 0.1), 4, "1"), "fibres, min": ((0.1, 0.6, 0.1), 1, "2"),
+                 "fibres, max": ((0.1, 0.6, 0.1), 1, "2"),
+                 "Modenese & Kohout 2020 fibres, median": ((0.15, 0.35, 0.85), 3, "1")}
+        paths = [n for n in series if n.endswith("(straight path)")]
+        for i, name in enumerate(paths):
+            shade = i / max(1, len(paths) - 1)
+            style[name] = ((0.95 - 0.4 * shade, 0.55 - 0.3 * shade, 0.1), 2, "3")
+        display.SeriesColor = [x for name in series for x in [name] + ["%g" % c for c in style[name][0]]]
+        display.SeriesLineThickness = [x for name in series for x in (name, str(style[name][1]))]
+        display.SeriesLineStyle = [x for name in series for x in (name, style[name][2])]
+        view.LegendLocation = "BottomRight" if band["upper"][0][1] > 0 else "TopRight"
         simple.Render(view)
         path_png = os.path.join(folder, "%s_moment_arm_%s.png" % (motion_name, muscle))
         simple.SaveScreenshot(path_png, view, ImageResolution=[700, 450])

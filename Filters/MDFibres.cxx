@@ -4,6 +4,7 @@
 #include "Anatomy/TendonExcursion.h"
 #include "MDBlocks.h"
 #include "MDConvert.h"
+#include "Geometry/MeshChecks.h"
 
 #include <vtkAlgorithm.h>
 #include <vtkCellArray.h>
@@ -135,6 +136,21 @@ std::vector<std::string> LineNames(vtkPolyData* lines, const std::string& muscle
     }
   }
   return names;
+}
+
+md::FibreObstacle BoneWhereItIs(const md::TriangleTree& restTree, std::unique_ptr<md::TriangleTree>& moved,
+  const md::Points& rest, const md::Points& now)
+{
+  if (const auto rigid = md::RigidMotionOf(rest, now, md::kOnSurfaceShare * md::BoxDiagonal(rest)))
+  {
+    return { &restTree, *rigid };
+  }
+  if (!moved)
+  {
+    moved = std::make_unique<md::TriangleTree>(restTree);
+  }
+  moved->Refit(now);
+  return { moved.get(), md::RigidTransform() };
 }
 
 vtkSmartPointer<vtkPolyData> FibrePolylines(const md::Points& points, int perFibre, const std::vector<double>& lengths)

@@ -129,7 +129,9 @@ struct vtkMotionMuscleDeformation::Internals
   std::vector<md::Points> restPoints;             // [muscle given]: as given, in the data's coordinates
   std::vector<std::vector<md::Points>> restLines; // [muscle given]
   std::vector<std::unique_ptr<md::MuscleFibres>> fibres; // [muscle given]; null: none
-  std::vector<md::TriangleTree> boneTrees;               // the bones', refitted to each frame's
+  std::vector<md::TriangleTree> boneTrees;               // the bones' in the rest pose
+  std::vector<std::unique_ptr<md::TriangleTree>> boneMoved; // a bone's refitted to a frame's, where not rigid
+  std::vector<md::Points> boneRest;
   mdvtk::PoseCoordinates coordinates;                    // named at the first frame
   std::map<int, FrameKept> frames;
   std::map<int, FrameMeasures> measures;
@@ -151,6 +153,8 @@ struct vtkMotionMuscleDeformation::Internals
     this->restLines.clear();
     this->fibres.clear();
     this->boneTrees.clear();
+    this->boneMoved.clear();
+    this->boneRest.clear();
     this->coordinates = {};
     this->frames.clear();
     this->measures.clear();
@@ -257,11 +261,11 @@ struct vtkMotionMuscleDeformation::Internals
   void CarryFibres(const md::MotionPose& pose, const std::vector<md::Points>& points, FrameKept& kept,
     FrameMeasures& measures)
   {
-    std::vector<const md::TriangleTree*> obstacles;
-    for (size_t b = 0; b < this->boneTrees.size(); ++b)
+    const bool anyFibres = std::any_of(this->fibres.begin(), this->fibres.end(), [](const auto& f) { return !!f; });
+    std::vector<md::FibreObstacle> obstacles;
+    for (size_t b = 0; b < this->boneTrees.size() && anyFibres; ++b)
     {
-      this->boneTrees[b].Refit(pose.bones[b]);
-      obstacles.push_back(&this->boneTrees[b]);
+      obstacles.push_back(mdvtk::BoneWhereItIs(this->boneTrees[b], this->boneMoved[b], this->boneRest[b], pose.bones[b]));
     }
     kept.fibres.resize(this->blockOf.size());
     measures.fibreLengths.resize(this->blockOf.size());
@@ -738,7 +742,9 @@ bool vtkMotionMuscleDeformation::Start(const Leaves& leaves, vtkDataObject* land
   for (const md::MotionDeformation::Bone& bone : bones)
   {
     in.boneTrees.emplace_back(bone.rest);
+    in.boneRest.push_back(bone.rest.points);
   }
+  in.boneMoved.resize(bones.size());
   for (const std::string& warning : in.deformation->Warnings())
   {
     vtkWarningMacro(<< warning);

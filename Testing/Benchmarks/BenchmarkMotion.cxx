@@ -48,6 +48,7 @@ struct FibreMeasures
   }
   std::vector<std::int64_t> outside, inBone;
   std::vector<std::vector<std::vector<double>>> lengths; ///< [muscle][frame][fibre]
+  std::vector<std::vector<md::Points>> points;           ///< [frame][muscle]
   std::vector<double> seconds;                           ///< carrying and lengths, a frame
   long long moved = 0, stuck = 0;                        ///< fibre points kept in, over the motion
 
@@ -55,14 +56,14 @@ struct FibreMeasures
     const std::vector<md::Points>& bonesNow, const std::vector<md::MotionDeformation::Bone>& bones)
   {
     std::vector<md::TriangleTree> boneTrees;
-    std::vector<const md::TriangleTree*> obstacles;
+    std::vector<md::FibreObstacle> obstacles;
     for (size_t b = 0; b < bones.size(); ++b)
     {
       boneTrees.emplace_back(md::TriangleMesh{ bonesNow[b], bones[b].rest.triangles });
     }
     for (const md::TriangleTree& t : boneTrees)
     {
-      obstacles.push_back(&t);
+      obstacles.push_back({ &t, md::RigidTransform() });
     }
     const auto start = std::chrono::steady_clock::now();
     std::vector<md::Points> carried;
@@ -75,6 +76,7 @@ struct FibreMeasures
       stuck += kept.second;
     }
     seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    points.push_back(carried);
     // Outside the muscle: by the winding number (a muscle folded over itself encloses its fold
     // twice); inside a bone: by the parity of rays.
     for (size_t m = 0; m < fibres.size(); ++m)
@@ -123,6 +125,33 @@ struct FibreMeasures
     }
   }
 };
+
+md::FibreParameters FibreSettings();
+
+/// Each muscle's fibres (MuscleFibres.h) between its areas, out of the bones; said when `say`.
+std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(const MotionFrames& frames, bool say)
+{
+  std::vector<std::unique_ptr<md::MuscleFibres>> fibres;
+  std::vector<const md::TriangleMesh*> restBones;
+  for (const md::MotionDeformation::Bone& b : frames.bones)
+  {
+    restBones.push_back(&b.rest);
+  }
+  for (const md::MotionDeformation::Muscle& m : frames.muscles)
+  {
+    const auto made = std::chrono::steady_clock::now();
+    const md::FibreEnds ends = md::FindFibreEnds(m.rest, m.attachments, m.restLines);
+    fibres.push_back(std::make_unique<md::MuscleFibres>(m.rest, ends, FibreSettings(), restBones));
+    if (say)
+    {
+      std::printf("fibres of %s: %d from %s to %s, %.1f weights a point, made in %.2f s\n", m.name.c_str(),
+        fibres.back()->Count(), ends.originSource.c_str(), ends.insertionSource.c_str(),
+        fibres.back()->MeanWeightsPerPoint(),
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - made).count());
+    }
+  }
+  return fibres;
+}
 
 md::FibreParameters FibreSettings()
 {
@@ -202,22 +231,7 @@ int main(int argc, char** argv)
   const std::vector<SlipProbe> probes = LhdlSlipProbes(landmarks, muscleNames, restMuscles, boneNames);
   std::vector<double> worstSlip(frames.muscles.size(), 0.0);
   // The fibres of each muscle (MuscleFibres.h), made at rest, carried to every frame.
-  std::vector<std::unique_ptr<md::MuscleFibres>> fibres;
-  std::vector<const md::TriangleMesh*> restBones;
-  for (const md::MotionDeformation::Bone& b : frames.bones)
-  {
-    restBones.push_back(&b.rest);
-  }
-  for (const md::MotionDeformation::Muscle& m : frames.muscles)
-  {
-    const auto made = std::chrono::steady_clock::now();
-    const md::FibreEnds ends = md::FindFibreEnds(m.rest, m.attachments, m.restLines);
-    fibres.push_back(std::make_unique<md::MuscleFibres>(m.rest, ends, FibreSettings(), restBones));
-    std::printf("fibres of %s: %d from %s to %s, %.1f weights a point, made in %.2f s\n", m.name.c_str(),
-      fibres.back()->Count(), ends.originSource.c_str(), ends.insertionSource.c_str(),
-      fibres.back()->MeanWeightsPerPoint(),
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - made).count());
-  }
+  const std::vector<std::unique_ptr<md::MuscleFibres>> fibres = MakeFibres(frames, true);
   FibreMeasures fibreMeasures(frames.muscles.size());
   md::InterpolationParameters parameters;
   parameters.numberOfSteps = 0; // the first frame from the rest pose: automatic
@@ -314,6 +328,17 @@ int main(int argc, char** argv)
   {
     AttachMuscles(exactFrames, attachments, landmarks, false);
     md::MotionDeformation exact(exactFrames.muscles, exactFrames.bones, parameters);
+    const std::vector<std::unique_ptr<md::MuscleFibres>> exactFibres = MakeFibres(exactFrames, false);
+    FibreMeasures exactFibreMeasures(exactFrames.muscles.size());
+    for (size_t m = 0; m < fibres.size(); ++m)
+    {
+      std::printf("  %s: the fibres at rest, largest distance %.6f mm\n", frames.muscles[m].name.c_str(),
+        fibres[m]->Rest().rows() == exactFibres[m]->Rest().rows()
+          ? LargestDistance(fibres[m]->Rest(), exactFibres[m]->Rest())
+          : -1.0);
+    }
+    double largestFibre = 0;
+    size_t fibreCountsDiffer = 0;
     double largest = 0, worstRms = 0;
     size_t largestFrame = 0;
     std::string largestMuscle, beyond;
@@ -321,8 +346,19 @@ int main(int argc, char** argv)
     for (size_t k = 0; k < exactFrames.poses.size(); ++k)
     {
       const md::MotionFrameResult r = exact.Advance(exactFrames.poses[k]);
+      exactFibreMeasures.Add(exactFibres, r.points, exactFrames.poses[k].bones, exactFrames.bones);
       for (size_t m = 0; m < r.points.size(); ++m)
       {
+        const md::Points& a = fibreMeasures.points[k][m];
+        const md::Points& b = exactFibreMeasures.points.back()[m];
+        if (a.rows() == b.rows())
+        {
+          largestFibre = std::max(largestFibre, LargestDistance(a, b));
+        }
+        else
+        {
+          ++fibreCountsDiffer;
+        }
         const double distance = LargestDistance(points[k][m], r.points[m]);
         if (distance > kNoiseBound)
         {
@@ -343,6 +379,8 @@ int main(int argc, char** argv)
     std::printf("against the exact input, every frame: largest distance %.6f mm (frame %zu, %s), RMS up to %.6f mm\n",
       largest, largestFrame, largestMuscle.c_str(), worstRms);
     std::printf("  frames beyond %.2f mm:%s\n", kNoiseBound, beyond.empty() ? " none" : beyond.c_str());
+    std::printf("  the fibres, every frame: largest distance %.6f mm%s\n", largestFibre,
+      fibreCountsDiffer ? " (some muscles got another count of fibres)" : "");
   }
 
   // The frame nearest 60 degrees of flexion against the interpolation method from the rest pose.

@@ -218,24 +218,31 @@ struct Field
 };
 
 /// An end of the fibres as triangles: those of the surface with every corner in the end, or
-/// where the end has none, its points (as triangles of one point).
-std::vector<std::array<Eigen::Vector3d, 3>> EndTriangles(const TriangleMesh& mesh, const std::vector<Eigen::Index>& end)
+/// where the end has none, its points (as triangles of one point); each with its corners' indices.
+struct EndSurface
+{
+  std::vector<std::array<Eigen::Vector3d, 3>> corners;
+  std::vector<std::array<Eigen::Index, 3>> ids;
+};
+
+EndSurface EndTriangles(const TriangleMesh& mesh, const std::vector<Eigen::Index>& end)
 {
   std::vector<char> in(size_t(mesh.points.rows()), 0);
   for (Eigen::Index p : end)
   {
     in[size_t(p)] = 1;
   }
-  std::vector<std::array<Eigen::Vector3d, 3>> triangles;
+  EndSurface surface;
   std::vector<char> covered(size_t(mesh.points.rows()), 0);
   for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t)
   {
-    const auto corner = [&](int c) { return mesh.triangles(t, c); };
-    if (in[size_t(corner(0))] && in[size_t(corner(1))] && in[size_t(corner(2))])
+    const std::array<Eigen::Index, 3> ids{ mesh.triangles(t, 0), mesh.triangles(t, 1), mesh.triangles(t, 2) };
+    if (in[size_t(ids[0])] && in[size_t(ids[1])] && in[size_t(ids[2])])
     {
-      triangles.push_back({ mesh.points.row(corner(0)).transpose(), mesh.points.row(corner(1)).transpose(),
-        mesh.points.row(corner(2)).transpose() });
-      covered[size_t(corner(0))] = covered[size_t(corner(1))] = covered[size_t(corner(2))] = 1;
+      surface.corners.push_back({ mesh.points.row(ids[0]).transpose(), mesh.points.row(ids[1]).transpose(),
+        mesh.points.row(ids[2]).transpose() });
+      surface.ids.push_back(ids);
+      covered[size_t(ids[0])] = covered[size_t(ids[1])] = covered[size_t(ids[2])] = 1;
     }
   }
   for (Eigen::Index p : end)
@@ -243,10 +250,57 @@ std::vector<std::array<Eigen::Vector3d, 3>> EndTriangles(const TriangleMesh& mes
     if (!covered[size_t(p)])
     {
       const Eigen::Vector3d x = mesh.points.row(p).transpose();
-      triangles.push_back({ x, x, x });
+      surface.corners.push_back({ x, x, x });
+      surface.ids.push_back({ p, p, p });
     }
   }
-  return triangles;
+  return surface;
+}
+
+/// A point of an end's surface: its triangle's corners and its barycentric coordinates there.
+struct Anchor
+{
+  std::array<Eigen::Index, 3> ids{};
+  Eigen::Vector3d weights;
+  Eigen::Vector3d point;
+};
+
+/// How a fibre's end is carried: `share` of the way from its area's point to the next fibre point.
+struct FibreEnd
+{
+  Anchor anchor;
+  double share = 0.5;
+};
+
+/// The point of `end` nearest x.
+Anchor NearestAnchor(const EndSurface& end, const Eigen::Vector3d& x)
+{
+  Anchor best;
+  double nearest = std::numeric_limits<double>::max();
+  for (size_t t = 0; t < end.corners.size(); ++t)
+  {
+    const auto& [a, b, c] = end.corners[t];
+    const Eigen::Vector3d q = ClosestPointOnTriangle(x, a, b, c);
+    if ((q - x).squaredNorm() < nearest)
+    {
+      nearest = (q - x).squaredNorm();
+      best.ids = end.ids[t];
+      best.point = q;
+      const Eigen::Vector3d n = (b - a).cross(c - a);
+      const double area = n.squaredNorm();
+      if (area > 0)
+      {
+        best.weights[0] = (c - b).cross(q - b).dot(n) / area;
+        best.weights[1] = (a - c).cross(q - c).dot(n) / area;
+        best.weights[2] = 1 - best.weights[0] - best.weights[1];
+      }
+      else
+      {
+        best.weights = Eigen::Vector3d(1, 0, 0);
+      }
+    }
+  }
+  return best;
 }
 
 /// Marks the inside nodes within `radius` of the end's triangles with `label` (the nearer end wins).
@@ -293,13 +347,19 @@ Field SolveField(
   }
   Field field;
   Grid& grid = field.grid;
-  grid.h = std::cbrt(volume / std::max(gridNodes, 100));
+  // The spacing rounded to two significant digits and the nodes on multiples of it: the same grid
+  // for an input moved by rounding (the fibres then move by as little).
+  const double spacing = std::cbrt(volume / std::max(gridNodes, 100));
+  const double decade = std::pow(10.0, std::floor(std::log10(spacing)) - 1);
+  grid.h = std::round(spacing / decade) * decade;
   const Eigen::Vector3d low = rest.points.colwise().minCoeff().transpose();
   const Eigen::Vector3d high = rest.points.colwise().maxCoeff().transpose();
-  grid.origin = low - Eigen::Vector3d::Constant(2 * grid.h);
+  // Offset by fractions of the spacing no data lies on (round numbers do): no ray of the inside
+  // test runs along an edge of the surface.
+  grid.origin = ((low / grid.h).array().floor() - 2 + Eigen::Array3d(0.3183, 0.2718, 0.1414)).matrix() * grid.h;
   for (int d = 0; d < 3; ++d)
   {
-    grid.n[d] = static_cast<int>(std::ceil((high[d] - low[d]) / grid.h)) + 5;
+    grid.n[d] = static_cast<int>(std::ceil((high[d] - grid.origin[d]) / grid.h)) + 3;
   }
   std::vector<char> inside = InsideNodes(rest, grid);
   for (const TriangleMesh* obstacle : obstacles)
@@ -317,8 +377,8 @@ Field SolveField(
   {
     std::fill(field.fixed.begin(), field.fixed.end(), -1);
     std::vector<double> distance(size_t(grid.Size()), std::numeric_limits<double>::max());
-    MarkEnd(EndTriangles(rest, ends.origin), 0, reach * grid.h, grid, inside, field, distance);
-    MarkEnd(EndTriangles(rest, ends.insertion), 1, reach * grid.h, grid, inside, field, distance);
+    MarkEnd(EndTriangles(rest, ends.origin).corners, 0, reach * grid.h, grid, inside, field, distance);
+    MarkEnd(EndTriangles(rest, ends.insertion).corners, 1, reach * grid.h, grid, inside, field, distance);
     if (std::count(field.fixed.begin(), field.fixed.end(), 0) && std::count(field.fixed.begin(), field.fixed.end(), 1))
     {
       break;
@@ -511,11 +571,9 @@ std::vector<Eigen::Vector3d> LevelCrossings(const Field& field, double level)
   return crossings;
 }
 
-/// Seeds on the widest level set of the field (of the levels at the 10th, 20th, ... 90th
-/// percentile of phi over the inside, the one crossing the most grid edges: the muscle's belly,
-/// where next to a small tendon end the field is steep and its level sets small; every
-/// streamline from the origin to the insertion crosses each level once), spread by farthest
-/// point sampling (at most `count`).
+/// Seeds on the level set of the field's median over the inside (the muscle's belly: next to a
+/// small tendon end the field is steep and its level sets small; every streamline from the
+/// origin to the insertion crosses it once), spread by farthest point sampling (at most `count`).
 std::vector<Eigen::Vector3d> Seeds(const Field& field, size_t count)
 {
   std::vector<double> values;
@@ -526,17 +584,13 @@ std::vector<Eigen::Vector3d> Seeds(const Field& field, size_t count)
       values.push_back(field.At(node));
     }
   }
-  std::vector<Eigen::Vector3d> candidates;
-  std::sort(values.begin(), values.end());
-  for (int tenth = 1; tenth <= 9 && !values.empty(); ++tenth)
-  {
-    std::vector<Eigen::Vector3d> level = LevelCrossings(field, values[values.size() * size_t(tenth) / 10]);
-    if (level.size() > candidates.size())
-    {
-      candidates.swap(level);
-    }
-  }
   std::vector<Eigen::Vector3d> seeds;
+  if (values.empty())
+  {
+    return seeds;
+  }
+  std::nth_element(values.begin(), values.begin() + long(values.size() / 2), values.end());
+  const std::vector<Eigen::Vector3d> candidates = LevelCrossings(field, values[values.size() / 2]);
   if (candidates.empty())
   {
     return seeds;
@@ -591,6 +645,12 @@ std::vector<Eigen::Vector3d> Streamline(const Field& field, const Eigen::Vector3
     const bool sampled = field.Sample(x, value, gradient);
     if (sampled && progress(value) >= kArrived)
     {
+      // Ends where it crossed kArrived (between its last two points): not a step on.
+      if (line.size() >= 2 && progress(value) > last && last < kArrived)
+      {
+        const double t = (kArrived - last) / (progress(value) - last);
+        line.back() = line[line.size() - 2] + t * (line.back() - line[line.size() - 2]);
+      }
       return line;
     }
     if (!sampled || !(gradient.norm() > 0))
@@ -623,10 +683,6 @@ std::vector<Eigen::Vector3d> Streamline(const Field& field, const Eigen::Vector3
       x = 0.5 * (x + field.grid.Node(back));
     }
     line.push_back(x);
-    if (field.fixed[size_t(node)] == towards)
-    {
-      return line;
-    }
   }
   return {};
 }
@@ -655,40 +711,12 @@ Points Resample(const std::vector<Eigen::Vector3d>& line, int count)
   return points;
 }
 
-/// The point of the end's area nearest `from`, moved a little towards `from` until it is inside.
-template<class Free>
-std::optional<Eigen::Vector3d> EndPoint(
-  const std::vector<std::array<Eigen::Vector3d, 3>>& end, const Eigen::Vector3d& from, const Free& free)
-{
-  Eigen::Vector3d nearest = end.front()[0];
-  double best = std::numeric_limits<double>::max();
-  for (const auto& [a, b, c] : end)
-  {
-    const Eigen::Vector3d candidate = ClosestPointOnTriangle(from, a, b, c);
-    if ((candidate - from).squaredNorm() < best)
-    {
-      best = (candidate - from).squaredNorm();
-      nearest = candidate;
-    }
-  }
-  for (double share : { 0.05, 0.15, 0.3, 0.5, 0.8 })
-  {
-    const Eigen::Vector3d candidate = nearest + share * (from - nearest);
-    if (free(candidate))
-    {
-      return candidate;
-    }
-  }
-  return std::nullopt;
-}
-
-/// Whether x is on the outer side of `closest`, the point of the tree's surface nearest it: by
-/// the angle-weighted pseudo-normal of the feature the point lies on (the triangle, an edge or a
-/// corner; Baerentzen & Aanaes 2005), which decides the side exactly for a closed surface.
-/// `around` lists each point's triangles; without it (an obstacle), a point on an edge or a
-/// corner is decided by the parity of rays.
-bool OnOuterSide(const TriangleTree& tree, const TriangleTree::Closest& closest, const Eigen::Vector3d& x,
-  const std::vector<std::vector<Eigen::Index>>* around = nullptr)
+/// The outward angle-weighted pseudo-normal (Baerentzen & Aanaes 2005) at `closest`, the point of
+/// the tree's surface nearest some x, of the feature it lies on (the triangle, an edge or a
+/// corner): x - closest is along it outside and against it inside, for a closed surface.
+/// `around` lists each point's triangles; without it (an obstacle), none on an edge or a corner.
+std::optional<Eigen::Vector3d> OuterNormal(const TriangleTree& tree, const TriangleTree::Closest& closest,
+  const std::vector<std::vector<Eigen::Index>>* around)
 {
   const Triangles& triangles = tree.Mesh().triangles;
   const Points& points = tree.Mesh().points;
@@ -701,7 +729,7 @@ bool OnOuterSide(const TriangleTree& tree, const TriangleTree::Closest& closest,
   const Eigen::Index t = closest.triangle;
   const Eigen::Vector3d n = normal(t);
   const double area = n.squaredNorm();
-  const Eigen::Vector3d q = closest.point;
+  const Eigen::Vector3d& q = closest.point;
   std::array<double, 3> bary{};
   if (area > 0)
   {
@@ -713,11 +741,11 @@ bool OnOuterSide(const TriangleTree& tree, const TriangleTree::Closest& closest,
   const int onEdges = static_cast<int>(std::count_if(bary.begin(), bary.end(), [](double b) { return b <= kOnFeature; }));
   if (area > 0 && onEdges == 0)
   {
-    return (x - q).dot(n) > 0;
+    return n;
   }
   if (!around || !(area > 0))
   {
-    return !tree.Inside(x);
+    return std::nullopt;
   }
   Eigen::Vector3d pseudo = Eigen::Vector3d::Zero();
   if (onEdges == 1)
@@ -751,7 +779,14 @@ bool OnOuterSide(const TriangleTree& tree, const TriangleTree::Closest& closest,
       pseudo += angle * normal(other).normalized();
     }
   }
-  return (x - q).dot(pseudo) > 0;
+  return pseudo;
+}
+
+bool OnOuterSide(const TriangleTree& tree, const TriangleTree::Closest& closest, const Eigen::Vector3d& x,
+  const std::vector<std::vector<Eigen::Index>>* around = nullptr)
+{
+  const std::optional<Eigen::Vector3d> normal = OuterNormal(tree, closest, around);
+  return normal ? (x - closest.point).dot(*normal) > 0 : !tree.Inside(x);
 }
 
 /// Where x breaks the rules, if anywhere: the muscle's wall it is outside of, or the obstacle
@@ -762,8 +797,15 @@ struct Breach
   Eigen::Vector3d wall, obstacle;
 };
 
+/// An obstacle as a query needs it: the tree, and the motions to its pose and back.
+struct PlacedObstacle
+{
+  const TriangleTree* tree;
+  RigidTransform toNow, toTree;
+};
+
 Breach Check(const Eigen::Vector3d& x, double reach, const TriangleTree& muscle,
-  const std::vector<std::vector<Eigen::Index>>& around, const std::vector<const TriangleTree*>& obstacles)
+  const std::vector<std::vector<Eigen::Index>>& around, const std::vector<PlacedObstacle>& obstacles)
 {
   Breach breach;
   const TriangleTree::Closest wall = muscle.ClosestPoint(x, reach);
@@ -772,17 +814,18 @@ Breach Check(const Eigen::Vector3d& x, double reach, const TriangleTree& muscle,
     breach.outsideMuscle = true;
     breach.wall = wall.point;
   }
-  for (const TriangleTree* obstacle : obstacles)
+  for (const PlacedObstacle& obstacle : obstacles)
   {
-    if (!obstacle->InBounds(x))
+    const Eigen::Vector3d there = obstacle.toTree.Apply(x);
+    if (!obstacle.tree->InBounds(there))
     {
       continue;
     }
-    const TriangleTree::Closest bone = obstacle->ClosestPoint(x, reach);
-    if (bone.triangle >= 0 && !OnOuterSide(*obstacle, bone, x))
+    const TriangleTree::Closest bone = obstacle.tree->ClosestPoint(there, reach);
+    if (bone.triangle >= 0 && !OnOuterSide(*obstacle.tree, bone, there))
     {
       breach.insideObstacle = true;
-      breach.obstacle = bone.point;
+      breach.obstacle = obstacle.toNow.Apply(bone.point);
       break;
     }
   }
@@ -794,7 +837,7 @@ Breach Check(const Eigen::Vector3d& x, double reach, const TriangleTree& muscle,
 /// obstacle, half that out of it (the muscle may lie on it); where the muscle's wall lies closer
 /// to the obstacle than that, halfway between the two.
 int KeepInside(Eigen::Vector3d& x, double depth, double reach, const TriangleTree& muscle,
-  const std::vector<std::vector<Eigen::Index>>& around, const std::vector<const TriangleTree*>& obstacles)
+  const std::vector<std::vector<Eigen::Index>>& around, const std::vector<PlacedObstacle>& obstacles)
 {
   const Eigen::Vector3d carried = x;
   Breach breach = Check(x, reach, muscle, around, obstacles);
@@ -829,9 +872,13 @@ int KeepInside(Eigen::Vector3d& x, double depth, double reach, const TriangleTre
   return 2;
 }
 
-/// Mean value weights of `x` kept to `share` of their absolute sum (and to as many more as make
-/// the kept points span space: next to a flat part of the surface the largest weights are all
-/// on it), corrected so that the kept weights sum to 1 and reproduce x from the rest surface.
+/// Mean value weights of `x` with the smallest left out, continuously (a weight that crosses the
+/// threshold enters from nothing, so that the carried point does not jump under a small change of
+/// the input): the threshold tau is where the weights, largest first, reach `share` of their
+/// absolute sum (interpolated between two weights); a weight of at least 2 tau is kept whole, one
+/// between tau and 2 tau fades in smoothly, the rest is dropped. The kept points are as many more
+/// as make them span space (next to a flat part of the surface the largest weights are all on
+/// it). Last, the kept weights are corrected to sum to 1 and reproduce x from the rest surface.
 void KeepLargest(const Points& surface, const Eigen::Vector3d& x, const Eigen::RowVectorXd& weights, double share,
   std::vector<Eigen::Triplet<float, int>>& entries, Eigen::Index row)
 {
@@ -841,11 +888,31 @@ void KeepLargest(const Points& surface, const Eigen::Vector3d& x, const Eigen::R
     return std::abs(weights[a]) > std::abs(weights[b]) || (std::abs(weights[a]) == std::abs(weights[b]) && a < b);
   });
   const double total = weights.cwiseAbs().sum();
-  double kept = 0;
-  size_t count = 0;
-  while (count < order.size() && (kept < share * total || count < 4))
+  double tau = 0, cumulative = 0;
+  for (size_t i = 0; i < order.size(); ++i)
   {
-    kept += std::abs(weights[order[count++]]);
+    const double here = std::abs(weights[order[i]]);
+    if (cumulative + here >= share * total)
+    {
+      const double next = i + 1 < order.size() ? std::abs(weights[order[i + 1]]) : 0.0;
+      const double f = here > 0 ? (share * total - cumulative) / here : 0.0;
+      tau = here + f * (next - here);
+      break;
+    }
+    cumulative += here;
+  }
+  const auto fade = [&](double size) {
+    if (size >= 2 * tau)
+    {
+      return 1.0;
+    }
+    const double t = tau > 0 ? std::clamp(size / tau - 1, 0.0, 1.0) : 1.0;
+    return t * t * (3 - 2 * t);
+  };
+  size_t count = 0;
+  while (count < order.size() && (std::abs(weights[order[count]]) > tau || count < 4))
+  {
+    ++count;
   }
   // Constraints sum w (v - x) / size = 0 and sum w = 1 on the kept points.
   const double size = (surface.rowwise() - x.transpose()).rowwise().norm().maxCoeff();
@@ -874,7 +941,7 @@ void KeepLargest(const Points& surface, const Eigen::Vector3d& x, const Eigen::R
   Eigen::VectorXd w(static_cast<Eigen::Index>(count));
   for (size_t i = 0; i < count; ++i)
   {
-    w[Eigen::Index(i)] = weights[order[i]];
+    w[Eigen::Index(i)] = weights[order[i]] * fade(std::abs(weights[order[i]]));
   }
   const Eigen::Vector4d residual = Eigen::Vector4d(0, 0, 0, 1) - constraint * w;
   w += constraint.transpose() * (constraint * constraint.transpose()).ldlt().solve(residual);
@@ -883,6 +950,7 @@ void KeepLargest(const Points& surface, const Eigen::Vector3d& x, const Eigen::R
     entries.emplace_back(static_cast<int>(row), static_cast<int>(order[i]), static_cast<float>(w[Eigen::Index(i)]));
   }
 }
+
 }
 
 FibreEnds FindFibreEnds(
@@ -956,18 +1024,18 @@ FibreEnds FindFibreEnds(
   return ends;
 }
 
-MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& ends, const FibreParameters& parameters,
+MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& given, const FibreParameters& parameters,
   const std::vector<const TriangleMesh*>& obstacles)
 {
-  if (ends.origin.empty() || ends.insertion.empty())
+  if (given.origin.empty() || given.insertion.empty())
   {
     throw InputError("the fibres need an origin and an insertion");
   }
-  if (parameters.count < 1 || parameters.pointsPerFibre < 2)
+  if (parameters.count < 1 || parameters.pointsPerFibre < 3)
   {
-    throw InputError("the fibres need a count of at least 1 and at least 2 points each");
+    throw InputError("the fibres need a count of at least 1 and at least 3 points each");
   }
-  const Field field = SolveField(rest, ends, parameters.gridNodes, obstacles);
+  const Field field = SolveField(rest, given, parameters.gridNodes, obstacles);
   const TriangleTree tree(rest);
   std::vector<TriangleTree> obstacleTrees;
   for (const TriangleMesh* obstacle : obstacles)
@@ -982,7 +1050,8 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& ends, cons
   };
   const double longest = BoxDiagonal(rest.points);
   const auto wanted = size_t(parameters.count);
-  const auto origin = EndTriangles(rest, ends.origin), insertion = EndTriangles(rest, ends.insertion);
+  const EndSurface origin = EndTriangles(rest, given.origin), insertion = EndTriangles(rest, given.insertion);
+  std::vector<std::array<FibreEnd, 2>> ends; // per fibre, how each end is carried
   std::vector<Points> fibres;
   // Three times the seeds asked for: a streamline that stalls or leaves the muscle is replaced.
   for (const Eigen::Vector3d& seed : Seeds(field, 3 * wanted))
@@ -999,23 +1068,38 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& ends, cons
     }
     std::reverse(line.begin(), line.end()); // from the origin to the seed, then on to the insertion
     line.insert(line.end(), up.begin() + 1, up.end());
-    const auto first = EndPoint(origin, line.front(), free);
-    const auto last = EndPoint(insertion, line.back(), free);
-    if (!first || !last)
-    {
-      continue;
-    }
-    line.insert(line.begin(), *first);
-    line.push_back(*last);
-    Points fibre = Resample(line, parameters.pointsPerFibre);
+    // The inner points at equal arc lengths; each end on the segment from its area's point
+    // nearest the fibre's next point to that point, halfway (or farther in, to be inside).
+    const Points innerPoints = Resample(line, parameters.pointsPerFibre - 2);
+    Points fibre(parameters.pointsPerFibre, 3);
+    fibre.middleRows(1, parameters.pointsPerFibre - 2) = innerPoints;
+    std::array<FibreEnd, 2> closing;
     bool inside = true;
-    for (Eigen::Index p = 0; p < fibre.rows() && inside; ++p)
+    for (int side = 0; side < 2 && inside; ++side)
+    {
+      const Eigen::Vector3d next = innerPoints.row(side == 0 ? 0 : innerPoints.rows() - 1).transpose();
+      closing[size_t(side)].anchor = NearestAnchor(side == 0 ? origin : insertion, next);
+      inside = false;
+      for (double share : { 0.5, 0.7, 0.9 })
+      {
+        const Eigen::Vector3d end = closing[size_t(side)].anchor.point + share * (next - closing[size_t(side)].anchor.point);
+        if (free(end))
+        {
+          closing[size_t(side)].share = share;
+          fibre.row(side == 0 ? 0 : parameters.pointsPerFibre - 1) = end.transpose();
+          inside = true;
+          break;
+        }
+      }
+    }
+    for (Eigen::Index p = 1; p + 1 < fibre.rows() && inside; ++p)
     {
       inside = free(fibre.row(p).transpose());
     }
     if (inside)
     {
       fibres.push_back(std::move(fibre));
+      ends.push_back(closing);
     }
   }
   if (fibres.empty())
@@ -1034,12 +1118,54 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& ends, cons
   {
     this->RestPoints.middleRows(Eigen::Index(f) * this->PerFibre, this->PerFibre) = fibres[f];
   }
-  const WeightMatrix dense = MeanValueCoordinates(rest, this->RestPoints);
-  std::vector<Eigen::Triplet<float, int>> entries;
+  // Inner points by their mean value weights (sparse); a fibre's ends, near the surface, as the
+  // point of the segment between the area's point (carried by its triangle's corners, exactly
+  // with the surface) and the next fibre point: the mean value weights of a point that near the
+  // surface are all on the few points around it, and a sparse row there would depend on their
+  // choice (on the input's rounding) many times over.
+  std::vector<Eigen::Index> inner;
   for (Eigen::Index p = 0; p < this->RestPoints.rows(); ++p)
   {
-    KeepLargest(
-      rest.points, this->RestPoints.row(p).transpose(), dense.row(p), parameters.keptWeightShare, entries, p);
+    if (p % this->PerFibre != 0 && p % this->PerFibre != this->PerFibre - 1)
+    {
+      inner.push_back(p);
+    }
+  }
+  Points innerPoints(static_cast<Eigen::Index>(inner.size()), 3);
+  for (size_t i = 0; i < inner.size(); ++i)
+  {
+    innerPoints.row(Eigen::Index(i)) = this->RestPoints.row(inner[i]);
+  }
+  const WeightMatrix dense = MeanValueCoordinates(rest, innerPoints);
+  std::vector<std::vector<Eigen::Triplet<float, int>>> rows(size_t(this->RestPoints.rows()));
+  for (size_t i = 0; i < inner.size(); ++i)
+  {
+    KeepLargest(rest.points, innerPoints.row(Eigen::Index(i)).transpose(), dense.row(Eigen::Index(i)),
+      parameters.keptWeightShare, rows[size_t(inner[i])], inner[i]);
+  }
+  for (int f = 0; f < this->Fibres; ++f)
+  {
+    for (int side = 0; side < 2; ++side)
+    {
+      // (1 - share) of the area's point (its triangle's corners) and share of the next point.
+      const FibreEnd& end = ends[size_t(f)][size_t(side)];
+      const Eigen::Index p = Eigen::Index(f) * this->PerFibre + (side == 0 ? 0 : this->PerFibre - 1);
+      const Eigen::Index next = side == 0 ? p + 1 : p - 1;
+      for (int c = 0; c < 3; ++c)
+      {
+        rows[size_t(p)].emplace_back(static_cast<int>(p), static_cast<int>(end.anchor.ids[size_t(c)]),
+          static_cast<float>((1 - end.share) * end.anchor.weights[c]));
+      }
+      for (const auto& w : rows[size_t(next)])
+      {
+        rows[size_t(p)].emplace_back(static_cast<int>(p), w.col(), static_cast<float>(end.share * w.value()));
+      }
+    }
+  }
+  std::vector<Eigen::Triplet<float, int>> entries;
+  for (const auto& row : rows)
+  {
+    entries.insert(entries.end(), row.begin(), row.end());
   }
   this->RestTriangles = rest.triangles;
   this->Around.assign(size_t(rest.points.rows()), {});
@@ -1069,9 +1195,42 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& ends, cons
   this->Weights.setFromTriplets(entries.begin(), entries.end());
 }
 
-Points MuscleFibres::At(
-  const Points& surface, const std::vector<const TriangleTree*>& obstacles, std::pair<int, int>* kept) const
+std::optional<RigidTransform> RigidMotionOf(const Points& rest, const Points& now, double tolerance)
 {
+  if (rest.rows() != now.rows() || rest.rows() == 0)
+  {
+    return std::nullopt;
+  }
+  // Fitted to a few hundred points spread over the surface, then checked at every point.
+  const Eigen::Index stride = std::max<Eigen::Index>(1, rest.rows() / 500);
+  const Eigen::Index sampled = (rest.rows() + stride - 1) / stride;
+  Points from(sampled, 3), to(sampled, 3);
+  for (Eigen::Index i = 0; i < sampled; ++i)
+  {
+    from.row(i) = rest.row(i * stride);
+    to.row(i) = now.row(i * stride);
+  }
+  const RigidTransform motion = FitRigidTransform(from, to).transform;
+  const double squared = tolerance * tolerance;
+  for (Eigen::Index p = 0; p < rest.rows(); ++p)
+  {
+    if (!((motion.rotation * rest.row(p).transpose() + motion.translation - now.row(p).transpose()).squaredNorm() <=
+          squared))
+    {
+      return std::nullopt;
+    }
+  }
+  return motion;
+}
+
+Points MuscleFibres::At(
+  const Points& surface, const std::vector<FibreObstacle>& given, std::pair<int, int>* kept) const
+{
+  std::vector<PlacedObstacle> obstacles;
+  for (const FibreObstacle& o : given)
+  {
+    obstacles.push_back({ o.tree, o.toNow, Inverse(o.toNow) });
+  }
   Points points(this->Weights.rows(), 3);
 #pragma omp parallel for schedule(static)
   for (Eigen::Index p = 0; p < points.rows(); ++p)

@@ -6,11 +6,13 @@
 
 #include "Common/Attachment.h"
 #include "Common/MeshTypes.h"
+#include "Geometry/RigidMotion.h"
 #include "Geometry/TriangleTree.h"
 
 #include <Eigen/SparseCore>
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -32,6 +34,19 @@ struct FibreParameters
   /// exactly. Keeps a frame's fibres a sparse product.
   double keptWeightShare = 0.99;
 };
+
+/// An obstacle the carried fibres keep out of: a tree of its surface in one pose, and the rigid
+/// motion from that pose to where it is now (identity: the tree is where it is). A bone that
+/// moves rigidly keeps its rest tree: no refit a frame.
+struct FibreObstacle
+{
+  const TriangleTree* tree = nullptr;
+  RigidTransform toNow;
+};
+
+/// The rigid motion taking `rest` to `now` (the same points), when `now` is one to within
+/// `tolerance` at every point; nullopt otherwise (or when the counts differ).
+std::optional<RigidTransform> RigidMotionOf(const Points& rest, const Points& now, double tolerance);
 
 /// The surface points each end of the fibres starts from: the origin's (nearer the action
 /// lines' first points) and the insertion's.
@@ -75,7 +90,7 @@ public:
   /// the surface or inside one of `obstacles` (the bones where they are now), moved back to
   /// its rest depth below the surface (at most kFibreClearance) or as far out of the obstacle.
   /// `kept` (optional) receives how many points were moved and how many could not be kept in.
-  Points At(const Points& surface, const std::vector<const TriangleTree*>& obstacles = {},
+  Points At(const Points& surface, const std::vector<FibreObstacle>& obstacles = {},
     std::pair<int, int>* kept = nullptr) const;
   /// Each fibre's length (its polyline's) of fibre points `points`.
   std::vector<double> Lengths(const Points& points) const;
