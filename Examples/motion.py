@@ -63,6 +63,7 @@ def lhdl_pipeline(data, motion_name):
     # The psoas's and the iliacus's via points go at 40 and 54 degrees of flexion: faded over 10
     # degrees, their lines, and the muscles, move continuously instead of jumping there.
     reader.ConditionalPointFade = CONDITIONAL_POINT_FADE
+    READERS[motion_name] = reader
     bones = lhdl.producer(lhdl.named_blocks([(n, lhdl.read_surface(folder, n)) for n in lhdl.BONES]),
                           "LHDL bones (rest pose)")
     muscles = lhdl.producer(lhdl.named_blocks([(n, lhdl.read_surface(folder, n)) for n in lhdl.MUSCLES]),
@@ -81,6 +82,7 @@ def lhdl_pipeline(data, motion_name):
 
 
 LANDMARKS = "attachment_areas_rp_mm.csv"
+READERS = {}  # motion name: the model reader playing it (its MomentArms table)
 CONDITIONAL_POINT_FADE = 10.0  # degrees
 # The data set's names for the muscles and the bones its landmarks lie on (the iliotibial tract's,
 # on the tibia, is on no bone of the scan and left out).
@@ -293,9 +295,9 @@ def moment_arm_plots(motion, reader, data, motion_name, folder):
                  "fibres, median": ((0.1, 0.6, 0.1), 4, "1"), "fibres, min": ((0.1, 0.6, 0.1), 1, "2"),
                  "fibres, max": ((0.1, 0.6, 0.1), 1, "2"),
                  "Modenese & Kohout 2020 fibres, median": ((0.15, 0.35, 0.85), 3, "1")}
-        paths = [n for n in series if n.endswith("(straight path)")]
-        for i, name in enumerate(paths):
-            shade = i / max(1, len(paths) - 1)
+        straight = [n for n in series if n.endswith("(straight path)")]
+        for i, name in enumerate(straight):
+            shade = i / max(1, len(straight) - 1)
             style[name] = ((0.95 - 0.4 * shade, 0.55 - 0.3 * shade, 0.1), 2, "3")
         display.SeriesColor = [x for name in series for x in [name] + ["%g" % c for c in style[name][0]]]
         display.SeriesLineThickness = [x for name in series for x in (name, str(style[name][1]))]
@@ -439,7 +441,7 @@ def run_case(name, motion, camera, output, every, landmarks=None):
     if slip:
         figures["largest_landmark_slip_mm"] = slip.worst
         figures["landmark_probes"] = len(slip.probes)
-        reader = simple.FindSource("LHDL_hip_r.osim")
+        reader = READERS[name[len("lhdl_"):]]
         data = os.path.dirname(os.path.dirname(landmarks))
         inside, arm_plots = moment_arm_plots(motion, reader, data, name[len("lhdl_"):], folder)
         figures["moment_arm_inside_blemker2005_percent"] = inside

@@ -2,9 +2,9 @@
 #include "MDFibres.h"
 
 #include "Anatomy/TendonExcursion.h"
+#include "Geometry/MeshChecks.h"
 #include "MDBlocks.h"
 #include "MDConvert.h"
-#include "Geometry/MeshChecks.h"
 
 #include <vtkAlgorithm.h>
 #include <vtkCellArray.h>
@@ -108,8 +108,8 @@ std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, 
     }
     catch (const md::Error& e)
     {
-      vtkOutputWindow::GetInstance()->DisplayWarningText((filterName + " (" + filter->GetClassName() +
-        "): muscle '" + muscles[m].name + "' has no fibres: " + e.what() + "\n")
+      vtkOutputWindow::GetInstance()->DisplayWarningText((filterName + " (" + filter->GetClassName() + "): muscle '" +
+        muscles[m].name + "' has no fibres: " + e.what() + "\n")
                                                            .c_str());
     }
   }
@@ -119,8 +119,8 @@ std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, 
 
 std::vector<std::string> LineNames(vtkPolyData* lines, const std::string& muscle, size_t count)
 {
-  auto* given = lines ? vtkStringArray::SafeDownCast(lines->GetCellData()->GetAbstractArray(array::ActionLineName))
-                      : nullptr;
+  auto* given =
+    lines ? vtkStringArray::SafeDownCast(lines->GetCellData()->GetAbstractArray(array::ActionLineName)) : nullptr;
   const vtkIdType first = lines ? lines->GetNumberOfVerts() : 0;
   std::vector<std::string> names;
   for (size_t l = 0; l < count; ++l)
@@ -176,8 +176,7 @@ vtkSmartPointer<vtkPolyData> FibrePolylines(const md::Points& points, int perFib
 }
 
 void WriteMomentArms(const std::vector<FrameLengths>& frames, const PoseCoordinates& coordinates,
-  const std::vector<std::string>& muscleNames, const std::vector<std::vector<std::string>>& lineNames,
-  vtkTable* table)
+  const std::vector<std::string>& muscleNames, const std::vector<std::vector<std::string>>& lineNames, vtkTable* table)
 {
   const auto column = [&](const std::string& name) {
     vtkNew<vtkDoubleArray> array;
@@ -192,7 +191,8 @@ void WriteMomentArms(const std::vector<FrameLengths>& frames, const PoseCoordina
   for (size_t c = 0; c < coordinates.names.size(); ++c)
   {
     const bool moves = std::any_of(frames.begin(), frames.end(), [&](const FrameLengths& f) {
-      return c < f.coordinates.size() && std::abs(f.coordinates[c] - frames.front().coordinates[c]) > md::kCoordinateMoves;
+      return c < f.coordinates.size() &&
+        std::abs(f.coordinates[c] - frames.front().coordinates[c]) > md::kCoordinateMoves;
     });
     if (coordinates.rotational[c] && moves)
     {
@@ -272,12 +272,12 @@ void WriteMomentArms(const std::vector<FrameLengths>& frames, const PoseCoordina
     {
       const std::string& line = lineNames[m][l];
       vtkDoubleArray* length = column("Length(" + line + ")");
-      const auto arms = armsOf([&](size_t k) {
-        return l < frames[k].lineLengths[m].size() ? frames[k].lineLengths[m][l] : kNaN;
-      });
+      const auto arms =
+        armsOf([&](size_t k) { return l < frames[k].lineLengths[m].size() ? frames[k].lineLengths[m][l] : kNaN; });
       for (size_t k = 0; k < frames.size(); ++k)
       {
-        length->SetValue(static_cast<vtkIdType>(k), l < frames[k].lineLengths[m].size() ? frames[k].lineLengths[m][l] : kNaN);
+        length->SetValue(
+          static_cast<vtkIdType>(k), l < frames[k].lineLengths[m].size() ? frames[k].lineLengths[m][l] : kNaN);
       }
       for (size_t i = 0; i < moving.size(); ++i)
       {

@@ -72,6 +72,5 @@ struct FrameLengths
 /// smallest and largest length and moment arm about each of those coordinates, then each
 /// action line's length and moment arm (md::MomentArmsAlongMotion; per fibre, then over fibres).
 void WriteMomentArms(const std::vector<FrameLengths>& frames, const PoseCoordinates& coordinates,
-  const std::vector<std::string>& muscleNames, const std::vector<std::vector<std::string>>& lineNames,
-  vtkTable* table);
+  const std::vector<std::string>& muscleNames, const std::vector<std::vector<std::string>>& lineNames, vtkTable* table);
 }

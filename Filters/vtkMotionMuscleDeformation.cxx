@@ -1,23 +1,23 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkMotionMuscleDeformation.h"
 
+#include "Anatomy/MuscleFibres.h"
+#include "Anatomy/TendonExcursion.h"
 #include "MDAttachments.h"
 #include "MDBlocks.h"
 #include "MDConvert.h"
+#include "MDFibres.h"
 #include "MDReport.h"
 #include "MDTime.h"
-#include "Anatomy/MuscleFibres.h"
-#include "Anatomy/TendonExcursion.h"
-#include "MDFibres.h"
 #include "Method/InterpolatedDeformation.h"
 #include "Method/MotionDeformation.h"
 
+#include <vtkCompositeDataSet.h>
 #include <vtkDemandDrivenPipeline.h>
 #include <vtkDoubleArray.h>
 #include <vtkExecutive.h>
 #include <vtkFieldData.h>
 #include <vtkInformation.h>
-#include <vtkCompositeDataSet.h>
 #include <vtkInformationVector.h>
 #include <vtkMultiBlockDataSet.h>
 #include <vtkObjectFactory.h>
@@ -61,8 +61,8 @@ struct vtkMotionMuscleDeformation::Signature
     return restInputs == o.restInputs && motionPipeline == o.motionPipeline && times == o.times &&
       numberOfSteps == o.numberOfSteps && maximumStepDisplacement == o.maximumStepDisplacement &&
       interpolationMode == o.interpolationMode && deformableShare == o.deformableShare &&
-      preserveVolume == o.preserveVolume && attachmentAreas == o.attachmentAreas && attachmentFile == o.attachmentFile &&
-      numberOfFibres == o.numberOfFibres;
+      preserveVolume == o.preserveVolume && attachmentAreas == o.attachmentAreas &&
+      attachmentFile == o.attachmentFile && numberOfFibres == o.numberOfFibres;
   }
 };
 
@@ -123,16 +123,16 @@ struct vtkMotionMuscleDeformation::Internals
   std::string attachmentReport; ///< GetAttachmentReport
   std::unique_ptr<md::MotionDeformation> deformation;
   md::RestMappingCache kept;
-  std::vector<size_t> blockOf;                    // muscle block of each muscle given to the core
-  std::map<size_t, std::string> failedBlocks;     // muscle blocks left out, and why
-  std::vector<size_t> boneLeaf;                   // BonesRest leaf of each bone
-  std::vector<md::Points> restPoints;             // [muscle given]: as given, in the data's coordinates
-  std::vector<std::vector<md::Points>> restLines; // [muscle given]
-  std::vector<std::unique_ptr<md::MuscleFibres>> fibres; // [muscle given]; null: none
-  std::vector<md::TriangleTree> boneTrees;               // the bones' in the rest pose
+  std::vector<size_t> blockOf;                              // muscle block of each muscle given to the core
+  std::map<size_t, std::string> failedBlocks;               // muscle blocks left out, and why
+  std::vector<size_t> boneLeaf;                             // BonesRest leaf of each bone
+  std::vector<md::Points> restPoints;                       // [muscle given]: as given, in the data's coordinates
+  std::vector<std::vector<md::Points>> restLines;           // [muscle given]
+  std::vector<std::unique_ptr<md::MuscleFibres>> fibres;    // [muscle given]; null: none
+  std::vector<md::TriangleTree> boneTrees;                  // the bones' in the rest pose
   std::vector<std::unique_ptr<md::TriangleTree>> boneMoved; // a bone's refitted to a frame's, where not rigid
   std::vector<md::Points> boneRest;
-  mdvtk::PoseCoordinates coordinates;                    // named at the first frame
+  mdvtk::PoseCoordinates coordinates; // named at the first frame
   std::map<int, FrameKept> frames;
   std::map<int, FrameMeasures> measures;
   int gather = -1;      ///< the frame the time-varying inputs are asked for; -1: none
@@ -258,14 +258,15 @@ struct vtkMotionMuscleDeformation::Internals
   }
   /// The fibres where the frame's muscles are (kept inside them and out of the bones), their
   /// lengths, and the action lines' lengths.
-  void CarryFibres(const md::MotionPose& pose, const std::vector<md::Points>& points, FrameKept& kept,
-    FrameMeasures& measures)
+  void CarryFibres(
+    const md::MotionPose& pose, const std::vector<md::Points>& points, FrameKept& kept, FrameMeasures& measures)
   {
     const bool anyFibres = std::any_of(this->fibres.begin(), this->fibres.end(), [](const auto& f) { return !!f; });
     std::vector<md::FibreObstacle> obstacles;
     for (size_t b = 0; b < this->boneTrees.size() && anyFibres; ++b)
     {
-      obstacles.push_back(mdvtk::BoneWhereItIs(this->boneTrees[b], this->boneMoved[b], this->boneRest[b], pose.bones[b]));
+      obstacles.push_back(
+        mdvtk::BoneWhereItIs(this->boneTrees[b], this->boneMoved[b], this->boneRest[b], pose.bones[b]));
     }
     kept.fibres.resize(this->blockOf.size());
     measures.fibreLengths.resize(this->blockOf.size());
@@ -979,8 +980,8 @@ void vtkMotionMuscleDeformation::WriteMomentArms(const Leaves& leaves, vtkTable*
   {
     const std::string muscle = mdvtk::NameOf(leaves.muscles[in.blockOf[m]]);
     muscleNames.push_back(in.deformation->Failures()[m].empty() ? muscle : std::string());
-    lineNames.push_back(mdvtk::LineNames(leaves.restLines[leaves.restLinesOf[in.blockOf[m]]].data, muscle,
-      in.restLines[m].size()));
+    lineNames.push_back(
+      mdvtk::LineNames(leaves.restLines[leaves.restLinesOf[in.blockOf[m]]].data, muscle, in.restLines[m].size()));
   }
   // Failed muscles: no columns.
   for (size_t m = 0; m < muscleNames.size(); ++m)

@@ -156,8 +156,10 @@ std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(const MotionFrames& fr
 md::FibreParameters FibreSettings()
 {
   md::FibreParameters p;
-  if (const char* share = std::getenv("FIBRE_SHARE")) p.keptWeightShare = std::atof(share);
-  if (const char* n = std::getenv("FIBRE_POINTS")) p.pointsPerFibre = std::atoi(n);
+  if (const char* share = std::getenv("FIBRE_SHARE"))
+    p.keptWeightShare = std::atof(share);
+  if (const char* n = std::getenv("FIBRE_POINTS"))
+    p.pointsPerFibre = std::atoi(n);
   return p;
 }
 

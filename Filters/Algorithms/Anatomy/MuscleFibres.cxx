@@ -134,8 +134,8 @@ struct Field
 {
   Grid grid;
   std::vector<double> phi;
-  std::vector<signed char> fixed; ///< -1 free (or unused), 0 next to the origin, 1 next to the insertion
-  std::vector<char> used;         ///< inside the muscle, connected to both ends
+  std::vector<signed char> fixed;        ///< -1 free (or unused), 0 next to the origin, 1 next to the insertion
+  std::vector<char> used;                ///< inside the muscle, connected to both ends
   std::vector<Eigen::Vector3d> gradient; ///< per node: differences of phi over its used neighbours
 
   double At(Eigen::Index index) const { return this->phi[size_t(index)]; }
@@ -163,7 +163,9 @@ struct Field
     Eigen::Index best = -1;
     double nearest = std::numeric_limits<double>::max();
     for (int dk = -1; dk <= 1; ++dk)
+    {
       for (int dj = -1; dj <= 1; ++dj)
+      {
         for (int di = -1; di <= 1; ++di)
         {
           const int a = i + di, b = j + dj, c = k + dk;
@@ -179,6 +181,8 @@ struct Field
             best = other;
           }
         }
+      }
+    }
     return best;
   }
   /// phi and its gradient at x (both trilinear in the cell, the gradient from the nodes'
@@ -201,7 +205,9 @@ struct Field
     value = 0;
     direction.setZero();
     for (int dk = 0; dk < 2; ++dk)
+    {
       for (int dj = 0; dj < 2; ++dj)
+      {
         for (int di = 0; di < 2; ++di)
         {
           const Eigen::Index node = grid.Index(cell[0] + di, cell[1] + dj, cell[2] + dk);
@@ -213,6 +219,8 @@ struct Field
           value += w * this->phi[size_t(node)];
           direction += w * this->gradient[size_t(node)];
         }
+      }
+    }
     return true;
   }
 };
@@ -304,8 +312,8 @@ Anchor NearestAnchor(const EndSurface& end, const Eigen::Vector3d& x)
 }
 
 /// Marks the inside nodes within `radius` of the end's triangles with `label` (the nearer end wins).
-void MarkEnd(const std::vector<std::array<Eigen::Vector3d, 3>>& end, signed char label, double radius,
-  const Grid& grid, const std::vector<char>& inside, Field& field, std::vector<double>& distance)
+void MarkEnd(const std::vector<std::array<Eigen::Vector3d, 3>>& end, signed char label, double radius, const Grid& grid,
+  const std::vector<char>& inside, Field& field, std::vector<double>& distance)
 {
   for (const auto& [a, b, c] : end)
   {
@@ -318,7 +326,9 @@ void MarkEnd(const std::vector<std::array<Eigen::Vector3d, 3>>& end, signed char
       to[d] = std::min(grid.n[d] - 1, static_cast<int>(std::floor(high[d])));
     }
     for (int k = from[2]; k <= to[2]; ++k)
+    {
       for (int j = from[1]; j <= to[1]; ++j)
+      {
         for (int i = from[0]; i <= to[0]; ++i)
         {
           const Eigen::Index node = grid.Index(i, j, k);
@@ -333,6 +343,8 @@ void MarkEnd(const std::vector<std::array<Eigen::Vector3d, 3>>& end, signed char
             field.fixed[size_t(node)] = label;
           }
         }
+      }
+    }
   }
 }
 
@@ -484,7 +496,8 @@ Field SolveField(
   {
     if (used[size_t(node)])
     {
-      field.phi[size_t(node)] = unknown[size_t(node)] >= 0 ? solution[unknown[size_t(node)]] : field.fixed[size_t(node)];
+      field.phi[size_t(node)] =
+        unknown[size_t(node)] >= 0 ? solution[unknown[size_t(node)]] : field.fixed[size_t(node)];
     }
     else
     {
@@ -529,7 +542,7 @@ Field SolveField(
     const std::array<Eigen::Index, 6> around = grid.Neighbours(node);
     for (int d = 0; d < 3; ++d)
     {
-      const Eigen::Index below = around[size_t(2 * d)], above = around[size_t(2 * d + 1)];
+      const Eigen::Index below = around[2 * size_t(d)], above = around[2 * size_t(d) + 1];
       const bool hasBelow = below >= 0 && !std::isnan(field.phi[size_t(below)]);
       const bool hasAbove = above >= 0 && !std::isnan(field.phi[size_t(above)]);
       const double here = field.phi[size_t(node)];
@@ -633,7 +646,9 @@ std::vector<Eigen::Vector3d> Streamline(const Field& field, const Eigen::Vector3
   const double step = field.grid.h / 2;
   const double sign = towards == 1 ? 1.0 : -1.0;
   // Progress towards the end: phi going up to 1, or down to 0.
-  const auto progress = [&](double value) { return towards == 1 ? value : 1 - value; };
+  const auto progress = [&](double value) {
+    return towards == 1 ? value : 1 - value;
+  };
   const int most = static_cast<int>(std::ceil(4 * longest / step));
   std::vector<Eigen::Vector3d> line{ seed };
   Eigen::Vector3d x = seed;
@@ -715,8 +730,8 @@ Points Resample(const std::vector<Eigen::Vector3d>& line, int count)
 /// the tree's surface nearest some x, of the feature it lies on (the triangle, an edge or a
 /// corner): x - closest is along it outside and against it inside, for a closed surface.
 /// `around` lists each point's triangles; without it (an obstacle), none on an edge or a corner.
-std::optional<Eigen::Vector3d> OuterNormal(const TriangleTree& tree, const TriangleTree::Closest& closest,
-  const std::vector<std::vector<Eigen::Index>>* around)
+std::optional<Eigen::Vector3d> OuterNormal(
+  const TriangleTree& tree, const TriangleTree::Closest& closest, const std::vector<std::vector<Eigen::Index>>* around)
 {
   const Triangles& triangles = tree.Mesh().triangles;
   const Points& points = tree.Mesh().points;
@@ -738,7 +753,8 @@ std::optional<Eigen::Vector3d> OuterNormal(const TriangleTree& tree, const Trian
     bary[2] = 1 - bary[0] - bary[1];
   }
   constexpr double kOnFeature = 1e-9;
-  const int onEdges = static_cast<int>(std::count_if(bary.begin(), bary.end(), [](double b) { return b <= kOnFeature; }));
+  const int onEdges =
+    static_cast<int>(std::count_if(bary.begin(), bary.end(), [](double b) { return b <= kOnFeature; }));
   if (area > 0 && onEdges == 0)
   {
     return n;
@@ -1044,9 +1060,9 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& given, con
   }
   // Inside the muscle and outside every obstacle.
   const auto free = [&](const Eigen::Vector3d& x) {
-    return tree.Inside(x) &&
-      std::none_of(obstacleTrees.begin(), obstacleTrees.end(),
-        [&](const TriangleTree& o) { return o.InBounds(x) && o.Inside(x); });
+    return tree.Inside(x) && std::none_of(obstacleTrees.begin(), obstacleTrees.end(), [&](const TriangleTree& o) {
+      return o.InBounds(x) && o.Inside(x);
+    });
   };
   const double longest = BoxDiagonal(rest.points);
   const auto wanted = size_t(parameters.count);
@@ -1082,7 +1098,8 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& given, con
       inside = false;
       for (double share : { 0.5, 0.7, 0.9 })
       {
-        const Eigen::Vector3d end = closing[size_t(side)].anchor.point + share * (next - closing[size_t(side)].anchor.point);
+        const Eigen::Vector3d end =
+          closing[size_t(side)].anchor.point + share * (next - closing[size_t(side)].anchor.point);
         if (free(end))
         {
           closing[size_t(side)].share = share;
@@ -1223,8 +1240,7 @@ std::optional<RigidTransform> RigidMotionOf(const Points& rest, const Points& no
   return motion;
 }
 
-Points MuscleFibres::At(
-  const Points& surface, const std::vector<FibreObstacle>& given, std::pair<int, int>* kept) const
+Points MuscleFibres::At(const Points& surface, const std::vector<FibreObstacle>& given, std::pair<int, int>* kept) const
 {
   std::vector<PlacedObstacle> obstacles;
   for (const FibreObstacle& o : given)

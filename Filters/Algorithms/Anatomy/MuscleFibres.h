@@ -26,9 +26,9 @@ constexpr double kFibreClearance = 0.25;
 
 struct FibreParameters
 {
-  int count = 100;          ///< fibres per muscle
-  int pointsPerFibre = 13;  ///< points of each fibre's polyline, its ends included
-  int gridNodes = 20000;    ///< about this many grid nodes inside the muscle carry the field
+  int count = 100;         ///< fibres per muscle
+  int pointsPerFibre = 13; ///< points of each fibre's polyline, its ends included
+  int gridNodes = 20000;   ///< about this many grid nodes inside the muscle carry the field
   /// Share of the mean value weights (by absolute size) each fibre point keeps; the rest, the
   /// far surface's, is dropped and the kept weights are corrected to reproduce every affine map
   /// exactly. Keeps a frame's fibres a sparse product.
@@ -90,8 +90,8 @@ public:
   /// the surface or inside one of `obstacles` (the bones where they are now), moved back to
   /// its rest depth below the surface (at most kFibreClearance) or as far out of the obstacle.
   /// `kept` (optional) receives how many points were moved and how many could not be kept in.
-  Points At(const Points& surface, const std::vector<FibreObstacle>& obstacles = {},
-    std::pair<int, int>* kept = nullptr) const;
+  Points At(
+    const Points& surface, const std::vector<FibreObstacle>& obstacles = {}, std::pair<int, int>* kept = nullptr) const;
   /// Each fibre's length (its polyline's) of fibre points `points`.
   std::vector<double> Lengths(const Points& points) const;
   /// What was said while making them (fewer fibres than asked for).

@@ -115,9 +115,8 @@ TEST(MuscleFibres, InACylinderTheyRunStraightFromCapToCap)
   double nearest = radius, farthest = 0;
   for (int f = 0; f < fibres.Count(); ++f)
   {
-    const double r = rest.row(Eigen::Index(f) * parameters.pointsPerFibre + parameters.pointsPerFibre / 2)
-                       .head<2>()
-                       .norm();
+    const double r =
+      rest.row(Eigen::Index(f) * parameters.pointsPerFibre + parameters.pointsPerFibre / 2).head<2>().norm();
     nearest = std::min(nearest, r);
     farthest = std::max(farthest, r);
   }
