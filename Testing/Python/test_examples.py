@@ -88,9 +88,12 @@ class MotionExample(unittest.TestCase):
             self.assertGreater(non_white_fraction(picture), 0.01, picture)
         with open(os.path.join(folder, "phantom.pvd")) as f:
             series = f.read()
-        self.assertEqual(series.count("<DataSet "), 32)  # the muscles and the bones at every frame
-        for name in ("phantom_muscles_015.vtm", "phantom_bones_015.vtm"):
+        self.assertEqual(series.count("<DataSet "), 48)  # the muscles, the bones and the fibres at every frame
+        for name in ("phantom_muscles_015.vtm", "phantom_bones_015.vtm", "phantom_fibres_015.vtm"):
             self.assertTrue(os.path.isfile(os.path.join(folder, name)), name)
+        # The fibres inside their muscles and out of the bones at every frame (VTK's own test).
+        self.assertEqual(sum(figures["fibre_points_outside_muscle"].values()), 0)
+        self.assertEqual(sum(figures["fibre_points_inside_bone"].values()), 0)
         self.assertEqual(len(figures["measures"]["Time"]), 16)
 
 
