@@ -62,16 +62,6 @@ std::vector<double> ReadCoordinates(vtkDataObject* bones, PoseCoordinates& names
   return values;
 }
 
-double PolylineLength(const md::Points& line)
-{
-  double length = 0;
-  for (Eigen::Index p = 1; p < line.rows(); ++p)
-  {
-    length += (line.row(p) - line.row(p - 1)).norm();
-  }
-  return length;
-}
-
 std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, const std::string& filterName,
   int count, const std::vector<md::MotionDeformation::Muscle>& muscles,
   const std::vector<md::MotionDeformation::Bone>& bones, const std::vector<char>& failed)

@@ -34,9 +34,6 @@ struct PoseCoordinates
 /// one), NaN for one it lacks; with `names` empty, names them first (none: no coordinates).
 std::vector<double> ReadCoordinates(vtkDataObject* bones, PoseCoordinates& names);
 
-/// The length of a polyline.
-double PolylineLength(const md::Points& line);
-
 /// Each muscle's fibres (`count` of them; 0: none), made in the rest pose between its attachment
 /// areas (or its ends along its lines) and out of the bones; a muscle whose fibres cannot be made
 /// gets none and a warning naming it. Says in the output messages what was made (`filterName`

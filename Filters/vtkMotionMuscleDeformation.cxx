@@ -3,6 +3,7 @@
 
 #include "Anatomy/MuscleFibres.h"
 #include "Anatomy/TendonExcursion.h"
+#include "Geometry/Polyline.h"
 #include "MDAttachments.h"
 #include "MDBlocks.h"
 #include "MDConvert.h"
@@ -275,7 +276,7 @@ struct vtkMotionMuscleDeformation::Internals
     {
       for (const md::Points& line : pose.lines[m])
       {
-        measures.lineLengths[m].push_back(mdvtk::PolylineLength(line));
+        measures.lineLengths[m].push_back(md::PolylineLength(line));
       }
       if (this->fibres[m] && points[m].rows() > 0)
       {

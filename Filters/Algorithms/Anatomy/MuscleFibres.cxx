@@ -3,6 +3,7 @@
 
 #include "Geometry/MeanValueCoordinates.h"
 #include "Geometry/MeshChecks.h"
+#include "Geometry/Polyline.h"
 #include "Geometry/TriangleTree.h"
 
 #include <Eigen/Cholesky>
@@ -702,30 +703,6 @@ std::vector<Eigen::Vector3d> Streamline(const Field& field, const Eigen::Vector3
   return {};
 }
 
-/// `count` points at equal arc lengths along the polyline.
-Points Resample(const std::vector<Eigen::Vector3d>& line, int count)
-{
-  std::vector<double> at(line.size(), 0.0);
-  for (size_t i = 1; i < line.size(); ++i)
-  {
-    at[i] = at[i - 1] + (line[i] - line[i - 1]).norm();
-  }
-  Points points(count, 3);
-  size_t segment = 1;
-  for (int p = 0; p < count; ++p)
-  {
-    const double s = at.back() * p / (count - 1);
-    while (segment + 1 < line.size() && at[segment] < s)
-    {
-      ++segment;
-    }
-    const double span = at[segment] - at[segment - 1];
-    const double t = span > 0 ? std::clamp((s - at[segment - 1]) / span, 0.0, 1.0) : 0.0;
-    points.row(p) = ((1 - t) * line[segment - 1] + t * line[segment]).transpose();
-  }
-  return points;
-}
-
 /// The outward angle-weighted pseudo-normal (Baerentzen & Aanaes 2005) at `closest`, the point of
 /// the tree's surface nearest some x, of the feature it lies on (the triangle, an edge or a
 /// corner): x - closest is along it outside and against it inside, for a closed surface.
@@ -1086,7 +1063,7 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& given, con
     line.insert(line.end(), up.begin() + 1, up.end());
     // The inner points at equal arc lengths; each end on the segment from its area's point
     // nearest the fibre's next point to that point, halfway (or farther in, to be inside).
-    const Points innerPoints = Resample(line, parameters.pointsPerFibre - 2);
+    const Points innerPoints = ResampleByArcLength(line, parameters.pointsPerFibre - 2);
     Points fibre(parameters.pointsPerFibre, 3);
     fibre.middleRows(1, parameters.pointsPerFibre - 2) = innerPoints;
     std::array<FibreEnd, 2> closing;
@@ -1195,7 +1172,7 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& given, con
   }
   this->RestTree = std::make_shared<const TriangleTree>(tree);
   this->Depth.resize(this->RestPoints.rows());
-  this->Reach.resize(this->RestPoints.rows());
+  this->Reach = kEscapeReach * field.grid.h;
   for (Eigen::Index p = 0; p < this->RestPoints.rows(); ++p)
   {
     const Eigen::Vector3d x = this->RestPoints.row(p).transpose();
@@ -1206,7 +1183,6 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& given, con
       depth = nearest.triangle >= 0 ? nearest.distance : depth;
     }
     this->Depth[p] = std::min(depth, kFibreClearance * field.grid.h);
-    this->Reach[p] = kEscapeReach * field.grid.h;
   }
   this->Weights.resize(this->RestPoints.rows(), rest.points.rows());
   this->Weights.setFromTriplets(entries.begin(), entries.end());
@@ -1265,7 +1241,7 @@ Points MuscleFibres::At(const Points& surface, const std::vector<FibreObstacle>&
   for (Eigen::Index p = 0; p < points.rows(); ++p)
   {
     Eigen::Vector3d x = points.row(p).transpose();
-    const int result = KeepInside(x, this->Depth[p], this->Reach[p], tree, this->Around, obstacles);
+    const int result = KeepInside(x, this->Depth[p], this->Reach, tree, this->Around, obstacles);
     moved += result > 0;
     stuck += result > 1;
     points.row(p) = x.transpose();
@@ -1279,14 +1255,10 @@ Points MuscleFibres::At(const Points& surface, const std::vector<FibreObstacle>&
 
 std::vector<double> MuscleFibres::Lengths(const Points& points) const
 {
-  std::vector<double> lengths(size_t(this->Fibres), 0.0);
+  std::vector<double> lengths;
   for (int f = 0; f < this->Fibres; ++f)
   {
-    for (int p = 1; p < this->PerFibre; ++p)
-    {
-      const Eigen::Index at = Eigen::Index(f) * this->PerFibre + p;
-      lengths[size_t(f)] += (points.row(at) - points.row(at - 1)).norm();
-    }
+    lengths.push_back(PolylineLength(points.middleRows(Eigen::Index(f) * this->PerFibre, this->PerFibre)));
   }
   return lengths;
 }

@@ -109,7 +109,7 @@ private:
   std::shared_ptr<const TriangleTree> RestTree;
   std::vector<std::vector<Eigen::Index>> Around; ///< per surface point, its triangles
   Eigen::VectorXd Depth; ///< per fibre point: how deep it is put back (its rest clearance, at most kFibreClearance)
-  Eigen::VectorXd Reach; ///< per fibre point: how far from it the surfaces are searched
+  double Reach = 0;      ///< how far from a carried point the surfaces are searched
   /// Fibre points x surface points; single precision (a frame reads every weight: half the
   /// memory traffic; 1e-7 of a weight is far below the settle's tolerance).
   Eigen::SparseMatrix<float, Eigen::RowMajor, int> Weights;

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "OpenSim/OpenSimKinematics.h"
 
+#include "Geometry/Polyline.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -156,12 +158,7 @@ PathGeometry PathAt(const Model& model, const Path& path, const std::vector<doub
 
 double PolylineLength(const Points& points)
 {
-  double length = 0.0;
-  for (Eigen::Index i = 1; i < points.rows(); ++i)
-  {
-    length += (points.row(i) - points.row(i - 1)).norm();
-  }
-  return length;
+  return md::PolylineLength(points);
 }
 
 namespace

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Phantom/Phantom.h"
 
+#include "Geometry/Polyline.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -10,29 +12,16 @@ namespace
 {
 using Vec3 = Eigen::Vector3d;
 
+/// Points along `curve` at most `spacing` apart, at equal arc lengths.
 Points Resample(const std::vector<Vec3>& curve, double spacing)
 {
-  std::vector<double> s(curve.size(), 0.0);
+  double length = 0.0;
   for (size_t i = 1; i < curve.size(); ++i)
   {
-    s[i] = s[i - 1] + (curve[i] - curve[i - 1]).norm();
+    length += (curve[i] - curve[i - 1]).norm();
   }
-  const double length = s.back();
   const auto segments = std::max<Eigen::Index>(1, static_cast<Eigen::Index>(std::ceil(length / spacing)));
-  Points out(segments + 1, 3);
-  size_t k = 1;
-  for (Eigen::Index i = 0; i <= segments; ++i)
-  {
-    const double target = length * static_cast<double>(i) / static_cast<double>(segments);
-    while (k + 1 < curve.size() && s[k] < target)
-    {
-      ++k;
-    }
-    const double span = s[k] - s[k - 1];
-    const double f = span > 0 ? std::clamp((target - s[k - 1]) / span, 0.0, 1.0) : 0.0;
-    out.row(i) = ((1 - f) * curve[k - 1] + f * curve[k]).transpose();
-  }
-  return out;
+  return ResampleByArcLength(curve, segments + 1);
 }
 
 /// Smooth step from 0 (x <= a) to 1 (x >= b).
