@@ -126,8 +126,6 @@ struct FibreMeasures
   }
 };
 
-md::FibreParameters FibreSettings();
-
 /// Each muscle's fibres (MuscleFibres.h) between its areas, out of the bones; said when `say`.
 std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(const MotionFrames& frames, bool say)
 {
@@ -141,7 +139,7 @@ std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(const MotionFrames& fr
   {
     const auto made = std::chrono::steady_clock::now();
     const md::FibreEnds ends = md::FindFibreEnds(m.rest, m.attachments, m.restLines);
-    fibres.push_back(std::make_unique<md::MuscleFibres>(m.rest, ends, FibreSettings(), restBones));
+    fibres.push_back(std::make_unique<md::MuscleFibres>(m.rest, ends, md::FibreParameters{}, restBones));
     if (say)
     {
       std::printf("fibres of %s: %d from %s to %s, %.1f weights a point, made in %.2f s\n", m.name.c_str(),
@@ -151,16 +149,6 @@ std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(const MotionFrames& fr
     }
   }
   return fibres;
-}
-
-md::FibreParameters FibreSettings()
-{
-  md::FibreParameters p;
-  if (const char* share = std::getenv("FIBRE_SHARE"))
-    p.keptWeightShare = std::atof(share);
-  if (const char* n = std::getenv("FIBRE_POINTS"))
-    p.pointsPerFibre = std::atoi(n);
-  return p;
 }
 
 double LargestDistance(const md::Points& a, const md::Points& b)
