@@ -12,6 +12,7 @@
 #include <vtkDataArray.h>
 #include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
+#include <vtkIdTypeArray.h>
 #include <vtkNew.h>
 #include <vtkOutputWindow.h>
 #include <vtkPolyData.h>
@@ -21,6 +22,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 namespace mdvtk
 {
@@ -131,7 +133,7 @@ std::vector<std::string> LineNames(vtkPolyData* lines, const std::string& muscle
 md::FibreObstacle BoneWhereItIs(const md::TriangleTree& restTree, std::unique_ptr<md::TriangleTree>& moved,
   const md::Points& rest, const md::Points& now)
 {
-  if (const auto rigid = md::RigidMotionOf(rest, now, md::kOnSurfaceShare * md::BoxDiagonal(rest)))
+  if (const auto rigid = md::RigidMotionOf(rest, now, md::kRigidObstacleShare * md::BoxDiagonal(rest)))
   {
     return { &restTree, *rigid };
   }
@@ -147,18 +149,24 @@ vtkSmartPointer<vtkPolyData> FibrePolylines(const md::Points& points, int perFib
 {
   auto polylines = vtkSmartPointer<vtkPolyData>::New();
   polylines->SetPoints(ToVtkPoints(points));
-  vtkNew<vtkCellArray> cells;
+  // Written through raw pointers: ParaView's VTK is built unoptimised, and a call a point shows.
+  const auto fibres = static_cast<vtkIdType>(lengths.size());
+  vtkNew<vtkIdTypeArray> offsets, connectivity;
+  offsets->SetNumberOfTuples(fibres + 1);
+  connectivity->SetNumberOfTuples(fibres * perFibre);
+  vtkIdType* offset = offsets->GetPointer(0);
+  vtkIdType* point = connectivity->GetPointer(0);
   vtkNew<vtkDoubleArray> length;
   length->SetName(array::FibreLength);
-  for (size_t f = 0; f < lengths.size(); ++f)
+  length->SetNumberOfTuples(fibres);
+  for (vtkIdType f = 0; f <= fibres; ++f)
   {
-    cells->InsertNextCell(perFibre);
-    for (int p = 0; p < perFibre; ++p)
-    {
-      cells->InsertCellPoint(static_cast<vtkIdType>(f) * perFibre + p);
-    }
-    length->InsertNextValue(lengths[f]);
+    offset[f] = f * perFibre;
   }
+  std::iota(point, point + fibres * perFibre, vtkIdType(0));
+  std::copy(lengths.begin(), lengths.end(), length->GetPointer(0));
+  vtkNew<vtkCellArray> cells;
+  cells->SetData(offsets, connectivity);
   polylines->SetLines(cells);
   polylines->GetCellData()->AddArray(length);
   polylines->GetCellData()->SetActiveScalars(array::FibreLength);

@@ -46,9 +46,9 @@ std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, 
 /// "<muscle> line <i>" for several; `count` names.
 std::vector<std::string> LineNames(vtkPolyData* lines, const std::string& muscle, size_t count);
 
-/// A bone where it is now (`now`, its points) as an obstacle of the fibres: its rest tree and the
-/// rigid motion there when it moved rigidly (to 1e-9 of its size); else `moved`, a copy of the
-/// rest tree refitted to `now`.
+/// A bone where it is now (`now`, its points) as an obstacle of the fibres: its rest tree (and
+/// distance grid) and the rigid motion there when it moved rigidly (to md::kRigidObstacleShare of
+/// its size); else `moved`, a copy of the rest tree refitted to `now`.
 md::FibreObstacle BoneWhereItIs(const md::TriangleTree& restTree, std::unique_ptr<md::TriangleTree>& moved,
   const md::Points& rest, const md::Points& now);
 

@@ -744,6 +744,10 @@ bool vtkMotionMuscleDeformation::Start(const Leaves& leaves, vtkDataObject* land
   for (const md::MotionDeformation::Bone& bone : bones)
   {
     in.boneTrees.emplace_back(bone.rest);
+    if (std::any_of(in.fibres.begin(), in.fibres.end(), [](const auto& f) { return !!f; }))
+    {
+      in.boneTrees.back().BuildDistanceGrid(); // the fibres' test for a point inside a bone
+    }
     in.boneRest.push_back(bone.rest.points);
   }
   in.boneMoved.resize(bones.size());

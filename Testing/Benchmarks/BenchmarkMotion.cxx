@@ -51,21 +51,33 @@ struct FibreMeasures
   std::vector<std::vector<md::Points>> points;           ///< [frame][muscle]
   std::vector<double> seconds;                           ///< carrying and lengths, a frame
   long long moved = 0, stuck = 0;                        ///< fibre points kept in, over the motion
+  std::vector<md::TriangleTree> restTrees;               ///< the bones' at rest, with distance grids
 
   void Add(const std::vector<std::unique_ptr<md::MuscleFibres>>& fibres, const std::vector<md::Points>& muscles,
     const std::vector<md::Points>& bonesNow, const std::vector<md::MotionDeformation::Bone>& bones)
   {
+    // As the motion filter does: each bone's rest tree (with its distance grid), moved rigidly.
+    if (restTrees.empty())
+    {
+      for (const md::MotionDeformation::Bone& bone : bones)
+      {
+        restTrees.emplace_back(bone.rest);
+        restTrees.back().BuildDistanceGrid();
+      }
+    }
     std::vector<md::TriangleTree> boneTrees;
-    std::vector<md::FibreObstacle> obstacles;
     for (size_t b = 0; b < bones.size(); ++b)
     {
       boneTrees.emplace_back(md::TriangleMesh{ bonesNow[b], bones[b].rest.triangles });
     }
-    for (const md::TriangleTree& t : boneTrees)
-    {
-      obstacles.push_back({ &t, md::RigidTransform() });
-    }
     const auto start = std::chrono::steady_clock::now();
+    std::vector<md::FibreObstacle> obstacles;
+    for (size_t b = 0; b < bones.size(); ++b)
+    {
+      const auto rigid =
+        md::RigidMotionOf(bones[b].rest.points, bonesNow[b], md::kRigidObstacleShare * md::BoxDiagonal(bonesNow[b]));
+      obstacles.push_back(rigid ? md::FibreObstacle{ &restTrees[b], *rigid } : md::FibreObstacle{ &boneTrees[b], {} });
+    }
     std::vector<md::Points> carried;
     for (size_t m = 0; m < fibres.size(); ++m)
     {

@@ -29,6 +29,9 @@ constexpr double kNearEnd = 0.9;
 /// A carried fibre point outside its muscle (or inside a bone) is found when it is out by less
 /// than this many grid spacings (the search's radius: a point deeper inside costs little).
 constexpr double kEscapeReach = 1.5;
+/// A bone can poke into a muscle deeper than a fibre point strays out of it in a frame: an
+/// obstacle without a distance grid (a bone refitted to a frame) is searched this many times farther.
+constexpr double kObstacleReach = 3.0;
 /// Share of the muscle's extent along its lines that makes an end's cap where it has no area.
 constexpr double kCapShare = 0.05;
 
@@ -802,7 +805,11 @@ Breach Check(const Eigen::Vector3d& x, double reach, const TriangleTree& muscle,
 {
   Breach breach;
   const TriangleTree::Closest wall = muscle.ClosestPoint(x, reach);
-  if (wall.triangle >= 0 && OnOuterSide(muscle, wall, x, &around))
+  // The nearest wall's side decides locally, and cheaply; where the surface folds through itself
+  // it flips between two sheets under the slightest change of x, so an outside is confirmed by the
+  // winding number, which changes only where x crosses the surface.
+  if (wall.triangle >= 0 && OnOuterSide(muscle, wall, x, &around) &&
+    std::abs(WindingNumber(muscle.Mesh().points, muscle.Mesh().triangles, x)) < 0.5)
   {
     breach.outsideMuscle = true;
     breach.wall = wall.point;
@@ -814,7 +821,18 @@ Breach Check(const Eigen::Vector3d& x, double reach, const TriangleTree& muscle,
     {
       continue;
     }
-    const TriangleTree::Closest bone = obstacle.tree->ClosestPoint(there, reach);
+    // Searched as far as the point may be inside: by the obstacle's distance grid (none needed
+    // where it is surely outside), else a few reaches.
+    double radius = kObstacleReach * reach;
+    if (const auto bounds = obstacle.tree->SignedDistanceBounds(there))
+    {
+      if (bounds->first > 0)
+      {
+        continue;
+      }
+      radius = std::max(-bounds->first, bounds->second);
+    }
+    const TriangleTree::Closest bone = obstacle.tree->ClosestPoint(there, radius);
     if (bone.triangle >= 0 && !OnOuterSide(*obstacle.tree, bone, there))
     {
       breach.insideObstacle = true;
@@ -1223,16 +1241,23 @@ Points MuscleFibres::At(const Points& surface, const std::vector<FibreObstacle>&
   {
     obstacles.push_back({ o.tree, o.toNow, Inverse(o.toNow) });
   }
+  // Four lanes a point (the fourth zero), read through raw pointers: a frame reads every weight.
+  Eigen::Matrix<double, 4, Eigen::Dynamic> padded(4, surface.rows());
+  padded.topRows<3>() = surface.transpose();
+  padded.row(3).setZero();
   Points points(this->Weights.rows(), 3);
+  const float* values = this->Weights.valuePtr();
+  const int* columns = this->Weights.innerIndexPtr();
+  const int* starts = this->Weights.outerIndexPtr();
 #pragma omp parallel for schedule(static)
   for (Eigen::Index p = 0; p < points.rows(); ++p)
   {
-    Eigen::RowVector3d x = Eigen::RowVector3d::Zero();
-    for (Eigen::SparseMatrix<float, Eigen::RowMajor, int>::InnerIterator w(this->Weights, p); w; ++w)
+    Eigen::Array4d x = Eigen::Array4d::Zero();
+    for (int k = starts[p]; k < starts[p + 1]; ++k)
     {
-      x += static_cast<double>(w.value()) * surface.row(w.col());
+      x += static_cast<double>(values[k]) * padded.col(columns[k]).array();
     }
-    points.row(p) = x;
+    points.row(p) = x.head<3>().matrix().transpose();
   }
   TriangleTree tree = *this->RestTree;
   tree.Refit(surface);

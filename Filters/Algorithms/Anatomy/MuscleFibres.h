@@ -37,12 +37,19 @@ struct FibreParameters
 
 /// An obstacle the carried fibres keep out of: a tree of its surface in one pose, and the rigid
 /// motion from that pose to where it is now (identity: the tree is where it is). A bone that
-/// moves rigidly keeps its rest tree: no refit a frame.
+/// moves rigidly keeps its rest tree: no refit a frame. A tree with a distance grid
+/// (TriangleTree::BuildDistanceGrid) is searched only where a point may be inside it, as deep as
+/// it may be.
 struct FibreObstacle
 {
   const TriangleTree* tree = nullptr;
   RigidTransform toNow;
 };
+
+/// A bone that moved rigidly to within this share of its size is an obstacle of the fibres as its
+/// rest tree moved rigidly: far below their clearance, and above the rounding of points stored in
+/// single precision (6e-8), which would otherwise cost a refit and a slower search every frame.
+constexpr double kRigidObstacleShare = 1e-6;
 
 /// The rigid motion taking `rest` to `now` (the same points), when `now` is one to within
 /// `tolerance` at every point; nullopt otherwise (or when the counts differ).

@@ -171,8 +171,64 @@ void TriangleTree::Refit(const Points& points)
     throw InputError("TriangleTree::Refit needs the same number of points as the tree was built with");
   }
   this->Surface.points = points;
+  this->GridDistance.clear(); // the distances were the old surface's
   this->UpdateBoxes();
   this->Size = (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
+}
+
+void TriangleTree::BuildDistanceGrid(int nodes)
+{
+  this->GridDistance.clear();
+  if (!(this->Size > 0) || !std::isfinite(this->Size))
+  {
+    return; // a surface of one point (or none finite): no grid, the queries search
+  }
+  // A flat box gets a hundredth of the surface's size across, so that the cells stay few.
+  const Eigen::Vector3d box = (this->Nodes[0].high - this->Nodes[0].low).cwiseMax(0.01 * this->Size);
+  this->GridCell = std::cbrt(box.prod() / std::max(nodes, 8));
+  this->GridMargin = this->GridCell;
+  this->GridOrigin = this->Nodes[0].low - Eigen::Vector3d::Constant(this->GridMargin);
+  const Eigen::Vector3d extent = box + Eigen::Vector3d::Constant(2 * this->GridMargin);
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    this->GridCount[size_t(axis)] = static_cast<int>(std::ceil(extent[axis] / this->GridCell)) + 1;
+  }
+  const Eigen::Index total = Eigen::Index(this->GridCount[0]) * this->GridCount[1] * this->GridCount[2];
+  std::vector<float> distance(size_t(total), 0.0F);
+#pragma omp parallel for schedule(dynamic, 256)
+  for (Eigen::Index node = 0; node < total; ++node)
+  {
+    const Eigen::Index i = node % this->GridCount[0];
+    const Eigen::Index j = (node / this->GridCount[0]) % this->GridCount[1];
+    const Eigen::Index k = node / (Eigen::Index(this->GridCount[0]) * this->GridCount[1]);
+    const Eigen::Vector3d x = this->GridOrigin + this->GridCell * Eigen::Vector3d(double(i), double(j), double(k));
+    const double d = this->ClosestPoint(x).distance;
+    distance[size_t(node)] = static_cast<float>(this->Inside(x) ? -d : d);
+  }
+  this->GridDistance = std::move(distance);
+}
+
+std::optional<std::pair<double, double>> TriangleTree::SignedDistanceBounds(const Eigen::Vector3d& p) const
+{
+  if (this->GridDistance.empty())
+  {
+    return std::nullopt;
+  }
+  std::array<Eigen::Index, 3> at{};
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    const double u = std::round((p[axis] - this->GridOrigin[axis]) / this->GridCell);
+    if (!(u >= 0 && u < this->GridCount[size_t(axis)]))
+    {
+      return std::make_pair(this->GridMargin, std::numeric_limits<double>::infinity());
+    }
+    at[size_t(axis)] = static_cast<Eigen::Index>(u);
+  }
+  const Eigen::Vector3d node =
+    this->GridOrigin + this->GridCell * Eigen::Vector3d(double(at[0]), double(at[1]), double(at[2]));
+  const double slack = (p - node).norm() * (1 + 1e-6) + 1e-9 * this->GridCell; // the float's rounding too
+  const double d = this->GridDistance[size_t((at[2] * this->GridCount[1] + at[1]) * this->GridCount[0] + at[0])];
+  return std::make_pair(d - slack - 1e-6 * std::abs(d), d + slack + 1e-6 * std::abs(d));
 }
 
 void TriangleTree::UpdateBoxes()

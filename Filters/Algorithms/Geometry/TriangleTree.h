@@ -6,8 +6,10 @@
 
 #include "Common/MeshTypes.h"
 
+#include <array>
 #include <limits>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace md
@@ -50,6 +52,16 @@ public:
   Closest ClosestPoint(const Eigen::Vector3d& p, double within = std::numeric_limits<double>::max()) const;
 
   const TriangleMesh& Mesh() const { return this->Surface; }
+
+  /// Builds a coarse grid of the surface's signed distance (negative inside) at about `nodes`
+  /// nodes over its box grown by a cell, for SignedDistanceBounds: a query far from the
+  /// surface then learns its side without a search. A refit drops it; a surface with no extent
+  /// gets none.
+  void BuildDistanceGrid(int nodes = 32768);
+  /// Bounds on p's signed distance to the surface (negative inside), from the nearest node of
+  /// the distance grid give or take p's distance to that node (a distance changes no faster
+  /// than the point): {a cell, infinity} beyond the grid; nullopt without a grid.
+  std::optional<std::pair<double, double>> SignedDistanceBounds(const Eigen::Vector3d& p) const;
 
   /// Moves the surface's points (same triangles) and updates the boxes
   /// bottom-up: O(triangles), far cheaper than a rebuild, for obstacles that
@@ -104,6 +116,10 @@ private:
 
   TriangleMesh Surface;
   std::vector<Node> Nodes;
+  std::vector<float> GridDistance; ///< signed distance at each grid node, x fastest; empty: no grid
+  Eigen::Vector3d GridOrigin = Eigen::Vector3d::Zero();
+  double GridCell = 0, GridMargin = 0;
+  std::array<int, 3> GridCount{};
   std::vector<Eigen::Index> Order;
   /// Each leaf's points, once each: a refit reads each point about twice rather than six times.
   std::vector<Eigen::Index> LeafPoints;

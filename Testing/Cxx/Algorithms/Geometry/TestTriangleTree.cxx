@@ -160,3 +160,40 @@ TEST(TriangleTree, RefitAnswersLikeATreeBuiltOnTheMovedPoints)
   }
   EXPECT_THROW(refitted.Refit(moved.points.topRows(3)), md::InputError);
 }
+
+// The distance grid's bounds hold the true signed distance (negative inside, by the winding
+// number), at points near the surface and far from it, beyond the grid too; a refit drops it.
+TEST(TriangleTree, DistanceGridBoundsHoldTheSignedDistance)
+{
+  const md::TriangleMesh femur = Femur();
+  md::TriangleTree tree(femur);
+  EXPECT_FALSE(tree.SignedDistanceBounds(femur.points.row(0).transpose()).has_value());
+  tree.BuildDistanceGrid(4096);
+  std::mt19937 generator(5);
+  const double size = md::BoxDiagonal(femur.points);
+  int decided = 0;
+  for (int i = 0; i < 3000; ++i)
+  {
+    const Eigen::Vector3d p = RandomPoint(generator, femur, 0.2 * size);
+    const double distance = tree.ClosestPoint(p).distance;
+    const double signedDistance = md::WindingNumber(femur.points, femur.triangles, p) > 0.5 ? -distance : distance;
+    const auto bounds = tree.SignedDistanceBounds(p);
+    ASSERT_TRUE(bounds.has_value());
+    EXPECT_LE(bounds->first, signedDistance) << i;
+    EXPECT_GE(bounds->second, signedDistance) << i;
+    decided += bounds->first > 0 || bounds->second < 0; // the side known without a search
+  }
+  EXPECT_GT(decided, 2000);
+  tree.Refit(femur.points);
+  EXPECT_FALSE(tree.SignedDistanceBounds(femur.points.row(0).transpose()).has_value());
+}
+
+// A bone collapsed to one point (a fuzzed input) gets no grid rather than a grid of no cell size.
+TEST(TriangleTree, ASurfaceOfOnePointGetsNoDistanceGrid)
+{
+  md::TriangleMesh collapsed = Femur();
+  collapsed.points.rowwise() = collapsed.points.row(0);
+  md::TriangleTree tree(collapsed);
+  tree.BuildDistanceGrid();
+  EXPECT_FALSE(tree.SignedDistanceBounds(Eigen::Vector3d(1, 2, 3)).has_value());
+}
