@@ -1,20 +1,24 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkInterpolatedMuscleDeformation.h"
 
+#include "Anatomy/MuscleFibres.h"
 #include "Geometry/LocalFrame.h"
 #include "MDAttachments.h"
 #include "MDBlocks.h"
 #include "MDConvert.h"
+#include "MDFibres.h"
 #include "MDReport.h"
 #include "MDTime.h"
 #include "Method/InterpolatedDeformation.h"
 #include "Motion/ActionLineMatching.h"
 
 #include <vtkAlgorithmOutput.h>
+#include <vtkCompositeDataSet.h>
 #include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
 #include <vtkInformation.h>
 #include <vtkInformationVector.h>
+#include <vtkMultiBlockDataSet.h>
 #include <vtkObjectFactory.h>
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
@@ -43,6 +47,8 @@ struct vtkInterpolatedMuscleDeformation::Cache
   std::vector<size_t> boneLeaf;                               // BonesRest leaf of each bone
   std::vector<std::vector<md::PoseInterpolator>> lineMotions; // per muscle
   std::vector<size_t> lineLeaf;                               // ActionLinesRest leaf of each muscle
+  std::vector<std::unique_ptr<md::MuscleFibres>> fibres;      // per muscle, in `frame`; null: none
+  std::vector<md::TriangleTree> boneTrees;                    // the bones at rest in `frame`, for the fibres
 };
 
 /// The muscles' action lines as given: ActionLinesRest leaf restOf[b] of muscle block b, and
@@ -58,6 +64,7 @@ namespace
 const char* const PortNames[] = { "Input", "BonesRest", "BonesCurrent", "ActionLinesRest", "ActionLinesCurrent",
   "Attachments" };
 constexpr int kAttachmentsPort = 5;
+constexpr int kTablePort = 3, kFibresPort = 4;
 
 /// Output 3: a row per muscle, a column per measure (NaN in the rows of the muscles that failed),
 /// then DeformationFailed.
@@ -118,7 +125,7 @@ vtkInterpolatedMuscleDeformation::vtkInterpolatedMuscleDeformation()
   , KeptRest(std::make_unique<md::RestMappingCache>())
 {
   this->SetNumberOfInputPorts(kPorts);
-  this->SetNumberOfOutputPorts(4);
+  this->SetNumberOfOutputPorts(5);
   const md::InterpolationParameters method;
   this->NumberOfSteps = method.numberOfSteps;
   this->ResolvedNumberOfSteps = method.numberOfSteps;
@@ -134,6 +141,7 @@ vtkInterpolatedMuscleDeformation::vtkInterpolatedMuscleDeformation()
   this->BoneContactWeight = method.deformation.contactWeight;
   this->HullTargetNumberOfPoints = method.hull.targetNumberOfPoints;
   this->RefitRegularisation = method.refitRegularisation;
+  this->NumberOfFibres = md::FibreParameters().count;
 }
 
 int vtkInterpolatedMuscleDeformation::GetHullBuildCount() const
@@ -148,9 +156,14 @@ int vtkInterpolatedMuscleDeformation::GetSurfaceEnergyBuildCount() const
 
 int vtkInterpolatedMuscleDeformation::FillOutputPortInformation(int port, vtkInformation* info)
 {
-  if (port == 3)
+  if (port == kTablePort)
   {
     info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkTable");
+    return 1;
+  }
+  if (port == kFibresPort)
+  {
+    info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkMultiBlockDataSet");
     return 1;
   }
   return this->Superclass::FillOutputPortInformation(port, info);
@@ -160,7 +173,12 @@ int vtkInterpolatedMuscleDeformation::RequestDataObject(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   // Each output has the type of the input it follows: muscles, bones, action lines; then the table.
-  mdvtk::OutputsFollowInputs(inputVector, outputVector, { 0, 1, 3 }, 3);
+  mdvtk::OutputsFollowInputs(inputVector, outputVector, { 0, 1, 3 }, kTablePort);
+  if (!vtkMultiBlockDataSet::GetData(outputVector, kFibresPort))
+  {
+    vtkNew<vtkMultiBlockDataSet> fibres;
+    outputVector->GetInformationObject(kFibresPort)->Set(vtkDataObject::DATA_OBJECT(), fibres);
+  }
   return 1;
 }
 
@@ -251,6 +269,7 @@ int vtkInterpolatedMuscleDeformation::RequestData(
   {
     return 0;
   }
+  this->WriteFibres(muscles, step, vtkMultiBlockDataSet::GetData(outputVector, kFibresPort));
   mdvtk::SetDataTime(outputVector, step);
   this->UpdateProgress(1.0);
   return 1;
@@ -353,6 +372,7 @@ int vtkInterpolatedMuscleDeformation::Deform(
   {
     cache.boneMotions.emplace_back(bone.rest.points, bone.current, parameters.interpolationMode);
   }
+  this->MakeFibres(motions, bones);
   for (const std::string& warning : cache.result.warnings)
   {
     vtkWarningMacro(<< warning);
@@ -613,6 +633,72 @@ bool vtkInterpolatedMuscleDeformation::WriteBonesAndLines(
   return true;
 }
 
+void vtkInterpolatedMuscleDeformation::MakeFibres(
+  const std::vector<md::MuscleMotion>& motions, const std::vector<md::BoneMotion>& bones)
+{
+  Cache& cache = *this->Computed;
+  std::vector<md::MotionDeformation::Muscle> muscles;
+  std::vector<char> failed;
+  for (size_t m = 0; m < motions.size(); ++m)
+  {
+    md::MotionDeformation::Muscle muscle{ motions[m].name, motions[m].muscle, {}, motions[m].attachments };
+    for (const md::MatchedLine& line : motions[m].lines)
+    {
+      muscle.restLines.push_back(line.rest);
+    }
+    muscles.push_back(std::move(muscle));
+    failed.push_back(cache.result.failures[m].empty() ? 0 : 1);
+  }
+  std::vector<md::MotionDeformation::Bone> restBones;
+  for (const md::BoneMotion& bone : bones)
+  {
+    restBones.push_back({ bone.name, bone.rest });
+  }
+  cache.fibres =
+    mdvtk::MakeFibres(this, "InterpolatedMuscleDeformation", this->NumberOfFibres, muscles, restBones, failed);
+  if (std::any_of(cache.fibres.begin(), cache.fibres.end(), [](const auto& f) { return !!f; }))
+  {
+    for (const md::BoneMotion& bone : bones)
+    {
+      cache.boneTrees.emplace_back(bone.rest);
+      cache.boneTrees.back().BuildDistanceGrid(); // the fibres' test for a point inside a bone
+    }
+  }
+}
+
+void vtkInterpolatedMuscleDeformation::WriteFibres(
+  const std::vector<mdvtk::Leaf>& muscles, int step, vtkMultiBlockDataSet* output) const
+{
+  const Cache& cache = *this->Computed;
+  output->Initialize();
+  std::vector<md::FibreObstacle> obstacles;
+  std::vector<std::unique_ptr<md::TriangleTree>> moved(cache.boneTrees.size());
+  for (size_t k = 0; k < cache.boneTrees.size(); ++k)
+  {
+    obstacles.push_back(mdvtk::BoneWhereItIs(cache.boneTrees[k], moved[k], cache.boneTrees[k].Mesh().points,
+      cache.boneMotions[k].AtStep(step, cache.result.numberOfSteps)));
+  }
+  for (size_t m = 0; m < cache.blockOf.size(); ++m)
+  {
+    if (!cache.fibres[m] || cache.result.points[step][m].rows() == 0)
+    {
+      continue;
+    }
+    md::Points surface = cache.result.points[step][m];
+    cache.frame.ToLocal(surface);
+    md::Points fibres = cache.fibres[m]->At(surface, obstacles);
+    std::vector<double> lengths = cache.fibres[m]->Lengths(fibres);
+    for (double& length : lengths)
+    {
+      length = cache.frame.LengthToWorld(length);
+    }
+    cache.frame.ToWorld(fibres);
+    const unsigned block = output->GetNumberOfBlocks();
+    output->SetBlock(block, mdvtk::FibrePolylines(fibres, cache.fibres[m]->PointsPerFibre(), lengths));
+    output->GetMetaData(block)->Set(vtkCompositeDataSet::NAME(), mdvtk::NameOf(muscles[cache.blockOf[m]]).c_str());
+  }
+}
+
 void vtkInterpolatedMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
@@ -629,6 +715,7 @@ void vtkInterpolatedMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "HullTargetNumberOfPoints: " << this->HullTargetNumberOfPoints << "\n";
   os << indent << "BoneContactWeight: " << this->BoneContactWeight << "\n";
   os << indent << "RefitRegularisation: " << this->RefitRegularisation << "\n";
+  os << indent << "NumberOfFibres: " << this->NumberOfFibres << "\n";
   os << indent << "AttachmentAreas: " << this->AttachmentAreas << "\n";
   os << indent << "AttachmentFileName: " << (this->AttachmentFileName ? this->AttachmentFileName : "") << "\n";
   os << indent << "ResolvedNumberOfSteps: " << this->ResolvedNumberOfSteps << "\n";

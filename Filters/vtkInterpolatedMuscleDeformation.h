@@ -33,6 +33,9 @@
  * lines at the same step, as the method moved them, in the structure of
  * BonesRest and ActionLinesRest. Output 3 (Measures): a table of the
  * muscles' field data below, one row per muscle (column Muscle: its name).
+ * Output 4 (Fibres): each muscle's fibres at the same step (NumberOfFibres,
+ * made in the rest pose, carried by the muscle), a block of polylines per
+ * muscle with cell data FibreLength.
  *
  * Output 0: the muscles at the requested time step j (0 = rest pose, N =
  * current pose; every step is computed once and kept), point arrays
@@ -68,6 +71,7 @@ namespace mdvtk
 {
 struct Leaf;
 }
+class vtkMultiBlockDataSet;
 
 class MUSCLEDEFORMATIONFILTERS_EXPORT vtkInterpolatedMuscleDeformation : public vtkPassInputTypeAlgorithm
 {
@@ -158,6 +162,11 @@ public:
   /// How the areas were found, as the output messages said it at the last run.
   const char* GetAttachmentReport() const;
 
+  /// Fibres per muscle, made in the rest pose and carried to every step (output Fibres,
+  /// docs/DESIGN.md "Fibres"); 0: none. Default 100.
+  vtkSetClampMacro(NumberOfFibres, int, 0, 10000);
+  vtkGetMacro(NumberOfFibres, int);
+
   /// N as resolved by the last RequestInformation.
   vtkGetMacro(ResolvedNumberOfSteps, int);
 
@@ -197,6 +206,7 @@ protected:
   int HullTargetNumberOfPoints;
   double RefitRegularisation;
   int ResolvedNumberOfSteps;
+  int NumberOfFibres;
   int AttachmentAreas = 1;
   char* AttachmentFileName = nullptr;
   std::string AttachmentReport;
@@ -227,6 +237,11 @@ private:
     vtkDataObject* input, const std::vector<mdvtk::Leaf>& muscles, int step, vtkInformationVector* outputVector);
   /// Outputs 1 and 2: the bones and action lines at `step`.
   bool WriteBonesAndLines(vtkDataObject* const inputs[5], int step, vtkInformationVector* outputVector);
+  /// Each muscle's fibres (NumberOfFibres), made in the rest pose of `motions` and `bones` (the
+  /// local frame), into Computed.
+  void MakeFibres(const std::vector<md::MuscleMotion>& motions, const std::vector<md::BoneMotion>& bones);
+  /// Output 4: each muscle's fibres at `step`, carried by the muscle there, out of the bones there.
+  void WriteFibres(const std::vector<mdvtk::Leaf>& muscles, int step, vtkMultiBlockDataSet* output) const;
   std::unique_ptr<Cache> Computed;
   std::unique_ptr<md::RestMappingCache> KeptRest;
 };

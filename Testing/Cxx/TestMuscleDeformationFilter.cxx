@@ -7,6 +7,7 @@
 #include "FilterTestUtilities.h"
 
 #include "Deformation/MuscleDeformer.h"
+#include "Geometry/MeshChecks.h"
 #include "Geometry/TriangleTree.h"
 #include "MDBlocks.h"
 #include "MDConvert.h"
@@ -20,6 +21,7 @@
 #include "vtkMusculoskeletalPhantom.h"
 
 #include <vtkCallbackCommand.h>
+#include <vtkCellData.h>
 #include <vtkCommand.h>
 #include <vtkDataArray.h>
 #include <vtkFieldData.h>
@@ -31,6 +33,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -589,6 +592,86 @@ void ExpectOnlyTheBrokenMuscleFailed(
     EXPECT_NE(message->GetValue(0).find(why), std::string::npos) << message->GetValue(0);
   }
 }
+}
+
+// Output 4: each muscle's fibres at the step shown, inside their muscle at every step (the
+// winding number), their lengths as cell data; none asked for, none made and the muscles alike.
+TEST(InterpolatedMuscleDeformationFilter, FibresRunInsideEachMuscleAtEveryStepWithTheirLengths)
+{
+  PhantomPipeline pipeline;
+  vtkNew<vtkInterpolatedMuscleDeformation> f;
+  pipeline.Connect(f);
+  f->SetNumberOfSteps(2);
+  f->SetNumberOfFibres(30);
+  std::vector<double> restLengths;
+  for (int step = 0; step <= 2; ++step)
+  {
+    SCOPED_TRACE(step);
+    f->UpdateInformation();
+    for (int port : { 0, 4 })
+    {
+      f->GetOutputInformation(port)->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(), step);
+      f->Update(port);
+    }
+    auto* muscles = vtkMultiBlockDataSet::SafeDownCast(f->GetOutputDataObject(0));
+    auto* fibres = vtkMultiBlockDataSet::SafeDownCast(f->GetOutputDataObject(4));
+    ASSERT_NE(fibres, nullptr);
+    ASSERT_EQ(fibres->GetNumberOfBlocks(), muscles->GetNumberOfBlocks());
+    for (unsigned int b = 0; b < fibres->GetNumberOfBlocks(); ++b)
+    {
+      auto* lines = vtkPolyData::SafeDownCast(fibres->GetBlock(b));
+      ASSERT_NE(lines, nullptr);
+      EXPECT_EQ(BlockName(fibres, b), BlockName(muscles, b));
+      EXPECT_EQ(lines->GetNumberOfLines(), 30);
+      vtkDataArray* lengths = lines->GetCellData()->GetArray("FibreLength");
+      ASSERT_NE(lengths, nullptr);
+      EXPECT_GT(lengths->GetRange()[0], 0.0);
+      md::TriangleMesh surface;
+      mdvtk::ReadTriangles(vtkPolyData::SafeDownCast(muscles->GetBlock(b)), surface);
+      EXPECT_EQ(md::CountOutside(surface, mdvtk::ToPoints(lines->GetPoints()), 0.0), 0) << BlockName(fibres, b);
+      for (vtkIdType c = 0; c < lengths->GetNumberOfTuples(); ++c)
+      {
+        if (step == 0)
+        {
+          restLengths.push_back(lengths->GetTuple1(c));
+        }
+      }
+    }
+    if (step == 2)
+    {
+      // The phantom's motion changes its fibres' lengths.
+      double largestChange = 0;
+      vtkIdType i = 0;
+      for (unsigned int b = 0; b < fibres->GetNumberOfBlocks(); ++b)
+      {
+        vtkDataArray* lengths = vtkPolyData::SafeDownCast(fibres->GetBlock(b))->GetCellData()->GetArray("FibreLength");
+        for (vtkIdType c = 0; c < lengths->GetNumberOfTuples(); ++c, ++i)
+        {
+          largestChange = std::max(largestChange, std::abs(lengths->GetTuple1(c) - restLengths[size_t(i)]));
+        }
+      }
+      EXPECT_GT(largestChange, 0.01);
+    }
+  }
+  vtkNew<vtkPoints> with;
+  with->SetDataTypeToDouble();
+  with->DeepCopy(
+    vtkPolyData::SafeDownCast(vtkMultiBlockDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetBlock(0))->GetPoints());
+  f->SetNumberOfFibres(0);
+  f->Update(0);
+  EXPECT_EQ(vtkMultiBlockDataSet::SafeDownCast(f->GetOutputDataObject(4))->GetNumberOfBlocks(), 0u);
+  vtkPoints* without =
+    vtkPolyData::SafeDownCast(vtkMultiBlockDataSet::SafeDownCast(f->GetOutputDataObject(0))->GetBlock(0))->GetPoints();
+  ASSERT_EQ(without->GetNumberOfPoints(), with->GetNumberOfPoints());
+  double largest = 0;
+  for (vtkIdType i = 0; i < with->GetNumberOfPoints(); ++i)
+  {
+    double a[3], b[3];
+    with->GetPoint(i, a);
+    without->GetPoint(i, b);
+    largest = std::max({ largest, std::abs(a[0] - b[0]), std::abs(a[1] - b[1]), std::abs(a[2] - b[2]) });
+  }
+  EXPECT_EQ(largest, 0.0);
 }
 
 // One muscle no hull can be built for is reported by name and flagged in its block; the other

@@ -35,9 +35,9 @@ class Gui(unittest.TestCase):
         with open(os.path.join(output, "report.txt")) as f:
             report = dict(line.split() for line in f if line.strip())
         # The phantom shows its rest pose (muscles, bones, action lines), the method its muscles,
-        # bones and action lines with the measures in a spreadsheet.
+        # bones, action lines and fibres with the measures in a spreadsheet.
         self.assertEqual(report, {"plugin_loaded": "1", "phantom_shows": "0,1,3",
-                                  "method_shows": "0:RenderView,1:RenderView,2:RenderView,3:SpreadSheetView",
+                                  "method_shows": "0:RenderView,1:RenderView,2:RenderView,3:SpreadSheetView,4:RenderView",
                                   "coloured_by_role": "1", "action_lines_as_tubes": "1",
                                   "surfaces_not_tubes": "1", "time_steps": "5", "points_every_step": "1",
                                   "last_step": "4"})

@@ -70,6 +70,12 @@ class Interpolation(unittest.TestCase):
         for name in MUSCLES:
             self.assertIn("  muscle '%s': no attachment area (it moves with its action lines only)" % name, report)
         said = [line for line in said if line not in report]
+        # Then the fibres each muscle got (100 by default), between its ends along its lines.
+        fibres = said[said.index("InterpolatedMuscleDeformation, fibres:"):][:len(MUSCLES) + 1]
+        for name in MUSCLES:
+            self.assertIn("  muscle '%s': 100 fibres from its end along its action lines to its end along its "
+                          "action lines" % name, fibres)
+        said = [line for line in said if line not in fibres]
         self.assertEqual(len(said), 1, messages.text)
         self.assertIn("muscle 'RectusFemoris' crosses bone 'Femur'", said[0])
         rest = servermanager.Fetch(simple.OutputPort(self.phantom, 0))
