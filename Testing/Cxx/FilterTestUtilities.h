@@ -2,7 +2,11 @@
 // Helpers for the VTK filter tests.
 #pragma once
 
+#include "Geometry/MeshChecks.h"
+#include "MDConvert.h"
+
 #include <vtkCellArray.h>
+#include <vtkCellData.h>
 #include <vtkCompositeDataSet.h>
 #include <vtkDoubleArray.h>
 #include <vtkInformation.h>
@@ -13,6 +17,8 @@
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 #include <vtkStringOutputWindow.h>
+
+#include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
@@ -71,4 +77,28 @@ inline vtkSmartPointer<vtkMultiBlockDataSet> MakeBlocks(
 inline std::string BlockName(vtkMultiBlockDataSet* tree, unsigned int index)
 {
   return tree->GetMetaData(index)->Get(vtkCompositeDataSet::NAME());
+}
+
+/// A deformation filter's Fibres output against its Muscles: a block per muscle, named alike,
+/// each `count` polylines with a positive FibreLength, every point inside its muscle (the winding
+/// number). `where` names the frame or step in a failure.
+inline void ExpectFibresInsideTheirMuscles(
+  vtkMultiBlockDataSet* fibres, vtkMultiBlockDataSet* muscles, int count, const std::string& where)
+{
+  ASSERT_NE(fibres, nullptr) << where;
+  ASSERT_EQ(fibres->GetNumberOfBlocks(), muscles->GetNumberOfBlocks()) << where;
+  for (unsigned int b = 0; b < fibres->GetNumberOfBlocks(); ++b)
+  {
+    auto* lines = vtkPolyData::SafeDownCast(fibres->GetBlock(b));
+    ASSERT_NE(lines, nullptr) << where;
+    EXPECT_EQ(BlockName(fibres, b), BlockName(muscles, b)) << where;
+    EXPECT_EQ(lines->GetNumberOfLines(), count) << where;
+    vtkDataArray* lengths = lines->GetCellData()->GetArray("FibreLength");
+    ASSERT_NE(lengths, nullptr) << where;
+    EXPECT_GT(lengths->GetRange()[0], 0.0) << where;
+    md::TriangleMesh surface;
+    mdvtk::ReadTriangles(vtkPolyData::SafeDownCast(muscles->GetBlock(b)), surface);
+    EXPECT_EQ(md::CountOutside(surface, mdvtk::ToPoints(lines->GetPoints()), 0.0), 0)
+      << BlockName(fibres, b) << ", " << where;
+  }
 }

@@ -383,23 +383,7 @@ TEST(MotionMuscleDeformation, FibresRunInsideEachMuscleAtEveryFrameWithTheirLeng
     ASSERT_EQ(p.At(k), 1);
     auto* muscles = vtkMultiBlockDataSet::SafeDownCast(p.motion->GetOutputDataObject(0));
     auto* fibres = vtkMultiBlockDataSet::SafeDownCast(p.motion->GetOutputDataObject(4));
-    ASSERT_NE(fibres, nullptr);
-    ASSERT_EQ(fibres->GetNumberOfBlocks(), muscles->GetNumberOfBlocks());
-    for (unsigned int b = 0; b < fibres->GetNumberOfBlocks(); ++b)
-    {
-      auto* lines = vtkPolyData::SafeDownCast(fibres->GetBlock(b));
-      ASSERT_NE(lines, nullptr);
-      EXPECT_EQ(BlockName(fibres, b), BlockName(muscles, b));
-      EXPECT_EQ(lines->GetNumberOfLines(), 40);
-      vtkDataArray* lengths = lines->GetCellData()->GetArray("FibreLength");
-      ASSERT_NE(lengths, nullptr);
-      EXPECT_GT(lengths->GetRange()[0], 0.0);
-      // Every fibre point inside its muscle (winding number).
-      md::TriangleMesh surface;
-      mdvtk::ReadTriangles(vtkPolyData::SafeDownCast(muscles->GetBlock(b)), surface);
-      EXPECT_EQ(md::CountOutside(surface, mdvtk::ToPoints(lines->GetPoints()), 0.0), 0)
-        << BlockName(fibres, b) << " frame " << k;
-    }
+    ExpectFibresInsideTheirMuscles(fibres, muscles, 40, "frame " + std::to_string(k));
   }
   // The lengths of every frame, in order; no moment arms where BonesMotion names no coordinates.
   auto* arms = vtkTable::SafeDownCast(p.motion->GetOutputDataObject(5));
