@@ -130,9 +130,26 @@ std::vector<std::string> LineNames(vtkPolyData* lines, const std::string& muscle
   return names;
 }
 
-md::FibreObstacle BoneWhereItIs(const md::TriangleTree& restTree, std::unique_ptr<md::TriangleTree>& moved,
-  const md::Points& rest, const md::Points& now)
+std::vector<md::TriangleTree> FibreObstacleTrees(
+  const std::vector<md::MotionDeformation::Bone>& bones, const std::vector<std::unique_ptr<md::MuscleFibres>>& fibres)
 {
+  std::vector<md::TriangleTree> trees;
+  if (std::none_of(fibres.begin(), fibres.end(), [](const auto& f) { return !!f; }))
+  {
+    return trees;
+  }
+  for (const md::MotionDeformation::Bone& bone : bones)
+  {
+    trees.emplace_back(bone.rest);
+    trees.back().BuildDistanceGrid(); // the fibres' test for a point inside a bone
+  }
+  return trees;
+}
+
+md::FibreObstacle BoneWhereItIs(
+  const md::TriangleTree& restTree, std::unique_ptr<md::TriangleTree>& moved, const md::Points& now)
+{
+  const md::Points& rest = restTree.Mesh().points;
   if (const auto rigid = md::RigidMotionOf(rest, now, md::kRigidObstacleShare * md::BoxDiagonal(rest)))
   {
     return { &restTree, *rigid };

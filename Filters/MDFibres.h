@@ -46,11 +46,16 @@ std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, 
 /// "<muscle> line <i>" for several; `count` names.
 std::vector<std::string> LineNames(vtkPolyData* lines, const std::string& muscle, size_t count);
 
+/// The rest trees of `bones`, each with its distance grid, that the fibres keep out of; none
+/// when no muscle has fibres.
+std::vector<md::TriangleTree> FibreObstacleTrees(
+  const std::vector<md::MotionDeformation::Bone>& bones, const std::vector<std::unique_ptr<md::MuscleFibres>>& fibres);
+
 /// A bone where it is now (`now`, its points) as an obstacle of the fibres: its rest tree (and
 /// distance grid) and the rigid motion there when it moved rigidly (to md::kRigidObstacleShare of
 /// its size); else `moved`, a copy of the rest tree refitted to `now`.
-md::FibreObstacle BoneWhereItIs(const md::TriangleTree& restTree, std::unique_ptr<md::TriangleTree>& moved,
-  const md::Points& rest, const md::Points& now);
+md::FibreObstacle BoneWhereItIs(
+  const md::TriangleTree& restTree, std::unique_ptr<md::TriangleTree>& moved, const md::Points& now);
 
 /// A muscle's fibres as polylines: cell data FibreLength (`lengths`).
 vtkSmartPointer<vtkPolyData> FibrePolylines(const md::Points& points, int perFibre, const std::vector<double>& lengths);

@@ -48,7 +48,7 @@ struct vtkInterpolatedMuscleDeformation::Cache
   std::vector<std::vector<md::PoseInterpolator>> lineMotions; // per muscle
   std::vector<size_t> lineLeaf;                               // ActionLinesRest leaf of each muscle
   std::vector<std::unique_ptr<md::MuscleFibres>> fibres;      // per muscle, in `frame`; null: none
-  std::vector<md::TriangleTree> boneTrees;                    // the bones at rest in `frame`, for the fibres
+  std::vector<md::TriangleTree> boneTrees; // the bones at rest in `frame`, for the fibres; none without fibres
 };
 
 /// The muscles' action lines as given: ActionLinesRest leaf restOf[b] of muscle block b, and
@@ -656,14 +656,7 @@ void vtkInterpolatedMuscleDeformation::MakeFibres(
   }
   cache.fibres =
     mdvtk::MakeFibres(this, "InterpolatedMuscleDeformation", this->NumberOfFibres, muscles, restBones, failed);
-  if (std::any_of(cache.fibres.begin(), cache.fibres.end(), [](const auto& f) { return !!f; }))
-  {
-    for (const md::BoneMotion& bone : bones)
-    {
-      cache.boneTrees.emplace_back(bone.rest);
-      cache.boneTrees.back().BuildDistanceGrid(); // the fibres' test for a point inside a bone
-    }
-  }
+  cache.boneTrees = mdvtk::FibreObstacleTrees(restBones, cache.fibres);
 }
 
 void vtkInterpolatedMuscleDeformation::WriteFibres(
@@ -675,8 +668,8 @@ void vtkInterpolatedMuscleDeformation::WriteFibres(
   std::vector<std::unique_ptr<md::TriangleTree>> moved(cache.boneTrees.size());
   for (size_t k = 0; k < cache.boneTrees.size(); ++k)
   {
-    obstacles.push_back(mdvtk::BoneWhereItIs(cache.boneTrees[k], moved[k], cache.boneTrees[k].Mesh().points,
-      cache.boneMotions[k].AtStep(step, cache.result.numberOfSteps)));
+    obstacles.push_back(mdvtk::BoneWhereItIs(
+      cache.boneTrees[k], moved[k], cache.boneMotions[k].AtStep(step, cache.result.numberOfSteps)));
   }
   for (size_t m = 0; m < cache.blockOf.size(); ++m)
   {

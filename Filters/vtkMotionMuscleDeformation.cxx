@@ -130,10 +130,9 @@ struct vtkMotionMuscleDeformation::Internals
   std::vector<md::Points> restPoints;                       // [muscle given]: as given, in the data's coordinates
   std::vector<std::vector<md::Points>> restLines;           // [muscle given]
   std::vector<std::unique_ptr<md::MuscleFibres>> fibres;    // [muscle given]; null: none
-  std::vector<md::TriangleTree> boneTrees;                  // the bones' in the rest pose
+  std::vector<md::TriangleTree> boneTrees;                  // the bones' in the rest pose; none without fibres
   std::vector<std::unique_ptr<md::TriangleTree>> boneMoved; // a bone's refitted to a frame's, where not rigid
-  std::vector<md::Points> boneRest;
-  mdvtk::PoseCoordinates coordinates; // named at the first frame
+  mdvtk::PoseCoordinates coordinates;                       // named at the first frame
   std::map<int, FrameKept> frames;
   std::map<int, FrameMeasures> measures;
   int gather = -1;      ///< the frame the time-varying inputs are asked for; -1: none
@@ -155,7 +154,6 @@ struct vtkMotionMuscleDeformation::Internals
     this->fibres.clear();
     this->boneTrees.clear();
     this->boneMoved.clear();
-    this->boneRest.clear();
     this->coordinates = {};
     this->frames.clear();
     this->measures.clear();
@@ -262,12 +260,10 @@ struct vtkMotionMuscleDeformation::Internals
   void CarryFibres(
     const md::MotionPose& pose, const std::vector<md::Points>& points, FrameKept& kept, FrameMeasures& measures)
   {
-    const bool anyFibres = std::any_of(this->fibres.begin(), this->fibres.end(), [](const auto& f) { return !!f; });
     std::vector<md::FibreObstacle> obstacles;
-    for (size_t b = 0; b < this->boneTrees.size() && anyFibres; ++b)
+    for (size_t b = 0; b < this->boneTrees.size(); ++b)
     {
-      obstacles.push_back(
-        mdvtk::BoneWhereItIs(this->boneTrees[b], this->boneMoved[b], this->boneRest[b], pose.bones[b]));
+      obstacles.push_back(mdvtk::BoneWhereItIs(this->boneTrees[b], this->boneMoved[b], pose.bones[b]));
     }
     kept.fibres.resize(this->blockOf.size());
     measures.fibreLengths.resize(this->blockOf.size());
@@ -741,16 +737,8 @@ bool vtkMotionMuscleDeformation::Start(const Leaves& leaves, vtkDataObject* land
     }
   }
   in.fibres = mdvtk::MakeFibres(this, "MotionMuscleDeformation", this->NumberOfFibres, muscles, bones, failed);
-  for (const md::MotionDeformation::Bone& bone : bones)
-  {
-    in.boneTrees.emplace_back(bone.rest);
-    if (std::any_of(in.fibres.begin(), in.fibres.end(), [](const auto& f) { return !!f; }))
-    {
-      in.boneTrees.back().BuildDistanceGrid(); // the fibres' test for a point inside a bone
-    }
-    in.boneRest.push_back(bone.rest.points);
-  }
-  in.boneMoved.resize(bones.size());
+  in.boneTrees = mdvtk::FibreObstacleTrees(bones, in.fibres);
+  in.boneMoved.resize(in.boneTrees.size());
   for (const std::string& warning : in.deformation->Warnings())
   {
     vtkWarningMacro(<< warning);
