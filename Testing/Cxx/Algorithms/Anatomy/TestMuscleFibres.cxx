@@ -124,6 +124,40 @@ TEST(MuscleFibres, InACylinderTheyRunStraightFromCapToCap)
   EXPECT_GT(farthest, 0.7 * radius);
 }
 
+// A bone poked deep into the muscle (6 deep at the axis, beyond any fixed search radius the
+// fibres use): with its distance grid, every fibre point inside it is put out of it, and stays
+// inside the muscle.
+TEST(MuscleFibres, APointDeepInsideABoneIsPutOutOfIt)
+{
+  const double length = 100, radius = 10;
+  const md::TriangleMesh cylinder = Cylinder(radius, length);
+  const md::MuscleFibres fibres(cylinder, CapEnds(cylinder, length));
+  const md::TriangleMesh box = Box(Eigen::Vector3d(-6, -6, 40), Eigen::Vector3d(6, 6, 60));
+  md::TriangleTree bone(box);
+  const auto insideBone = [&](const md::Points& points) {
+    int count = 0;
+    for (Eigen::Index p = 0; p < points.rows(); ++p)
+    {
+      count += md::WindingNumber(box.points, box.triangles, points.row(p).transpose()) > 0.5;
+    }
+    return count;
+  };
+  int deepest = 0;
+  for (Eigen::Index p = 0; p < fibres.Rest().rows(); ++p)
+  {
+    const Eigen::Vector3d x = fibres.Rest().row(p).transpose();
+    deepest += std::abs(x[0]) < 0.5 && std::abs(x[1]) < 0.5 && std::abs(x[2] - 50) < 5;
+  }
+  ASSERT_GT(deepest, 0); // some fibre points lie at least 5 inside the bone
+  ASSERT_GT(insideBone(fibres.Rest()), deepest);
+  bone.BuildDistanceGrid();
+  std::pair<int, int> kept;
+  const md::Points carried = fibres.At(cylinder.points, { md::FibreObstacle{ &bone, md::RigidTransform() } }, &kept);
+  EXPECT_EQ(insideBone(carried), 0);
+  EXPECT_EQ(md::CountOutside(cylinder, carried, 0.0), 0);
+  EXPECT_EQ(kept.second, 0);
+}
+
 TEST(MuscleFibres, AnAffineMapOfTheSurfaceCarriesThemExactly)
 {
   const double length = 80;
