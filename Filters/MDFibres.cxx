@@ -20,6 +20,7 @@
 #include <vtkTable.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -232,15 +233,9 @@ void WriteMomentArms(const std::vector<FrameLengths>& frames, const PoseCoordina
       values->SetValue(static_cast<vtkIdType>(k), q[k][i] / kDegree);
     }
   }
-  // A length per frame: its moment arms [frame][moving coordinate].
-  const auto armsOf = [&](const auto& lengthAt) {
-    std::vector<double> lengths;
-    for (size_t k = 0; k < frames.size(); ++k)
-    {
-      lengths.push_back(lengthAt(k));
-    }
-    return md::MomentArmsAlongMotion(q, lengths);
-  };
+  // Which frames each frame's moment arm differences, and about which coordinate: found once for
+  // every length (md::MomentArmsAlongMotion's).
+  const std::vector<md::ExcursionDifference> differences = md::ExcursionDifferences(q);
   for (size_t m = 0; m < muscleNames.size(); ++m)
   {
     const std::string& muscle = muscleNames[m];
@@ -249,11 +244,6 @@ void WriteMomentArms(const std::vector<FrameLengths>& frames, const PoseCoordina
     {
       vtkDoubleArray* spread[3] = { column("FibreLength(" + muscle + ")"), column("FibreLengthMin(" + muscle + ")"),
         column("FibreLengthMax(" + muscle + ")") };
-      std::vector<std::vector<std::vector<double>>> arms; // [fibre][frame][coordinate]
-      for (size_t f = 0; f < fibres; ++f)
-      {
-        arms.push_back(armsOf([&](size_t k) { return frames[k].fibreLengths[m][f]; }));
-      }
       for (size_t k = 0; k < frames.size(); ++k)
       {
         const md::Spread s = md::SpreadOf(frames[k].fibreLengths[m]);
@@ -261,25 +251,37 @@ void WriteMomentArms(const std::vector<FrameLengths>& frames, const PoseCoordina
         spread[1]->SetValue(static_cast<vtkIdType>(k), s.low);
         spread[2]->SetValue(static_cast<vtkIdType>(k), s.high);
       }
-      for (size_t i = 0; i < moving.size(); ++i)
+      std::vector<std::array<vtkDoubleArray*, 3>> armSpread; // [moving coordinate]: median, low, high
+      for (size_t c : moving)
       {
-        const std::string about = muscle + ", " + coordinates.names[moving[i]] + ")";
-        vtkDoubleArray* armSpread[3] = { column("FibreMomentArm(" + about), column("FibreMomentArmMin(" + about),
-          column("FibreMomentArmMax(" + about) };
-        for (size_t k = 0; k < frames.size(); ++k)
+        const std::string about = muscle + ", " + coordinates.names[c] + ")";
+        armSpread.push_back({ column("FibreMomentArm(" + about), column("FibreMomentArmMin(" + about),
+          column("FibreMomentArmMax(" + about) });
+      }
+      std::vector<double> values;
+      for (size_t k = 0; k < frames.size(); ++k)
+      {
+        const md::ExcursionDifference& d = differences[k];
+        if (d.coordinate < 0)
         {
-          std::vector<double> values;
-          for (size_t f = 0; f < fibres; ++f)
+          continue; // NaN: no moment arm at this frame
+        }
+        values.clear();
+        for (size_t f = 0; f < fibres; ++f)
+        {
+          const double arm = -(frames[d.to].fibreLengths[m][f] - frames[d.from].fibreLengths[m][f]) / d.dq;
+          if (!std::isnan(arm))
           {
-            if (!std::isnan(arms[f][k][i]))
-            {
-              values.push_back(arms[f][k][i]);
-            }
+            values.push_back(arm);
           }
-          const md::Spread s = md::SpreadOf(values);
-          armSpread[0]->SetValue(static_cast<vtkIdType>(k), s.median);
-          armSpread[1]->SetValue(static_cast<vtkIdType>(k), s.low);
-          armSpread[2]->SetValue(static_cast<vtkIdType>(k), s.high);
+        }
+        const md::Spread s = md::SpreadOf(values);
+        for (int j = 0; j < 3; ++j)
+        {
+          armSpread[size_t(d.coordinate)][size_t(j)]->SetValue(static_cast<vtkIdType>(k),
+            j == 0     ? s.median
+              : j == 1 ? s.low
+                       : s.high);
         }
       }
     }
@@ -287,19 +289,22 @@ void WriteMomentArms(const std::vector<FrameLengths>& frames, const PoseCoordina
     {
       const std::string& line = lineNames[m][l];
       vtkDoubleArray* length = column("Length(" + line + ")");
-      const auto arms =
-        armsOf([&](size_t k) { return l < frames[k].lineLengths[m].size() ? frames[k].lineLengths[m][l] : kNaN; });
+      std::vector<double> lengths;
       for (size_t k = 0; k < frames.size(); ++k)
       {
-        length->SetValue(
-          static_cast<vtkIdType>(k), l < frames[k].lineLengths[m].size() ? frames[k].lineLengths[m][l] : kNaN);
+        lengths.push_back(l < frames[k].lineLengths[m].size() ? frames[k].lineLengths[m][l] : kNaN);
+        length->SetValue(static_cast<vtkIdType>(k), lengths.back());
       }
-      for (size_t i = 0; i < moving.size(); ++i)
+      std::vector<vtkDoubleArray*> arm;
+      for (size_t c : moving)
       {
-        vtkDoubleArray* arm = column("MomentArm(" + line + ", " + coordinates.names[moving[i]] + ")");
-        for (size_t k = 0; k < frames.size(); ++k)
+        arm.push_back(column("MomentArm(" + line + ", " + coordinates.names[c] + ")"));
+      }
+      for (size_t k = 0; k < frames.size(); ++k)
+      {
+        if (differences[k].coordinate >= 0)
         {
-          arm->SetValue(static_cast<vtkIdType>(k), arms[k][i]);
+          arm[size_t(differences[k].coordinate)]->SetValue(static_cast<vtkIdType>(k), differences[k].Of(lengths));
         }
       }
     }

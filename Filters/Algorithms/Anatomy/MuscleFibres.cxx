@@ -800,16 +800,15 @@ struct PlacedObstacle
   RigidTransform toNow, toTree;
 };
 
-Breach Check(const Eigen::Vector3d& x, double reach, const TriangleTree& muscle,
+Breach Check(const Eigen::Vector3d& x, double reach, const TriangleTree& muscle, Eigen::Index hint,
   const std::vector<std::vector<Eigen::Index>>& around, const std::vector<PlacedObstacle>& obstacles)
 {
   Breach breach;
-  const TriangleTree::Closest wall = muscle.ClosestPoint(x, reach);
+  const TriangleTree::Closest wall = muscle.ClosestPoint(x, reach, hint);
   // The nearest wall's side decides locally, and cheaply; where the surface folds through itself
   // it flips between two sheets under the slightest change of x, so an outside is confirmed by the
   // winding number, which changes only where x crosses the surface.
-  if (wall.triangle >= 0 && OnOuterSide(muscle, wall, x, &around) &&
-    std::abs(WindingNumber(muscle.Mesh().points, muscle.Mesh().triangles, x)) < 0.5)
+  if (wall.triangle >= 0 && OnOuterSide(muscle, wall, x, &around) && muscle.Winding(x) == 0)
   {
     breach.outsideMuscle = true;
     breach.wall = wall.point;
@@ -847,11 +846,11 @@ Breach Check(const Eigen::Vector3d& x, double reach, const TriangleTree& muscle,
 /// in (then where it was). Outside the muscle, x goes `depth` below the wall it left; inside an
 /// obstacle, half that out of it (the muscle may lie on it); where the muscle's wall lies closer
 /// to the obstacle than that, halfway between the two.
-int KeepInside(Eigen::Vector3d& x, double depth, double reach, const TriangleTree& muscle,
+int KeepInside(Eigen::Vector3d& x, double depth, double reach, const TriangleTree& muscle, Eigen::Index hint,
   const std::vector<std::vector<Eigen::Index>>& around, const std::vector<PlacedObstacle>& obstacles)
 {
   const Eigen::Vector3d carried = x;
-  Breach breach = Check(x, reach, muscle, around, obstacles);
+  Breach breach = Check(x, reach, muscle, hint, around, obstacles);
   if (!breach.outsideMuscle && !breach.insideObstacle)
   {
     return 0;
@@ -873,7 +872,7 @@ int KeepInside(Eigen::Vector3d& x, double depth, double reach, const TriangleTre
     {
       x = 0.5 * (*wall + *obstacle);
     }
-    breach = Check(x, reach, muscle, around, obstacles);
+    breach = Check(x, reach, muscle, hint, around, obstacles);
     if (!breach.outsideMuscle && !breach.insideObstacle)
     {
       return 1;
@@ -1159,7 +1158,8 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& given, con
   {
     for (int side = 0; side < 2; ++side)
     {
-      // (1 - share) of the area's point (its triangle's corners) and share of the next point.
+      // (1 - share) of the area's point (its triangle's corners) and share of the next point,
+      // the next point added once it is carried (its weights not repeated: fewer to read).
       const FibreEnd& end = ends[size_t(f)][size_t(side)];
       const Eigen::Index p = Eigen::Index(f) * this->PerFibre + (side == 0 ? 0 : this->PerFibre - 1);
       const Eigen::Index next = side == 0 ? p + 1 : p - 1;
@@ -1168,10 +1168,7 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& given, con
         rows[size_t(p)].emplace_back(static_cast<int>(p), static_cast<int>(end.anchor.ids[size_t(c)]),
           static_cast<float>((1 - end.share) * end.anchor.weights[c]));
       }
-      for (const auto& w : rows[size_t(next)])
-      {
-        rows[size_t(p)].emplace_back(static_cast<int>(p), w.col(), static_cast<float>(end.share * w.value()));
-      }
+      this->EndBlends.push_back({ p, next, end.share });
     }
   }
   std::vector<Eigen::Triplet<float, int>> entries;
@@ -1190,11 +1187,14 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& given, con
   }
   this->RestTree = std::make_shared<const TriangleTree>(tree);
   this->Depth.resize(this->RestPoints.rows());
+  this->NearestWall.resize(size_t(this->RestPoints.rows()));
   this->Reach = kEscapeReach * field.grid.h;
   for (Eigen::Index p = 0; p < this->RestPoints.rows(); ++p)
   {
     const Eigen::Vector3d x = this->RestPoints.row(p).transpose();
-    double depth = tree.ClosestPoint(x).distance;
+    const TriangleTree::Closest wall = tree.ClosestPoint(x);
+    this->NearestWall[size_t(p)] = wall.triangle;
+    double depth = wall.distance;
     for (const TriangleTree& o : obstacleTrees)
     {
       const TriangleTree::Closest nearest = o.ClosestPoint(x, depth);
@@ -1223,15 +1223,15 @@ std::optional<RigidTransform> RigidMotionOf(const Points& rest, const Points& no
   }
   const RigidTransform motion = FitRigidTransform(from, to).transform;
   const double squared = tolerance * tolerance;
+  int beyond = 0; // points off the motion by more than the tolerance (or not finite)
+#pragma omp parallel for schedule(static) reduction(+ : beyond)
   for (Eigen::Index p = 0; p < rest.rows(); ++p)
   {
-    if (!((motion.rotation * rest.row(p).transpose() + motion.translation - now.row(p).transpose()).squaredNorm() <=
-          squared))
-    {
-      return std::nullopt;
-    }
+    beyond +=
+      !((motion.rotation * rest.row(p).transpose() + motion.translation - now.row(p).transpose()).squaredNorm() <=
+        squared);
   }
-  return motion;
+  return beyond == 0 ? std::optional<RigidTransform>(motion) : std::nullopt;
 }
 
 Points MuscleFibres::At(const Points& surface, const std::vector<FibreObstacle>& given, std::pair<int, int>* kept) const
@@ -1259,6 +1259,10 @@ Points MuscleFibres::At(const Points& surface, const std::vector<FibreObstacle>&
     }
     points.row(p) = x.head<3>().matrix().transpose();
   }
+  for (const EndBlend& end : this->EndBlends)
+  {
+    points.row(end.point) += end.share * points.row(end.next);
+  }
   TriangleTree tree = *this->RestTree;
   tree.Refit(surface);
   int moved = 0, stuck = 0;
@@ -1266,7 +1270,8 @@ Points MuscleFibres::At(const Points& surface, const std::vector<FibreObstacle>&
   for (Eigen::Index p = 0; p < points.rows(); ++p)
   {
     Eigen::Vector3d x = points.row(p).transpose();
-    const int result = KeepInside(x, this->Depth[p], this->Reach, tree, this->Around, obstacles);
+    const int result =
+      KeepInside(x, this->Depth[p], this->Reach, tree, this->NearestWall[size_t(p)], this->Around, obstacles);
     moved += result > 0;
     stuck += result > 1;
     points.row(p) = x.transpose();

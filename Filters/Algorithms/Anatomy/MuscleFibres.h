@@ -116,10 +116,21 @@ private:
   std::shared_ptr<const TriangleTree> RestTree;
   std::vector<std::vector<Eigen::Index>> Around; ///< per surface point, its triangles
   Eigen::VectorXd Depth; ///< per fibre point: how deep it is put back (its rest clearance, at most kFibreClearance)
-  double Reach = 0;      ///< how far from a carried point the surfaces are searched
+  /// Per fibre point, the muscle's triangle nearest it at rest: where the search for the wall
+  /// nearest the carried point starts (it prunes the search; the answer is the same).
+  std::vector<Eigen::Index> NearestWall;
+  double Reach = 0; ///< how far from a carried point the surfaces are searched
   /// Fibre points x surface points; single precision (a frame reads every weight: half the
   /// memory traffic; 1e-7 of a weight is far below the settle's tolerance).
   Eigen::SparseMatrix<float, Eigen::RowMajor, int> Weights;
+  /// A fibre's end: its row of Weights holds its area's point, (1 - share) of it; `share` of the
+  /// carried next point of the fibre is added.
+  struct EndBlend
+  {
+    Eigen::Index point, next;
+    double share;
+  };
+  std::vector<EndBlend> EndBlends;
   std::vector<std::string> Said;
 };
 

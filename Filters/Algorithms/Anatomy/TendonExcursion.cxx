@@ -2,6 +2,7 @@
 #include "Anatomy/TendonExcursion.h"
 
 #include <cmath>
+#include <cstddef>
 #include <limits>
 
 namespace md
@@ -27,14 +28,12 @@ int OneMoving(const std::vector<double>& a, const std::vector<double>& b)
 }
 }
 
-std::vector<std::vector<double>> MomentArmsAlongMotion(
-  const std::vector<std::vector<double>>& coordinates, const std::vector<double>& lengths)
+std::vector<ExcursionDifference> ExcursionDifferences(const std::vector<std::vector<double>>& coordinates)
 {
-  const size_t frames = std::min(coordinates.size(), lengths.size());
-  std::vector<std::vector<double>> arms(frames);
+  const size_t frames = coordinates.size();
+  std::vector<ExcursionDifference> differences(frames);
   for (size_t k = 0; k < frames; ++k)
   {
-    arms[k].assign(coordinates[k].size(), std::numeric_limits<double>::quiet_NaN());
     // Central first, then backward, then forward.
     const std::pair<size_t, size_t> pairs[] = { { k - 1, k + 1 }, { k - 1, k }, { k, k + 1 } };
     for (const auto& [a, b] : pairs)
@@ -46,9 +45,33 @@ std::vector<std::vector<double>> MomentArmsAlongMotion(
       const int c = OneMoving(coordinates[a], coordinates[b]);
       if (c >= 0)
       {
-        arms[k][size_t(c)] = -(lengths[b] - lengths[a]) / (coordinates[b][size_t(c)] - coordinates[a][size_t(c)]);
+        differences[k] = { a, b, c, coordinates[b][size_t(c)] - coordinates[a][size_t(c)] };
         break;
       }
+    }
+  }
+  return differences;
+}
+
+double ExcursionDifference::Of(const std::vector<double>& lengths) const
+{
+  return this->coordinate >= 0 && this->to < lengths.size() ? -(lengths[this->to] - lengths[this->from]) / this->dq
+                                                            : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::vector<std::vector<double>> MomentArmsAlongMotion(
+  const std::vector<std::vector<double>>& coordinates, const std::vector<double>& lengths)
+{
+  const size_t frames = std::min(coordinates.size(), lengths.size());
+  const std::vector<ExcursionDifference> differences =
+    ExcursionDifferences({ coordinates.begin(), coordinates.begin() + static_cast<std::ptrdiff_t>(frames) });
+  std::vector<std::vector<double>> arms(frames);
+  for (size_t k = 0; k < frames; ++k)
+  {
+    arms[k].assign(coordinates[k].size(), std::numeric_limits<double>::quiet_NaN());
+    if (differences[k].coordinate >= 0)
+    {
+      arms[k][size_t(differences[k].coordinate)] = differences[k].Of(lengths);
     }
   }
   return arms;

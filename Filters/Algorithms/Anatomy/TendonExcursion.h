@@ -2,6 +2,7 @@
 // Moment arms by tendon excursion along a motion: r = -dL/dq from the lengths at its frames.
 #pragma once
 
+#include <cstddef>
 #include <vector>
 
 namespace md
@@ -19,4 +20,18 @@ constexpr double kCoordinateMoves = 1e-9;
 /// tell them apart), NaN. Exact for a length linear in q; O(dq^2) central.
 std::vector<std::vector<double>> MomentArmsAlongMotion(
   const std::vector<std::vector<double>>& coordinates, const std::vector<double>& lengths);
+
+/// The difference MomentArmsAlongMotion takes at a frame: r = -(L[to] - L[from]) / (q[to] -
+/// q[from]) of coordinate `coordinate`; none (coordinate -1) where it has no moment arm.
+struct ExcursionDifference
+{
+  std::size_t from = 0, to = 0;
+  int coordinate = -1;
+  double dq = 0; ///< q[to] - q[from] of that coordinate
+  /// The moment arm of `lengths` at this frame (NaN for none).
+  double Of(const std::vector<double>& lengths) const;
+};
+/// The differences at every frame of `coordinates` (as MomentArmsAlongMotion): found once, they
+/// serve every length measured over the same frames.
+std::vector<ExcursionDifference> ExcursionDifferences(const std::vector<std::vector<double>>& coordinates);
 }

@@ -296,11 +296,11 @@ std::optional<TriangleTree::Hit> TriangleTree::FirstHit(const Eigen::Vector3d& f
 
 int TriangleTree::Crossings(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const
 {
-  bool grazed = false;
-  return this->SegmentCrossings(from, to - from, 0.0, grazed);
+  return this->SegmentCrossings(from, to - from, 0.0).crossings;
 }
 
-int TriangleTree::CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, bool& grazed) const
+TriangleTree::CrossingCount TriangleTree::CountCrossings(
+  const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const
 {
   // A segment just long enough to leave the surface's box (slab exits).
   double exit = std::numeric_limits<double>::max();
@@ -313,41 +313,35 @@ int TriangleTree::CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vec
     }
   }
   const Eigen::Vector3d d = (std::max(exit, 0.0) + 1e-3 * this->Size) * direction;
-  return this->SegmentCrossings(origin, d, 1e-9, grazed);
+  return this->SegmentCrossings(origin, d, 1e-9);
 }
 
-int TriangleTree::SegmentCrossings(
-  const Eigen::Vector3d& from, const Eigen::Vector3d& d, double edgeTolerance, bool& grazed) const
+TriangleTree::CrossingCount TriangleTree::SegmentCrossings(
+  const Eigen::Vector3d& from, const Eigen::Vector3d& d, double edgeTolerance) const
 {
-  int crossings = 0;
-  grazed = false;
+  CrossingCount count;
   this->ForTrianglesNearSegment(from, d, 1.0, [&](Eigen::Index t) {
     double t01, u, v;
-    if (!IntersectLineTriangle(
-          from, d, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2), edgeTolerance, t01, u, v) ||
-      t01 < 0 || t01 > 1)
+    const Eigen::Vector3d a = this->Corner(t, 0), b = this->Corner(t, 1), c = this->Corner(t, 2);
+    if (!IntersectLineTriangle(from, d, a, b, c, edgeTolerance, t01, u, v) || t01 < 0 || t01 > 1)
     {
       return;
     }
     if (u < edgeTolerance || v < edgeTolerance || u + v > 1 - edgeTolerance)
     {
-      grazed = true; // through an edge or a point: this ray cannot be trusted
+      count.grazed = true; // through an edge or a point: this ray cannot be trusted
     }
-    ++crossings;
+    ++count.crossings;
+    count.leavingMinusEntering += (b - a).cross(c - a).dot(d) > 0 ? 1 : -1;
   });
-  return crossings;
+  return count;
 }
 
-bool TriangleTree::Inside(const Eigen::Vector3d& p) const
+Eigen::Vector3d TriangleTree::RayDirection(const Eigen::Vector3d& p, int k) const
 {
-  if (!this->InBounds(p))
-  {
-    return false; // a closed surface lies within its box
-  }
-  // Rays towards the nearest faces of the surface's box, where they leave it
-  // soonest and so meet the fewest boxes of the tree; each tilted off its
-  // axis by fixed, unremarkable amounts so that no ray runs along the edges
-  // of a mesh aligned with the axes.
+  // Towards the nearest faces of the surface's box, where a ray leaves it soonest and so meets
+  // the fewest boxes of the tree; each tilted off its axis by fixed, unremarkable amounts so that
+  // no ray runs along the edges of a mesh aligned with the axes.
   const Eigen::Vector3d& low = this->Nodes[0].low;
   const Eigen::Vector3d& high = this->Nodes[0].high;
   std::array<std::pair<double, int>, 6> faces; // distance, 2 * axis + (1 towards high)
@@ -361,19 +355,27 @@ bool TriangleTree::Inside(const Eigen::Vector3d& p) const
     Eigen::Vector3d(-0.0963, 0.1311, -0.0729), Eigen::Vector3d(0.1102, -0.0658, -0.1247),
     Eigen::Vector3d(-0.1189, -0.1046, 0.0902), Eigen::Vector3d(0.0817, 0.1153, -0.1361),
     Eigen::Vector3d(-0.0744, -0.1278, -0.0986) };
+  const int axis = faces[size_t(k)].second / 2;
+  Eigen::Vector3d direction = tilts[k];
+  direction[axis] = faces[size_t(k)].second % 2 ? 1.0 : -1.0;
+  return direction.normalized();
+}
+
+bool TriangleTree::Inside(const Eigen::Vector3d& p) const
+{
+  if (!this->InBounds(p))
+  {
+    return false; // a closed surface lies within its box
+  }
   int votesInside = 0, votes = 0;
   for (int k = 0; k < 6; ++k)
   {
-    const int axis = faces[k].second / 2;
-    Eigen::Vector3d direction = tilts[k];
-    direction[axis] = faces[k].second % 2 ? 1.0 : -1.0;
-    bool grazed = false;
-    const int crossings = this->CountCrossings(p, direction.normalized(), grazed);
-    if (grazed)
+    const CrossingCount count = this->CountCrossings(p, this->RayDirection(p, k));
+    if (count.grazed)
     {
       continue;
     }
-    votesInside += crossings % 2;
+    votesInside += count.crossings % 2;
     ++votes;
     if (votes == 3 || (votes == 2 && votesInside != 1))
     {
@@ -387,10 +389,48 @@ bool TriangleTree::Inside(const Eigen::Vector3d& p) const
   return 2 * votesInside > votes;
 }
 
-TriangleTree::Closest TriangleTree::ClosestPoint(const Eigen::Vector3d& p, double within) const
+int TriangleTree::Winding(const Eigen::Vector3d& p) const
+{
+  if (!this->InBounds(p))
+  {
+    return 0;
+  }
+  std::array<int, 6> said{};
+  int rays = 0;
+  for (int k = 0; k < 6; ++k)
+  {
+    const CrossingCount count = this->CountCrossings(p, this->RayDirection(p, k));
+    if (count.grazed)
+    {
+      continue;
+    }
+    said[size_t(rays++)] = count.leavingMinusEntering;
+    for (int other = 0; other + 1 < rays; ++other)
+    {
+      if (said[size_t(other)] == count.leavingMinusEntering)
+      {
+        return count.leavingMinusEntering; // two rays that agree decide
+      }
+    }
+  }
+  // Every ray grazed, or no two agreed: the sum over every triangle.
+  return static_cast<int>(std::lround(WindingNumber(this->Surface.points, this->Surface.triangles, p)));
+}
+
+TriangleTree::Closest TriangleTree::ClosestPoint(const Eigen::Vector3d& p, double within, Eigen::Index hint) const
 {
   Closest best;
   double bestSquared = within < std::numeric_limits<double>::max() ? within * within : within;
+  if (hint >= 0 && hint < this->Surface.triangles.rows())
+  {
+    const double d = PointTriangleDistance(p, this->Corner(hint, 0), this->Corner(hint, 1), this->Corner(hint, 2));
+    if (d * d < bestSquared)
+    {
+      bestSquared = d * d;
+      best.distance = d;
+      best.triangle = hint;
+    }
+  }
   // Each node with its box's distance, found when its parent ordered its children (not again).
   NodeStack<std::pair<int, double>> stack;
   stack.Push({ 0, BoxDistanceSquared(p, this->Nodes[0].low, this->Nodes[0].high) });

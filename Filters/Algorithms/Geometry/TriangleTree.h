@@ -41,6 +41,13 @@ public:
   /// point cannot decide alone.
   bool Inside(const Eigen::Vector3d& p) const;
 
+  /// The winding number of the closed, oriented surface about p (1 inside, 0 outside, 2 where a
+  /// surface that passes through itself covers p twice): the crossings of a ray from p, each +1
+  /// where the ray leaves through a triangle and -1 where it enters, along the same rays as
+  /// Inside, two that agree deciding. The same integer as WindingNumber (MeshChecks.h) rounded,
+  /// at the cost of a ray query instead of a sum over every triangle.
+  int Winding(const Eigen::Vector3d& p) const;
+
   struct Closest
   {
     double distance = 0;
@@ -48,8 +55,11 @@ public:
     Eigen::Vector3d point;
   };
   /// The point of the surface closest to p; with `within`, only if closer
-  /// than that (else triangle -1), which prunes the search to that radius.
-  Closest ClosestPoint(const Eigen::Vector3d& p, double within = std::numeric_limits<double>::max()) const;
+  /// than that (else triangle -1), which prunes the search to that radius. A `hint`, a triangle
+  /// likely to be near p, prunes it from the start to that triangle's distance (the answer is
+  /// the same: a triangle as close as the closest).
+  Closest ClosestPoint(
+    const Eigen::Vector3d& p, double within = std::numeric_limits<double>::max(), Eigen::Index hint = -1) const;
 
   const TriangleMesh& Mesh() const { return this->Surface; }
 
@@ -103,11 +113,23 @@ private:
   {
     return this->Surface.points.row(this->Surface.triangles(triangle, k)).transpose();
   }
-  int CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, bool& grazed) const;
-  /// Triangles the segment from + t d, t in [0, 1], crosses, counting those it
-  /// meets within `edgeTolerance` (barycentric) of their edges, and whether
-  /// any crossing was that close to an edge or a point (`grazed`).
-  int SegmentCrossings(const Eigen::Vector3d& from, const Eigen::Vector3d& d, double edgeTolerance, bool& grazed) const;
+  /// Triangles a segment crosses: how many, their sum with +1 for each the segment leaves through
+  /// (along the triangle's normal) and -1 for each it enters through, and whether any crossing
+  /// was close to an edge or a point (`grazed`: the counts cannot be trusted).
+  struct CrossingCount
+  {
+    int crossings = 0;
+    int leavingMinusEntering = 0;
+    bool grazed = false;
+  };
+  /// The crossings of a ray from `origin` along `direction` out of the surface's box.
+  CrossingCount CountCrossings(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const;
+  /// The crossings of the segment from + t d, t in [0, 1], counting those it meets within
+  /// `edgeTolerance` (barycentric) of their edges.
+  CrossingCount SegmentCrossings(const Eigen::Vector3d& from, const Eigen::Vector3d& d, double edgeTolerance) const;
+  /// The k-th of six ray directions from p (k = 0 first): towards the nearest faces of the
+  /// surface's box, nearest first, each tilted off its axis.
+  Eigen::Vector3d RayDirection(const Eigen::Vector3d& p, int k) const;
   /// Calls visit(triangle) for every triangle whose leaf box the segment
   /// from + t direction, t in [0, limit], meets.
   template<typename Visit>

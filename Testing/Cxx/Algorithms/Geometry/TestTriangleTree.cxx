@@ -5,6 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <limits>
 #include <random>
 
@@ -64,6 +67,62 @@ TEST(TriangleTree, InsideAgreesWithTheWindingNumber)
   }
   EXPECT_EQ(rectusInside, md::CountInside(femur.points, femur.triangles, rectus.points));
   EXPECT_GT(rectusInside, 50);
+}
+
+TEST(TriangleTree, WindingCountsHowOftenTheSurfaceCoversAPoint)
+{
+  // Two femurs, the second moved by a fifth of its width: one surface that covers the overlap
+  // twice (as a muscle does where it folds through itself).
+  const md::TriangleMesh femur = Femur();
+  const double width = (femur.points.colwise().maxCoeff() - femur.points.colwise().minCoeff()).minCoeff();
+  md::TriangleMesh both;
+  both.points.resize(2 * femur.points.rows(), 3);
+  both.points << femur.points, femur.points.rowwise() + Eigen::RowVector3d(width / 5, 0.05 * width, 0.02 * width);
+  both.triangles.resize(2 * femur.triangles.rows(), 3);
+  both.triangles << femur.triangles, femur.triangles.array() + static_cast<int>(femur.points.rows());
+  const md::TriangleTree tree(both);
+  std::mt19937 generator(23);
+  std::array<int, 3> seen{};
+  for (int i = 0; i < 1500; ++i)
+  {
+    // Within half the bone's width of its surface, in any direction.
+    const Eigen::Index v = static_cast<Eigen::Index>(generator() % both.points.rows());
+    const Eigen::Vector3d offset = RandomPoint(generator, both, 0.0) - RandomPoint(generator, both, 0.0);
+    const Eigen::Vector3d p = both.points.row(v).transpose() +
+      0.5 * width * offset.normalized() * std::uniform_real_distribution<double>(0.0, 1.0)(generator);
+    if (tree.ClosestPoint(p).distance < 1e-6)
+    {
+      continue;
+    }
+    const long expected = std::lround(md::WindingNumber(both.points, both.triangles, p));
+    ASSERT_EQ(tree.Winding(p), expected) << p.transpose();
+    ++seen[size_t(std::clamp<long>(expected, 0, 2))];
+  }
+  // Every case met often: outside, covered once, covered twice.
+  EXPECT_GT(seen[0], 500);
+  EXPECT_GT(seen[1], 200);
+  EXPECT_GT(seen[2], 50);
+}
+
+TEST(TriangleTree, AHintChangesNotTheClosestPoint)
+{
+  const md::TriangleMesh femur = Femur();
+  const md::TriangleTree tree(femur);
+  std::mt19937 generator(31);
+  for (int i = 0; i < 500; ++i)
+  {
+    const Eigen::Vector3d p = RandomPoint(generator, femur, 10.0);
+    const Eigen::Index hint = static_cast<Eigen::Index>(generator() % femur.triangles.rows());
+    const double within = i % 2 ? 5.0 : std::numeric_limits<double>::max();
+    const md::TriangleTree::Closest plain = tree.ClosestPoint(p, within);
+    const md::TriangleTree::Closest hinted = tree.ClosestPoint(p, within, hint);
+    ASSERT_EQ(plain.triangle >= 0, hinted.triangle >= 0) << p.transpose();
+    if (plain.triangle >= 0)
+    {
+      EXPECT_EQ(hinted.distance, plain.distance);
+      EXPECT_LT((hinted.point - plain.point).norm(), 1e-12);
+    }
+  }
 }
 
 TEST(TriangleTree, FirstHitCrossingsAndClosestPointAgreeWithBruteForce)
