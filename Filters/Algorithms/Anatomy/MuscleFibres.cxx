@@ -961,6 +961,83 @@ void KeepLargest(const Points& surface, const Eigen::Vector3d& x, const Eigen::R
   }
 }
 
+/// Fibres traced through the field on a grid of about `gridNodes` nodes inside the muscle (see
+/// MuscleFibres::MuscleFibres), each with how its ends are carried; `free` says whether a point
+/// is inside the muscle and out of the obstacles. Throws InputError where SolveField does.
+struct TracedFibres
+{
+  int gridNodes = 0;
+  double spacing = 0; ///< the grid's
+  std::vector<Points> fibres;
+  std::vector<std::array<FibreEnd, 2>> ends; ///< per fibre, how each end is carried
+};
+
+template<typename Free>
+TracedFibres TraceFibres(const TriangleMesh& rest, const FibreEnds& given, const FibreParameters& parameters,
+  int gridNodes, const std::vector<const TriangleMesh*>& obstacles, const Free& free)
+{
+  const Field field = SolveField(rest, given, gridNodes, obstacles);
+  TracedFibres traced;
+  traced.spacing = field.grid.h;
+  traced.gridNodes = gridNodes;
+  std::vector<Points>& fibres = traced.fibres;
+  std::vector<std::array<FibreEnd, 2>>& ends = traced.ends;
+  const double longest = BoxDiagonal(rest.points);
+  const auto wanted = size_t(parameters.count);
+  const EndSurface origin = EndTriangles(rest, given.origin), insertion = EndTriangles(rest, given.insertion);
+  // Three times the seeds asked for: a streamline that stalls or leaves the muscle is replaced.
+  for (const Eigen::Vector3d& seed : Seeds(field, 3 * wanted))
+  {
+    if (fibres.size() == wanted)
+    {
+      break;
+    }
+    std::vector<Eigen::Vector3d> up = Streamline(field, seed, longest, 1);
+    std::vector<Eigen::Vector3d> line = Streamline(field, seed, longest, 0);
+    if (up.empty() || line.empty() || up.size() + line.size() < 3)
+    {
+      continue;
+    }
+    std::reverse(line.begin(), line.end()); // from the origin to the seed, then on to the insertion
+    line.insert(line.end(), up.begin() + 1, up.end());
+    // The inner points at equal arc lengths; each end on the segment from its area's point
+    // nearest the fibre's next point to that point, halfway (or farther in, to be inside).
+    const Points innerPoints = ResampleByArcLength(line, parameters.pointsPerFibre - 2);
+    Points fibre(parameters.pointsPerFibre, 3);
+    fibre.middleRows(1, parameters.pointsPerFibre - 2) = innerPoints;
+    std::array<FibreEnd, 2> closing;
+    bool inside = true;
+    for (int side = 0; side < 2 && inside; ++side)
+    {
+      const Eigen::Vector3d next = innerPoints.row(side == 0 ? 0 : innerPoints.rows() - 1).transpose();
+      closing[size_t(side)].anchor = NearestAnchor(side == 0 ? origin : insertion, next);
+      inside = false;
+      for (double share : { 0.5, 0.7, 0.9 })
+      {
+        const Eigen::Vector3d end =
+          closing[size_t(side)].anchor.point + share * (next - closing[size_t(side)].anchor.point);
+        if (free(end))
+        {
+          closing[size_t(side)].share = share;
+          fibre.row(side == 0 ? 0 : parameters.pointsPerFibre - 1) = end.transpose();
+          inside = true;
+          break;
+        }
+      }
+    }
+    for (Eigen::Index p = 1; p + 1 < fibre.rows() && inside; ++p)
+    {
+      inside = free(fibre.row(p).transpose());
+    }
+    if (inside)
+    {
+      fibres.push_back(std::move(fibre));
+      ends.push_back(closing);
+    }
+  }
+  return traced;
+}
+
 }
 
 FibreEnds FindFibreEnds(
@@ -1045,7 +1122,6 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& given, con
   {
     throw InputError("the fibres need a count of at least 1 and at least 3 points each");
   }
-  const Field field = SolveField(rest, given, parameters.gridNodes, obstacles);
   const TriangleTree tree(rest);
   std::vector<TriangleTree> obstacleTrees;
   for (const TriangleMesh* obstacle : obstacles)
@@ -1058,64 +1134,38 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& given, con
       return o.InBounds(x) && o.Inside(x);
     });
   };
-  const double longest = BoxDiagonal(rest.points);
+  // A muscle too slender for its grid (no inside next to an end, the ends not joined, or few
+  // streamlines that stay inside) is traced once more on a grid of four times the nodes; the
+  // attempt with more fibres is kept.
   const auto wanted = size_t(parameters.count);
-  const EndSurface origin = EndTriangles(rest, given.origin), insertion = EndTriangles(rest, given.insertion);
-  std::vector<std::array<FibreEnd, 2>> ends; // per fibre, how each end is carried
-  std::vector<Points> fibres;
-  // Three times the seeds asked for: a streamline that stalls or leaves the muscle is replaced.
-  for (const Eigen::Vector3d& seed : Seeds(field, 3 * wanted))
+  TracedFibres traced;
+  std::string firstError;
+  int nodes = parameters.gridNodes;
+  for (int attempt = 0; attempt < 2 && 2 * traced.fibres.size() < wanted; ++attempt, nodes *= 4)
   {
-    if (fibres.size() == wanted)
+    try
     {
-      break;
-    }
-    std::vector<Eigen::Vector3d> up = Streamline(field, seed, longest, 1);
-    std::vector<Eigen::Vector3d> line = Streamline(field, seed, longest, 0);
-    if (up.empty() || line.empty() || up.size() + line.size() < 3)
-    {
-      continue;
-    }
-    std::reverse(line.begin(), line.end()); // from the origin to the seed, then on to the insertion
-    line.insert(line.end(), up.begin() + 1, up.end());
-    // The inner points at equal arc lengths; each end on the segment from its area's point
-    // nearest the fibre's next point to that point, halfway (or farther in, to be inside).
-    const Points innerPoints = ResampleByArcLength(line, parameters.pointsPerFibre - 2);
-    Points fibre(parameters.pointsPerFibre, 3);
-    fibre.middleRows(1, parameters.pointsPerFibre - 2) = innerPoints;
-    std::array<FibreEnd, 2> closing;
-    bool inside = true;
-    for (int side = 0; side < 2 && inside; ++side)
-    {
-      const Eigen::Vector3d next = innerPoints.row(side == 0 ? 0 : innerPoints.rows() - 1).transpose();
-      closing[size_t(side)].anchor = NearestAnchor(side == 0 ? origin : insertion, next);
-      inside = false;
-      for (double share : { 0.5, 0.7, 0.9 })
+      TracedFibres more = TraceFibres(rest, given, parameters, nodes, obstacles, free);
+      if (more.fibres.size() > traced.fibres.size())
       {
-        const Eigen::Vector3d end =
-          closing[size_t(side)].anchor.point + share * (next - closing[size_t(side)].anchor.point);
-        if (free(end))
-        {
-          closing[size_t(side)].share = share;
-          fibre.row(side == 0 ? 0 : parameters.pointsPerFibre - 1) = end.transpose();
-          inside = true;
-          break;
-        }
+        traced = std::move(more);
       }
     }
-    for (Eigen::Index p = 1; p + 1 < fibre.rows() && inside; ++p)
+    catch (const InputError& error)
     {
-      inside = free(fibre.row(p).transpose());
-    }
-    if (inside)
-    {
-      fibres.push_back(std::move(fibre));
-      ends.push_back(closing);
+      firstError = firstError.empty() ? error.what() : firstError;
     }
   }
+  std::vector<Points>& fibres = traced.fibres;
+  std::vector<std::array<FibreEnd, 2>>& ends = traced.ends;
   if (fibres.empty())
   {
-    throw InputError("no fibre could be traced from its origin to its insertion");
+    throw InputError(firstError.empty() ? "no fibre could be traced from its origin to its insertion" : firstError);
+  }
+  if (traced.gridNodes != parameters.gridNodes)
+  {
+    this->Said.push_back("traced on a grid of " + std::to_string(traced.gridNodes) + " nodes, not " +
+      std::to_string(parameters.gridNodes) + ": the muscle is too slender for that");
   }
   if (fibres.size() < wanted)
   {
@@ -1188,7 +1238,7 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& given, con
   this->RestTree = std::make_shared<const TriangleTree>(tree);
   this->Depth.resize(this->RestPoints.rows());
   this->NearestWall.resize(size_t(this->RestPoints.rows()));
-  this->Reach = kEscapeReach * field.grid.h;
+  this->Reach = kEscapeReach * traced.spacing;
   for (Eigen::Index p = 0; p < this->RestPoints.rows(); ++p)
   {
     const Eigen::Vector3d x = this->RestPoints.row(p).transpose();
@@ -1200,7 +1250,7 @@ MuscleFibres::MuscleFibres(const TriangleMesh& rest, const FibreEnds& given, con
       const TriangleTree::Closest nearest = o.ClosestPoint(x, depth);
       depth = nearest.triangle >= 0 ? nearest.distance : depth;
     }
-    this->Depth[p] = std::min(depth, kFibreClearance * field.grid.h);
+    this->Depth[p] = std::min(depth, kFibreClearance * traced.spacing);
   }
   this->Weights.resize(this->RestPoints.rows(), rest.points.rows());
   this->Weights.setFromTriplets(entries.begin(), entries.end());

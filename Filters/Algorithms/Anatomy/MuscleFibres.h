@@ -28,7 +28,9 @@ struct FibreParameters
 {
   int count = 100;         ///< fibres per muscle
   int pointsPerFibre = 13; ///< points of each fibre's polyline, its ends included
-  int gridNodes = 20000;   ///< about this many grid nodes inside the muscle carry the field
+  /// About this many grid nodes inside the muscle carry the field (four times as many, once,
+  /// where that traces under half the fibres).
+  int gridNodes = 20000;
   /// Share of the mean value weights (by absolute size) each fibre point keeps; the rest, the
   /// far surface's, is dropped and the kept weights are corrected to reproduce every affine map
   /// exactly. Keeps a frame's fibres a sparse product.
@@ -81,8 +83,9 @@ public:
   /// streamline of grad phi from a seed next to the origin (seeds spread over it by farthest
   /// point sampling) to the insertion, closed at both ends by the nearest point of the end's
   /// area just inside the surface, and resampled to pointsPerFibre points at equal arc lengths.
-  /// Throws InputError when no fibre can be made (an end with no inside next to it, the ends
-  /// not connected inside the muscle).
+  /// Where fewer than half the fibres can be traced, the muscle is traced once more on a grid
+  /// of 4 * gridNodes (said in Warnings). Throws InputError when no fibre can be made on either
+  /// (an end with no inside next to it, the ends not connected inside the muscle).
   /// The fibres keep out of `obstacles` (closed surfaces: the bones, in the muscle's frame),
   /// where the rest muscle overlaps them too.
   MuscleFibres(const TriangleMesh& rest, const FibreEnds& ends, const FibreParameters& parameters = {},

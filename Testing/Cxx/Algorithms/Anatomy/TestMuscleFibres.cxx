@@ -124,6 +124,37 @@ TEST(MuscleFibres, InACylinderTheyRunStraightFromCapToCap)
   EXPECT_GT(farthest, 0.7 * radius);
 }
 
+// A muscle too slender for the grid asked for (spacing 3.2 about an axis 3 from the wall: few
+// nodes inside) is traced on a grid of four times the nodes, as if that had been asked for, and
+// says so.
+TEST(MuscleFibres, ATooSlenderMuscleIsTracedOnAFinerGrid)
+{
+  const double length = 200, radius = 3;
+  const md::TriangleMesh cylinder = Cylinder(radius, length, 16, 60);
+  md::FibreParameters parameters;
+  parameters.gridNodes = 200;
+  parameters.count = 8;
+  const md::MuscleFibres fibres(cylinder, CapEnds(cylinder, length), parameters);
+  ASSERT_FALSE(fibres.Warnings().empty());
+  EXPECT_NE(fibres.Warnings().front().find("grid of 800 nodes, not 200"), std::string::npos)
+    << fibres.Warnings().front();
+  md::FibreParameters finer = parameters;
+  finer.gridNodes = 800;
+  const md::MuscleFibres asked(cylinder, CapEnds(cylinder, length), finer);
+  EXPECT_EQ(fibres.Count(), 8);
+  EXPECT_EQ(fibres.Count(), asked.Count());
+  EXPECT_EQ(fibres.Rest(), asked.Rest());
+  const md::TriangleTree tree(cylinder);
+  for (Eigen::Index p = 0; p < fibres.Rest().rows(); ++p)
+  {
+    EXPECT_TRUE(tree.Inside(fibres.Rest().row(p).transpose())) << "fibre point " << p;
+  }
+  for (double l : fibres.Lengths(fibres.Rest()))
+  {
+    EXPECT_GT(l, length - 6.0);
+  }
+}
+
 // A bone poked deep into the muscle (6 deep at the axis, beyond any fixed search radius the
 // fibres use): with its distance grid, every fibre point inside it is put out of it, and stays
 // inside the muscle.
@@ -163,7 +194,7 @@ TEST(MuscleFibres, AnAffineMapOfTheSurfaceCarriesThemExactly)
   const double length = 80;
   const md::TriangleMesh cylinder = Cylinder(8, length);
   md::FibreParameters parameters;
-  parameters.count = 20;
+  parameters.count = 8;
   parameters.gridNodes = 4000;
   const md::MuscleFibres fibres(cylinder, CapEnds(cylinder, length), parameters);
   EXPECT_LT(fibres.MeanWeightsPerPoint(), 0.9 * static_cast<double>(cylinder.points.rows()));
