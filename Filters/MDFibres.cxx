@@ -269,20 +269,17 @@ void WriteMomentArms(const std::vector<FrameLengths>& frames, const PoseCoordina
         values.clear();
         for (size_t f = 0; f < fibres; ++f)
         {
-          const double arm = -(frames[d.to].fibreLengths[m][f] - frames[d.from].fibreLengths[m][f]) / d.dq;
+          const double arm = d.Of(frames[d.from].fibreLengths[m][f], frames[d.to].fibreLengths[m][f]);
           if (!std::isnan(arm))
           {
             values.push_back(arm);
           }
         }
         const md::Spread s = md::SpreadOf(values);
-        for (int j = 0; j < 3; ++j)
-        {
-          armSpread[size_t(d.coordinate)][size_t(j)]->SetValue(static_cast<vtkIdType>(k),
-            j == 0     ? s.median
-              : j == 1 ? s.low
-                       : s.high);
-        }
+        const std::array<vtkDoubleArray*, 3>& to = armSpread[size_t(d.coordinate)];
+        to[0]->SetValue(static_cast<vtkIdType>(k), s.median);
+        to[1]->SetValue(static_cast<vtkIdType>(k), s.low);
+        to[2]->SetValue(static_cast<vtkIdType>(k), s.high);
       }
     }
     for (size_t l = 0; m < lineNames.size() && l < lineNames[m].size(); ++l)

@@ -55,7 +55,7 @@ std::vector<ExcursionDifference> ExcursionDifferences(const std::vector<std::vec
 
 double ExcursionDifference::Of(const std::vector<double>& lengths) const
 {
-  return this->coordinate >= 0 && this->to < lengths.size() ? -(lengths[this->to] - lengths[this->from]) / this->dq
+  return this->coordinate >= 0 && this->to < lengths.size() ? this->Of(lengths[this->from], lengths[this->to])
                                                             : std::numeric_limits<double>::quiet_NaN();
 }
 

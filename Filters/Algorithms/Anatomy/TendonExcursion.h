@@ -30,6 +30,8 @@ struct ExcursionDifference
   double dq = 0; ///< q[to] - q[from] of that coordinate
   /// The moment arm of `lengths` at this frame (NaN for none).
   double Of(const std::vector<double>& lengths) const;
+  /// The moment arm of a length that is `atFrom` at frame `from` and `atTo` at frame `to`.
+  double Of(double atFrom, double atTo) const { return -(atTo - atFrom) / this->dq; }
 };
 /// The differences at every frame of `coordinates` (as MomentArmsAlongMotion): found once, they
 /// serve every length measured over the same frames.

@@ -186,9 +186,8 @@ void TriangleTree::BuildDistanceGrid(int nodes)
   // A flat box gets a hundredth of the surface's size across, so that the cells stay few.
   const Eigen::Vector3d box = (this->Nodes[0].high - this->Nodes[0].low).cwiseMax(0.01 * this->Size);
   this->GridCell = std::cbrt(box.prod() / std::max(nodes, 8));
-  this->GridMargin = this->GridCell;
-  this->GridOrigin = this->Nodes[0].low - Eigen::Vector3d::Constant(this->GridMargin);
-  const Eigen::Vector3d extent = box + Eigen::Vector3d::Constant(2 * this->GridMargin);
+  this->GridOrigin = this->Nodes[0].low - Eigen::Vector3d::Constant(this->GridCell);
+  const Eigen::Vector3d extent = box + Eigen::Vector3d::Constant(2 * this->GridCell);
   for (int axis = 0; axis < 3; ++axis)
   {
     this->GridCount[size_t(axis)] = static_cast<int>(std::ceil(extent[axis] / this->GridCell)) + 1;
@@ -220,7 +219,7 @@ std::optional<std::pair<double, double>> TriangleTree::SignedDistanceBounds(cons
     const double u = std::round((p[axis] - this->GridOrigin[axis]) / this->GridCell);
     if (!(u >= 0 && u < this->GridCount[size_t(axis)]))
     {
-      return std::make_pair(this->GridMargin, std::numeric_limits<double>::infinity());
+      return std::make_pair(this->GridCell, std::numeric_limits<double>::infinity());
     }
     at[size_t(axis)] = static_cast<Eigen::Index>(u);
   }
@@ -337,7 +336,7 @@ TriangleTree::CrossingCount TriangleTree::SegmentCrossings(
   return count;
 }
 
-Eigen::Vector3d TriangleTree::RayDirection(const Eigen::Vector3d& p, int k) const
+std::array<Eigen::Vector3d, 6> TriangleTree::RayDirections(const Eigen::Vector3d& p) const
 {
   // Towards the nearest faces of the surface's box, where a ray leaves it soonest and so meets
   // the fewest boxes of the tree; each tilted off its axis by fixed, unremarkable amounts so that
@@ -355,10 +354,15 @@ Eigen::Vector3d TriangleTree::RayDirection(const Eigen::Vector3d& p, int k) cons
     Eigen::Vector3d(-0.0963, 0.1311, -0.0729), Eigen::Vector3d(0.1102, -0.0658, -0.1247),
     Eigen::Vector3d(-0.1189, -0.1046, 0.0902), Eigen::Vector3d(0.0817, 0.1153, -0.1361),
     Eigen::Vector3d(-0.0744, -0.1278, -0.0986) };
-  const int axis = faces[size_t(k)].second / 2;
-  Eigen::Vector3d direction = tilts[k];
-  direction[axis] = faces[size_t(k)].second % 2 ? 1.0 : -1.0;
-  return direction.normalized();
+  std::array<Eigen::Vector3d, 6> directions;
+  for (size_t k = 0; k < 6; ++k)
+  {
+    const int axis = faces[k].second / 2;
+    directions[k] = tilts[k];
+    directions[k][axis] = faces[k].second % 2 ? 1.0 : -1.0;
+    directions[k].normalize();
+  }
+  return directions;
 }
 
 bool TriangleTree::Inside(const Eigen::Vector3d& p) const
@@ -368,9 +372,9 @@ bool TriangleTree::Inside(const Eigen::Vector3d& p) const
     return false; // a closed surface lies within its box
   }
   int votesInside = 0, votes = 0;
-  for (int k = 0; k < 6; ++k)
+  for (const Eigen::Vector3d& direction : this->RayDirections(p))
   {
-    const CrossingCount count = this->CountCrossings(p, this->RayDirection(p, k));
+    const CrossingCount count = this->CountCrossings(p, direction);
     if (count.grazed)
     {
       continue;
@@ -397,9 +401,9 @@ int TriangleTree::Winding(const Eigen::Vector3d& p) const
   }
   std::array<int, 6> said{};
   int rays = 0;
-  for (int k = 0; k < 6; ++k)
+  for (const Eigen::Vector3d& direction : this->RayDirections(p))
   {
-    const CrossingCount count = this->CountCrossings(p, this->RayDirection(p, k));
+    const CrossingCount count = this->CountCrossings(p, direction);
     if (count.grazed)
     {
       continue;

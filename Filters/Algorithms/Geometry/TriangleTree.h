@@ -127,9 +127,9 @@ private:
   /// The crossings of the segment from + t d, t in [0, 1], counting those it meets within
   /// `edgeTolerance` (barycentric) of their edges.
   CrossingCount SegmentCrossings(const Eigen::Vector3d& from, const Eigen::Vector3d& d, double edgeTolerance) const;
-  /// The k-th of six ray directions from p (k = 0 first): towards the nearest faces of the
-  /// surface's box, nearest first, each tilted off its axis.
-  Eigen::Vector3d RayDirection(const Eigen::Vector3d& p, int k) const;
+  /// Six ray directions from p: towards the faces of the surface's box, nearest first, each
+  /// tilted off its axis.
+  std::array<Eigen::Vector3d, 6> RayDirections(const Eigen::Vector3d& p) const;
   /// Calls visit(triangle) for every triangle whose leaf box the segment
   /// from + t direction, t in [0, limit], meets.
   template<typename Visit>
@@ -140,7 +140,7 @@ private:
   std::vector<Node> Nodes;
   std::vector<float> GridDistance; ///< signed distance at each grid node, x fastest; empty: no grid
   Eigen::Vector3d GridOrigin = Eigen::Vector3d::Zero();
-  double GridCell = 0, GridMargin = 0;
+  double GridCell = 0; ///< also the margin the grid reaches beyond the surface's box
   std::array<int, 3> GridCount{};
   std::vector<Eigen::Index> Order;
   /// Each leaf's points, once each: a refit reads each point about twice rather than six times.
