@@ -17,7 +17,10 @@ a movie (<case>.avi); plots of the measures over time (<case>_measures.png,
 <case>_smoothness.png); and figures.json (per-frame time through the filter, and every measure at
 every frame). For the LHDL hip, per muscle, a plot of its straight paths' moment arms (the
 reader's MomentArms table) against the joint angle beside Blemker & Delp 2005's range
-(<motion>_moment_arm_<muscle>.png), and in figures.json the share of poses inside that range.
+(<motion>_moment_arm_<muscle>.png), and in figures.json the share of poses inside that range;
+the motion filter's MomentArms table as <motion>_moment_arms.csv. The fibres' moment arms come
+from each frame stepped by +-1 degree in its coordinate (the reader's MomentArmStep; about three
+times a frame's cost, --moment-arm-step 0 for differences between frames instead).
 The LHDL paths' conditional points fade over 10 degrees (ConditionalPointFade), so
 the lines move continuously. The LHDL muscles are attached to their bones by the data set's own landmarks
 (attachment_areas_rp_mm.csv, AttachmentFileName); figures.json gives, per muscle, the largest slip
@@ -63,6 +66,7 @@ def lhdl_pipeline(data, motion_name):
     # The psoas's and the iliacus's via points go at 40 and 54 degrees of flexion: faded over 10
     # degrees, their lines, and the muscles, move continuously instead of jumping there.
     reader.ConditionalPointFade = CONDITIONAL_POINT_FADE
+    reader.MomentArmStep = MOMENT_ARM_STEP[0]
     READERS[motion_name] = reader
     bones = lhdl.producer(lhdl.named_blocks([(n, lhdl.read_surface(folder, n)) for n in lhdl.BONES]),
                           "LHDL bones (rest pose)")
@@ -84,6 +88,7 @@ def lhdl_pipeline(data, motion_name):
 LANDMARKS = "attachment_areas_rp_mm.csv"
 READERS = {}  # motion name: the model reader playing it (its MomentArms table)
 CONDITIONAL_POINT_FADE = 10.0  # degrees
+MOMENT_ARM_STEP = [1.0]  # degrees (--moment-arm-step)
 # The data set's names for the muscles and the bones its landmarks lie on (the iliotibial tract's,
 # on the tibia, is on no bone of the scan and left out).
 LANDMARK_MUSCLES = {"R_Glut_Max": "gluteus_maximus_r", "R_Glut_Med": "gluteus_medius_r", "R_Iliacus": "iliacus_r",
@@ -240,6 +245,11 @@ def moment_arm_plots(motion, reader, data, motion_name, folder):
     coordinate = {"hip_flexion": "hip_flexion_r", "hip_adduction": "hip_adduction_r"}[motion_name]
     paths = table_columns(servermanager.Fetch(reader, idx=6))
     fibres = table_columns(servermanager.Fetch(motion, idx=5))
+    # The motion filter's MomentArms table as it is, for a user's own plots and statistics.
+    with open(os.path.join(folder, "%s_moment_arms.csv" % motion_name), "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(list(fibres))
+        writer.writerows(zip(*fibres.values()))
     angles = fibres[coordinate]
     path_angles = paths[coordinate]
     inside = {"fibres": {}, "modenese_kohout_2020_fibres": {}, "straight_paths": {}}
@@ -486,7 +496,11 @@ def main(argv=None):
     parser.add_argument("--data", help="folder holding lhdl_hip_r (default ../shared/data)")
     parser.add_argument("--case", default="all", choices=["all", "phantom", "hip_flexion", "hip_adduction"])
     parser.add_argument("--every", type=int, default=1, help="a picture every this many frames")
+    parser.add_argument("--moment-arm-step", type=float, default=MOMENT_ARM_STEP[0],
+                        help="degrees: the LHDL fibres' moment arms from each frame stepped by +- this much in "
+                             "its coordinate (OpenSimModelReader's MomentArmStep); 0: from differences between frames")
     args = parser.parse_args(argv)
+    MOMENT_ARM_STEP[0] = args.moment_arm_step
     mdexamples.load_plugin(explicit=args.plugin)
     results = []
     if args.case in ("all", "phantom"):

@@ -133,10 +133,22 @@ constexpr const char* Body = "Body"; ///< a body's name: BodyTransforms' first c
 constexpr const char* RotationalCoordinates = "RotationalCoordinates";
 /// The motion filter's fibres (a cell array of output Fibres) and its MomentArms table's columns.
 constexpr const char* FibreLength = "FibreLength";
+/// BodyTransforms' column naming the pose of each row where OpenSimModelReader's MomentArmStep
+/// adds rows: empty for the frame's own pose, "<coordinate>+" or "<coordinate>-" for the frame's
+/// pose stepped by +-MomentArmStep in that coordinate. Absent: every row is the frame's.
+constexpr const char* Pose = "Pose";
+/// BodyTransforms' field data (and MoveWithBodies' output's): the step of the stepped poses, degrees.
+constexpr const char* MomentArmStep = "MomentArmStep";
 /// BodyTransforms' other columns (OpenSimModelReader writes them, MoveWithBodies reads them): each
 /// body's rest-to-current rotation, row by row, then its translation.
 constexpr const char* TransformColumns[12] = { "R00", "R01", "R02", "R10", "R11", "R12", "R20", "R21", "R22", "Tx",
   "Ty", "Tz" };
+}
+
+/// The point array of a block's points at a stepped pose (array::Pose): "PointsAt(<pose>)".
+inline std::string PointsAt(const std::string& pose)
+{
+  return "PointsAt(" + pose + ")";
 }
 
 /// Writes `role` as the cell array Role of every polydata leaf of `data` (in leaf order: muscle

@@ -15,6 +15,7 @@
 #include <vtkIdTypeArray.h>
 #include <vtkNew.h>
 #include <vtkOutputWindow.h>
+#include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkStringArray.h>
 #include <vtkTable.h>
@@ -48,7 +49,8 @@ std::vector<double> ReadCoordinates(vtkDataObject* bones, PoseCoordinates& names
     for (int a = 0; a < data->GetNumberOfArrays(); ++a)
     {
       const char* name = data->GetArrayName(a);
-      if (!name || std::string(name) == array::Time || !SingleNumber(data, name))
+      if (!name || std::string(name) == array::Time || std::string(name) == array::MomentArmStep ||
+        !SingleNumber(data, name))
       {
         continue;
       }
@@ -63,6 +65,40 @@ std::vector<double> ReadCoordinates(vtkDataObject* bones, PoseCoordinates& names
     values.push_back(array ? array->GetTuple1(0) * (names.rotational[c] ? kDegree : 1.0) : kNaN);
   }
   return values;
+}
+
+std::vector<std::pair<std::string, SteppedLengths>> SteppedPosesOf(
+  vtkDataObject* bones, vtkPolyData* bone, const PoseCoordinates& coordinates)
+{
+  std::vector<std::pair<std::string, SteppedLengths>> poses;
+  vtkDataArray* step = SingleNumber(bones ? bones->GetFieldData() : nullptr, array::MomentArmStep);
+  if (!step || !bone || step->GetTuple1(0) <= 0.0)
+  {
+    return poses;
+  }
+  const std::string prefix = PointsAt("");
+  const std::string opening = prefix.substr(0, prefix.size() - 1); // "PointsAt("
+  vtkPointData* data = bone->GetPointData();
+  for (int a = 0; a < data->GetNumberOfArrays(); ++a)
+  {
+    const std::string name = data->GetArrayName(a) ? data->GetArrayName(a) : "";
+    if (name.size() < opening.size() + 3 || name.compare(0, opening.size(), opening) != 0 || name.back() != ')')
+    {
+      continue;
+    }
+    const std::string pose = name.substr(opening.size(), name.size() - opening.size() - 1);
+    const char sign = pose.back();
+    if (sign != '+' && sign != '-')
+    {
+      continue;
+    }
+    SteppedLengths stepped;
+    const auto c = std::find(coordinates.names.begin(), coordinates.names.end(), pose.substr(0, pose.size() - 1));
+    stepped.coordinate = c == coordinates.names.end() ? -1 : static_cast<int>(c - coordinates.names.begin());
+    stepped.step = (sign == '+' ? 1.0 : -1.0) * step->GetTuple1(0) * kDegree;
+    poses.emplace_back(pose, std::move(stepped));
+  }
+  return poses;
 }
 
 std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, const std::string& filterName,
@@ -233,9 +269,50 @@ void WriteMomentArms(const std::vector<FrameLengths>& frames, const PoseCoordina
       values->SetValue(static_cast<vtkIdType>(k), q[k][i] / kDegree);
     }
   }
-  // Which frames each frame's moment arm differences, and about which coordinate: found once for
-  // every length (md::MomentArmsAlongMotion's).
+  // How each frame's moment arm about each moving coordinate is found: the central difference of
+  // its stepped poses where it has both, else md::MomentArmsAlongMotion's difference between frames.
   const std::vector<md::ExcursionDifference> differences = md::ExcursionDifferences(q);
+  struct Source
+  {
+    int plus = -1, minus = -1; // FrameLengths::stepped
+  };
+  std::vector<std::vector<Source>> sources(frames.size(), std::vector<Source>(moving.size()));
+  bool anyStepped = false, anyDifference = false;
+  for (size_t k = 0; k < frames.size(); ++k)
+  {
+    for (size_t s = 0; s < frames[k].stepped.size(); ++s)
+    {
+      const SteppedLengths& at = frames[k].stepped[s];
+      const auto i = std::find(moving.begin(), moving.end(), static_cast<size_t>(at.coordinate));
+      if (at.coordinate >= 0 && i != moving.end())
+      {
+        (at.step > 0 ? sources[k][size_t(i - moving.begin())].plus : sources[k][size_t(i - moving.begin())].minus) =
+          static_cast<int>(s);
+      }
+    }
+  }
+  // The moment arm at frame k about moving coordinate i of the length `of` gives at a frame or a
+  // stepped pose (both have fibreLengths and lineLengths).
+  const auto armAt = [&](size_t k, size_t i, const auto& of) {
+    const Source& source = sources[k][i];
+    if (source.plus >= 0 && source.minus >= 0)
+    {
+      const SteppedLengths &plus = frames[k].stepped[size_t(source.plus)],
+                           &minus = frames[k].stepped[size_t(source.minus)];
+      return -(of(plus) - of(minus)) / (plus.step - minus.step);
+    }
+    const md::ExcursionDifference& d = differences[k];
+    return d.coordinate == static_cast<int>(i) ? d.Of(of(frames[d.from]), of(frames[d.to])) : kNaN;
+  };
+  for (size_t k = 0; k < frames.size(); ++k)
+  {
+    for (size_t i = 0; i < moving.size(); ++i)
+    {
+      const bool stepped = sources[k][i].plus >= 0 && sources[k][i].minus >= 0;
+      anyStepped = anyStepped || stepped;
+      anyDifference = anyDifference || (!stepped && differences[k].coordinate == static_cast<int>(i));
+    }
+  }
   for (size_t m = 0; m < muscleNames.size(); ++m)
   {
     const std::string& muscle = muscleNames[m];
@@ -251,60 +328,62 @@ void WriteMomentArms(const std::vector<FrameLengths>& frames, const PoseCoordina
         spread[1]->SetValue(static_cast<vtkIdType>(k), s.low);
         spread[2]->SetValue(static_cast<vtkIdType>(k), s.high);
       }
-      std::vector<std::array<vtkDoubleArray*, 3>> armSpread; // [moving coordinate]: median, low, high
-      for (size_t c : moving)
+      for (size_t i = 0; i < moving.size(); ++i)
       {
-        const std::string about = muscle + ", " + coordinates.names[c] + ")";
-        armSpread.push_back({ column("FibreMomentArm(" + about), column("FibreMomentArmMin(" + about),
-          column("FibreMomentArmMax(" + about) });
-      }
-      std::vector<double> values;
-      for (size_t k = 0; k < frames.size(); ++k)
-      {
-        const md::ExcursionDifference& d = differences[k];
-        if (d.coordinate < 0)
+        const std::string about = muscle + ", " + coordinates.names[moving[i]] + ")";
+        vtkDoubleArray* armSpread[3] = { column("FibreMomentArm(" + about), column("FibreMomentArmMin(" + about),
+          column("FibreMomentArmMax(" + about) };
+        std::vector<double> values;
+        for (size_t k = 0; k < frames.size(); ++k)
         {
-          continue; // NaN: no moment arm at this frame
-        }
-        values.clear();
-        for (size_t f = 0; f < fibres; ++f)
-        {
-          const double arm = d.Of(frames[d.from].fibreLengths[m][f], frames[d.to].fibreLengths[m][f]);
-          if (!std::isnan(arm))
+          values.clear();
+          for (size_t f = 0; f < fibres; ++f)
           {
-            values.push_back(arm);
+            const double arm = armAt(k, i, [&](const auto& at) {
+              return m < at.fibreLengths.size() && f < at.fibreLengths[m].size() ? at.fibreLengths[m][f] : kNaN;
+            });
+            if (!std::isnan(arm))
+            {
+              values.push_back(arm);
+            }
           }
+          if (values.empty())
+          {
+            continue; // NaN: no moment arm at this frame
+          }
+          const md::Spread s = md::SpreadOf(values);
+          armSpread[0]->SetValue(static_cast<vtkIdType>(k), s.median);
+          armSpread[1]->SetValue(static_cast<vtkIdType>(k), s.low);
+          armSpread[2]->SetValue(static_cast<vtkIdType>(k), s.high);
         }
-        const md::Spread s = md::SpreadOf(values);
-        const std::array<vtkDoubleArray*, 3>& to = armSpread[size_t(d.coordinate)];
-        to[0]->SetValue(static_cast<vtkIdType>(k), s.median);
-        to[1]->SetValue(static_cast<vtkIdType>(k), s.low);
-        to[2]->SetValue(static_cast<vtkIdType>(k), s.high);
       }
     }
     for (size_t l = 0; m < lineNames.size() && l < lineNames[m].size(); ++l)
     {
       const std::string& line = lineNames[m][l];
+      const auto lengthOf = [&](const auto& at) {
+        return m < at.lineLengths.size() && l < at.lineLengths[m].size() ? at.lineLengths[m][l] : kNaN;
+      };
       vtkDoubleArray* length = column("Length(" + line + ")");
-      std::vector<double> lengths;
       for (size_t k = 0; k < frames.size(); ++k)
       {
-        lengths.push_back(l < frames[k].lineLengths[m].size() ? frames[k].lineLengths[m][l] : kNaN);
-        length->SetValue(static_cast<vtkIdType>(k), lengths.back());
+        length->SetValue(static_cast<vtkIdType>(k), lengthOf(frames[k]));
       }
-      std::vector<vtkDoubleArray*> arm;
-      for (size_t c : moving)
+      for (size_t i = 0; i < moving.size(); ++i)
       {
-        arm.push_back(column("MomentArm(" + line + ", " + coordinates.names[c] + ")"));
-      }
-      for (size_t k = 0; k < frames.size(); ++k)
-      {
-        if (differences[k].coordinate >= 0)
+        vtkDoubleArray* arm = column("MomentArm(" + line + ", " + coordinates.names[moving[i]] + ")");
+        for (size_t k = 0; k < frames.size(); ++k)
         {
-          arm[size_t(differences[k].coordinate)]->SetValue(static_cast<vtkIdType>(k), differences[k].Of(lengths));
+          arm->SetValue(static_cast<vtkIdType>(k), armAt(k, i, lengthOf));
         }
       }
     }
   }
+  vtkNew<vtkStringArray> from;
+  from->SetName("MomentArmsFrom");
+  from->InsertNextValue(anyStepped
+      ? (anyDifference ? "stepped poses, else differences between frames" : "stepped poses")
+      : "differences between frames");
+  table->GetFieldData()->AddArray(from);
 }
 }

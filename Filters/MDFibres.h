@@ -60,6 +60,16 @@ md::FibreObstacle BoneWhereItIs(
 /// A muscle's fibres as polylines: cell data FibreLength (`lengths`).
 vtkSmartPointer<vtkPolyData> FibrePolylines(const md::Points& points, int perFibre, const std::vector<double>& lengths);
 
+/// The lengths at a frame's pose stepped in one coordinate (OpenSimModelReader's MomentArmStep),
+/// the muscles deformed there from the frame's own state.
+struct SteppedLengths
+{
+  int coordinate = -1;                           ///< PoseCoordinates' index
+  double step = 0;                               ///< how far that coordinate was stepped (radians, signed)
+  std::vector<std::vector<double>> fibreLengths; ///< [muscle][fibre]
+  std::vector<std::vector<double>> lineLengths;  ///< [muscle][line]
+};
+
 /// One frame of a motion, for the MomentArms table.
 struct FrameLengths
 {
@@ -67,12 +77,23 @@ struct FrameLengths
   std::vector<double> coordinates;               ///< PoseCoordinates' order
   std::vector<std::vector<double>> fibreLengths; ///< [muscle][fibre]
   std::vector<std::vector<double>> lineLengths;  ///< [muscle][line]
+  std::vector<SteppedLengths> stepped;           ///< none without stepped poses
 };
+
+/// The stepped poses a motion's bones carry (OpenSimModelReader's MomentArmStep, passed on by
+/// MoveWithBodies: field data MomentArmStep on `bones`, point arrays PointsAt(<pose>) on each
+/// bone, of which `bone` is one): each pose's name and, as SteppedLengths, its coordinate (by
+/// `coordinates`' names; -1 for none of them) and step. None where the bones carry none.
+std::vector<std::pair<std::string, SteppedLengths>> SteppedPosesOf(
+  vtkDataObject* bones, vtkPolyData* bone, const PoseCoordinates& coordinates);
 
 /// The MomentArms table of a motion's frames (in order, consecutive): per frame Time, the
 /// coordinates that move (degrees where rotational), and for each muscle its fibres' median,
 /// smallest and largest length and moment arm about each of those coordinates, then each
-/// action line's length and moment arm (md::MomentArmsAlongMotion; per fibre, then over fibres).
+/// action line's length and moment arm, r = -dL/dq (per fibre, then over fibres). About a
+/// coordinate a frame was stepped in (SteppedLengths at +-step), the central difference of the
+/// stepped lengths; else the difference between frames (md::MomentArmsAlongMotion's). Field data
+/// MomentArmsFrom says which.
 void WriteMomentArms(const std::vector<FrameLengths>& frames, const PoseCoordinates& coordinates,
   const std::vector<std::string>& muscleNames, const std::vector<std::vector<std::string>>& lineNames, vtkTable* table);
 }

@@ -107,6 +107,7 @@ struct FrameMeasures
   std::vector<std::vector<double>> fibreLengths; ///< [muscle given][fibre]
   std::vector<std::vector<double>> lineLengths;  ///< [muscle given][action line]
   std::vector<double> coordinates;               ///< the pose's (Internals::coordinates), radians or as given
+  std::vector<mdvtk::SteppedLengths> stepped;    ///< at the frame's stepped poses (MomentArmStep)
 
   /// Muscle `m`'s measures, as written to its field data.
   std::vector<mdvtk::Measure> Of(size_t m) const
@@ -141,7 +142,8 @@ struct vtkMotionMuscleDeformation::Internals
   double upstreamTime = 0;
   bool upstreamAsked = false;
   int framesComputed = 0;
-  mdvtk::InputCheck checked[5]; ///< per input port, the rest pose's
+  bool steppedMissingSaid = false; ///< a pose stepped for moment arms lacked a block's points (said once)
+  mdvtk::InputCheck checked[5];    ///< per input port, the rest pose's
 
   void Restart()
   {
@@ -155,6 +157,7 @@ struct vtkMotionMuscleDeformation::Internals
     this->boneTrees.clear();
     this->boneMoved.clear();
     this->coordinates = {};
+    this->steppedMissingSaid = false;
     this->frames.clear();
     this->measures.clear();
   }
@@ -260,27 +263,38 @@ struct vtkMotionMuscleDeformation::Internals
   void CarryFibres(
     const md::MotionPose& pose, const std::vector<md::Points>& points, FrameKept& kept, FrameMeasures& measures)
   {
+    kept.fibres = this->FibresAt(pose, points, measures.fibreLengths, measures.lineLengths);
+    for (const md::Points& f : kept.fibres)
+    {
+      kept.bytes += Bytes(f);
+    }
+  }
+  /// The fibres of muscles at `points` in `pose` ([muscle]; empty: none), with their lengths and
+  /// those of the pose's action lines.
+  std::vector<md::Points> FibresAt(const md::MotionPose& pose, const std::vector<md::Points>& points,
+    std::vector<std::vector<double>>& fibreLengths, std::vector<std::vector<double>>& lineLengths)
+  {
     std::vector<md::FibreObstacle> obstacles;
     for (size_t b = 0; b < this->boneTrees.size(); ++b)
     {
       obstacles.push_back(mdvtk::BoneWhereItIs(this->boneTrees[b], this->boneMoved[b], pose.bones[b]));
     }
-    kept.fibres.resize(this->blockOf.size());
-    measures.fibreLengths.resize(this->blockOf.size());
-    measures.lineLengths.resize(this->blockOf.size());
+    std::vector<md::Points> fibrePoints(this->blockOf.size());
+    fibreLengths.assign(this->blockOf.size(), {});
+    lineLengths.assign(this->blockOf.size(), {});
     for (size_t m = 0; m < this->blockOf.size(); ++m)
     {
       for (const md::Points& line : pose.lines[m])
       {
-        measures.lineLengths[m].push_back(md::PolylineLength(line));
+        lineLengths[m].push_back(md::PolylineLength(line));
       }
       if (this->fibres[m] && points[m].rows() > 0)
       {
-        kept.fibres[m] = this->fibres[m]->At(points[m], obstacles);
-        measures.fibreLengths[m] = this->fibres[m]->Lengths(kept.fibres[m]);
-        kept.bytes += Bytes(kept.fibres[m]);
+        fibrePoints[m] = this->fibres[m]->At(points[m], obstacles);
+        fibreLengths[m] = this->fibres[m]->Lengths(fibrePoints[m]);
       }
     }
+    return fibrePoints;
   }
   /// The frame to compute first for `target`: after the last one kept before it.
   int FirstMissing(int target) const
@@ -747,10 +761,37 @@ bool vtkMotionMuscleDeformation::Start(const Leaves& leaves, vtkDataObject* land
 }
 
 bool vtkMotionMuscleDeformation::ReadPose(
-  vtkDataObject* motionBones, const Leaves& leaves, md::MotionPose& pose, int& result)
+  vtkDataObject* motionBones, const Leaves& leaves, md::MotionPose& pose, int& result, const std::string& stepped)
 {
   Internals& in = *this->In;
   const double time = in.signature.times[in.gather];
+  // The points of a leaf at the pose: its own, or its point array of the stepped pose.
+  bool missing = false;
+  const auto pointsOf = [&](vtkPolyData* data, const std::string& label) {
+    if (stepped.empty())
+    {
+      return mdvtk::ToPoints(data->GetPoints());
+    }
+    vtkDataArray* at = data->GetPointData()->GetArray(mdvtk::PointsAt(stepped).c_str());
+    if (!at || at->GetNumberOfComponents() != 3 || at->GetNumberOfTuples() != data->GetNumberOfPoints())
+    {
+      if (!missing && !in.steppedMissingSaid)
+      {
+        vtkWarningMacro(<< label << " has no point array " << mdvtk::PointsAt(stepped)
+                        << " (its points at the pose stepped in a coordinate, as the bones have): the moment "
+                           "arms come from differences between frames");
+        in.steppedMissingSaid = true;
+      }
+      missing = true;
+      return md::Points(0, 3);
+    }
+    md::Points points(at->GetNumberOfTuples(), 3);
+    for (vtkIdType i = 0; i < at->GetNumberOfTuples(); ++i)
+    {
+      at->GetTuple(i, points.row(i).data());
+    }
+    return points;
+  };
   std::vector<mdvtk::Leaf> bonesNow;
   std::vector<size_t> partner;
   std::string error;
@@ -764,7 +805,11 @@ bool vtkMotionMuscleDeformation::ReadPose(
   for (size_t leaf : in.boneLeaf)
   {
     const mdvtk::Leaf& moving = bonesNow[partner[leaf]];
-    pose.bones.push_back(moving.data ? mdvtk::ToPoints(moving.data->GetPoints()) : md::Points(0, 3));
+    pose.bones.push_back(moving.data ? pointsOf(moving.data, moving.label) : md::Points(0, 3));
+    if (missing)
+    {
+      return false;
+    }
     if (pose.bones.back().rows() != leaves.restBones[leaf].data->GetNumberOfPoints())
     {
       vtkErrorMacro(<< moving.label << " has " << pose.bones.back().rows() << " points at time " << time << " but "
@@ -783,7 +828,13 @@ bool vtkMotionMuscleDeformation::ReadPose(
     }
     const size_t restLeaf = leaves.restLinesOf[in.blockOf[m]];
     const mdvtk::Leaf& moving = leaves.motionLines[leaves.motionLinesOf[restLeaf]];
-    const std::vector<md::Points> lines = moving.data ? mdvtk::ToPolylines(moving.data) : std::vector<md::Points>{};
+    const md::Points linePoints = moving.data ? pointsOf(moving.data, moving.label) : md::Points(0, 3);
+    if (missing)
+    {
+      return false;
+    }
+    const std::vector<md::Points> lines =
+      moving.data ? mdvtk::ToPolylines(moving.data, &linePoints) : std::vector<md::Points>{};
     if (lines.size() != in.restLines[m].size())
     {
       vtkErrorMacro(<< moving.label << " has " << lines.size() << " action lines at time " << time << " but "
@@ -843,8 +894,67 @@ bool vtkMotionMuscleDeformation::ComputeFrame(vtkDataObject* motionBones, const 
   }
   std::vector<double> coordinates = mdvtk::ReadCoordinates(motionBones, in.coordinates);
   in.Keep(k, std::move(pose), std::move(coordinates), advanced);
+  if (!this->MeasureSteppedPoses(motionBones, leaves, result))
+  {
+    return false;
+  }
   in.Evict(this->CacheMemoryLimit, k);
   return true;
+}
+
+bool vtkMotionMuscleDeformation::MeasureSteppedPoses(vtkDataObject* motionBones, const Leaves& leaves, int& result)
+{
+  // Each stepped pose (OpenSimModelReader's MomentArmStep) is reached from the frame's own state
+  // in the method's steps, its lengths measured, and the motion put back where the frame left it.
+  Internals& in = *this->In;
+  const int k = in.gather;
+  if (in.boneLeaf.empty())
+  {
+    return true;
+  }
+  std::vector<mdvtk::Leaf> bonesNow;
+  std::string error;
+  if (!mdvtk::CollectLeaves(motionBones, PortNames[2], bonesNow, error) || bonesNow.empty())
+  {
+    return true; // ReadPose read them: not reached
+  }
+  const auto stepped = mdvtk::SteppedPosesOf(motionBones, bonesNow.front().data, in.coordinates);
+  const std::shared_ptr<const md::MotionDeformation::State> frame = in.frames.at(k).state;
+  FrameMeasures& measures = in.measures.at(k);
+  for (const auto& [name, lengths] : stepped)
+  {
+    if (lengths.coordinate < 0)
+    {
+      continue; // a coordinate the pose does not name: no moment arm about it
+    }
+    md::MotionPose pose;
+    if (!this->ReadPose(motionBones, leaves, pose, result, name))
+    {
+      measures.stepped.clear();
+      break; // said, or failed
+    }
+    md::MotionFrameResult advanced;
+    if (!mdvtk::CallCore(
+          this, "at time " + std::to_string(in.signature.times[k]) + ", pose " + name + ": ",
+          [&] {
+            in.deformation->Resume(frame);
+            advanced = in.deformation->Advance(pose);
+          },
+          result))
+    {
+      in.deformation->Resume(frame);
+      return false;
+    }
+    for (const std::string& warning : advanced.warnings)
+    {
+      vtkWarningMacro(<< "at time " << in.signature.times[k] << ", pose " << name << ": " << warning);
+    }
+    mdvtk::SteppedLengths measured = lengths;
+    in.FibresAt(pose, advanced.points, measured.fibreLengths, measured.lineLengths);
+    measures.stepped.push_back(std::move(measured));
+  }
+  in.deformation->Resume(frame);
+  return result != 0;
 }
 
 void vtkMotionMuscleDeformation::WriteMuscles(vtkDataObject* input, const Leaves& leaves, vtkDataObject* output)
@@ -965,7 +1075,8 @@ void vtkMotionMuscleDeformation::WriteMomentArms(const Leaves& leaves, vtkTable*
     {
       break;
     }
-    frames.push_back({ in.signature.times[k], measures.coordinates, measures.fibreLengths, measures.lineLengths });
+    frames.push_back(
+      { in.signature.times[k], measures.coordinates, measures.fibreLengths, measures.lineLengths, measures.stepped });
   }
   std::vector<std::string> muscleNames;
   std::vector<std::vector<std::string>> lineNames;
@@ -985,6 +1096,10 @@ void vtkMotionMuscleDeformation::WriteMomentArms(const Leaves& leaves, vtkTable*
       for (mdvtk::FrameLengths& f : frames)
       {
         f.fibreLengths[m].clear();
+        for (mdvtk::SteppedLengths& at : f.stepped)
+        {
+          at.fibreLengths[m].clear();
+        }
       }
     }
   }

@@ -39,6 +39,7 @@
 #include <vtkPassInputTypeAlgorithm.h>
 
 #include <memory>
+#include <string>
 
 class vtkMultiBlockDataSet;
 class vtkTable;
@@ -149,7 +150,11 @@ private:
   /// Reads the rest pose and makes the motion's deformation; false with RequestData's `result`.
   bool Start(const Leaves& leaves, vtkDataObject* landmarks, int& result);
   /// Reads the pose of frame In->gather (`motionBones`, the lines of `leaves`).
-  bool ReadPose(vtkDataObject* motionBones, const Leaves& leaves, md::MotionPose& pose, int& result);
+  bool ReadPose(vtkDataObject* motionBones, const Leaves& leaves, md::MotionPose& pose, int& result,
+    const std::string& stepped = {});
+  /// The lengths at frame In->gather's stepped poses (OpenSimModelReader's MomentArmStep), each
+  /// reached from the frame's own state; the motion stays at the frame.
+  bool MeasureSteppedPoses(vtkDataObject* motionBones, const Leaves& leaves, int& result);
   /// Deforms the muscles to frame In->gather and keeps it.
   bool ComputeFrame(vtkDataObject* motionBones, const Leaves& leaves, int& result);
   /// The outputs at the frame asked for: the muscles, the bones and lines, the measures table.

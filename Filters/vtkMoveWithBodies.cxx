@@ -14,11 +14,13 @@
 #include <vtkInformation.h>
 #include <vtkInformationVector.h>
 #include <vtkObjectFactory.h>
+#include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkStringArray.h>
 #include <vtkTable.h>
 
 #include <algorithm>
+#include <map>
 
 vtkStandardNewMacro(vtkMoveWithBodies);
 
@@ -84,11 +86,15 @@ int vtkMoveWithBodies::RequestData(
                      "(a table with columns Body, R00 ... R22, Tx, Ty, Tz)");
     return 0;
   }
-  std::vector<std::string> bodyNames;
+  // Rows of a stepped pose (column Pose, OpenSimModelReader's MomentArmStep) move the surfaces'
+  // points to point arrays PointsAt(<pose>); the others are the frame's.
+  auto* poseColumn = vtkStringArray::SafeDownCast(table->GetColumnByName(mdvtk::array::Pose));
+  std::vector<std::string> bodyNames, steppedNames;
   std::vector<md::RigidTransform> motions;
+  std::map<std::string, std::map<std::string, md::RigidTransform>> stepped; // [pose][body]
   for (vtkIdType row = 0; row < table->GetNumberOfRows(); ++row)
   {
-    bodyNames.push_back(bodies->GetValue(row));
+    const std::string pose = poseColumn ? poseColumn->GetValue(row) : std::string();
     md::RigidTransform t;
     for (int i = 0; i < 9; ++i)
     {
@@ -101,9 +107,19 @@ int vtkMoveWithBodies::RequestData(
     const std::string problem = md::NotARigidMotion(t);
     if (!problem.empty())
     {
-      vtkErrorMacro(<< "BodyTransforms row " << row << " (body '" << bodyNames.back() << "'): " << problem);
+      vtkErrorMacro(<< "BodyTransforms row " << row << " (body '" << bodies->GetValue(row) << "'): " << problem);
       return 0;
     }
+    if (!pose.empty())
+    {
+      if (stepped.find(pose) == stepped.end())
+      {
+        steppedNames.push_back(pose);
+      }
+      stepped[pose][bodies->GetValue(row)] = t;
+      continue;
+    }
+    bodyNames.push_back(bodies->GetValue(row));
     motions.push_back(t);
   }
   std::vector<vtkSmartPointer<vtkPolyData>> results(leaves.size());
@@ -148,7 +164,21 @@ int vtkMoveWithBodies::RequestData(
     moved->ShallowCopy(leaves[i].data);
     if (leaves[i].data->GetPoints())
     {
-      moved->SetPoints(mdvtk::ToVtkPoints(motions[body].Apply(mdvtk::ToPoints(leaves[i].data->GetPoints()))));
+      const md::Points rest = mdvtk::ToPoints(leaves[i].data->GetPoints());
+      moved->SetPoints(mdvtk::ToVtkPoints(motions[body].Apply(rest)));
+      for (const std::string& pose : steppedNames)
+      {
+        const auto t = stepped[pose].find(bodyNames[body]);
+        if (t == stepped[pose].end())
+        {
+          vtkErrorMacro(<< "BodyTransforms has rows of pose '" << pose << "' but none of body '" << bodyNames[body]
+                        << "'");
+          return 0;
+        }
+        vtkSmartPointer<vtkDataArray> at = mdvtk::ToVtkPoints(t->second.Apply(rest))->GetData();
+        at->SetName(mdvtk::PointsAt(pose).c_str());
+        moved->GetPointData()->AddArray(at);
+      }
     }
     vtkNew<vtkFieldData> fieldData;
     fieldData->ShallowCopy(leaves[i].data->GetFieldData());

@@ -8,7 +8,9 @@
  * BodyTransforms table. Each surface moves with one body: the one BodyOfSurface names for it
  * ("iliac_r=pelvis; sacrum=pelvis"), else the body of its name ("femur_r.vtk" -> femur_r), else
  * an error naming the surface and the bodies. The output is the surfaces at the reader's current
- * time, with field data Body.
+ * time, with field data Body. Where the table has rows of stepped poses (the reader's
+ * MomentArmStep: column Pose), each surface also gets its points at each of them as a point
+ * array PointsAt(<pose>).
  */
 #pragma once
 

@@ -261,6 +261,40 @@ struct vtkOpenSimModelReader::Internals
   std::string momentArmsKey;   ///< what it was computed from
 };
 
+struct vtkOpenSimModelReader::SteppedPose
+{
+  std::string name; ///< "<coordinate>+" or "<coordinate>-"
+  std::vector<double> coordinates;
+  std::vector<RigidTransform> bodyPoses;
+};
+
+std::vector<vtkOpenSimModelReader::SteppedPose> vtkOpenSimModelReader::SteppedPoses(const std::vector<double>& q) const
+{
+  const Internals& in = *this->Internal;
+  std::vector<SteppedPose> stepped;
+  if (this->MomentArmStep <= 0.0 || !this->PlayMotion || in.trajectory.times.empty())
+  {
+    return stepped;
+  }
+  for (int c : osim::MovingCoordinates(in.trajectory))
+  {
+    const osim::Coordinate& coordinate = in.model.coordinates[c];
+    if (coordinate.motionType != osim::MotionType::Rotational)
+    {
+      continue;
+    }
+    for (const double sign : { 1.0, -1.0 })
+    {
+      SteppedPose pose;
+      pose.name = coordinate.name + (sign > 0 ? "+" : "-");
+      pose.coordinates = osim::MovedCoordinate(in.model, q, c, sign * this->MomentArmStep * M_PI / 180.0);
+      pose.bodyPoses = osim::BodyPoses(in.model, pose.coordinates);
+      stepped.push_back(std::move(pose));
+    }
+  }
+  return stepped;
+}
+
 vtkOpenSimModelReader::vtkOpenSimModelReader()
   : Internal(new Internals)
 {
@@ -514,9 +548,10 @@ int vtkOpenSimModelReader::RequestData(
         this, "",
         [&] {
           const std::vector<RigidTransform> poses = osim::BodyPoses(in.model, q);
+          const std::vector<SteppedPose> stepped = this->SteppedPoses(q);
           this->WriteBodies(poses, vtkMultiBlockDataSet::GetData(outputVector, BODIES), when.str());
           this->WriteBodies(in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, BODIES_REST), "at the rest pose");
-          this->WritePaths(q, poses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS), when.str());
+          this->WritePaths(q, poses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS), when.str(), stepped);
           this->WritePaths(
             in.rest, in.restPoses, vtkMultiBlockDataSet::GetData(outputVector, MUSCLE_PATHS_REST), "at the rest pose");
           for (int port : { BODIES, BODIES_REST })
@@ -527,7 +562,7 @@ int vtkOpenSimModelReader::RequestData(
           {
             mdvtk::MarkRoles(vtkMultiBlockDataSet::GetData(outputVector, port), mdvtk::Role::ActionLine);
           }
-          this->WriteWrapsAndTransforms(poses, q, time, outputVector);
+          this->WriteWrapsAndTransforms(poses, q, time, stepped, outputVector);
           this->WriteMomentArms(vtkTable::GetData(outputVector, MOMENT_ARMS));
         },
         result))
@@ -543,7 +578,8 @@ int vtkOpenSimModelReader::RequestData(
 }
 
 void vtkOpenSimModelReader::WriteWrapsAndTransforms(const std::vector<md::RigidTransform>& poses,
-  const std::vector<double>& q, double time, vtkInformationVector* outputVector) const
+  const std::vector<double>& q, double time, const std::vector<SteppedPose>& stepped,
+  vtkInformationVector* outputVector) const
 {
   const Internals& in = *this->Internal;
   vtkMultiBlockDataSet* wraps = vtkMultiBlockDataSet::GetData(outputVector, WRAP_OBJECTS);
@@ -553,7 +589,7 @@ void vtkOpenSimModelReader::WriteWrapsAndTransforms(const std::vector<md::RigidT
     mesh.points = this->Scale * this->Placed(poses, in.model.wrapObjects[w].body).Apply(mesh.points);
     mdvtk::AddBlock(wraps, in.model.wrapObjects[w].name, mdvtk::ToPolyData(mesh));
   }
-  this->WriteTransforms(poses, q, time, vtkTable::GetData(outputVector, BODY_TRANSFORMS));
+  this->WriteTransforms(poses, q, time, stepped, vtkTable::GetData(outputVector, BODY_TRANSFORMS));
 }
 
 md::RigidTransform vtkOpenSimModelReader::Placed(const std::vector<md::RigidTransform>& poses, size_t body) const
@@ -602,22 +638,36 @@ void vtkOpenSimModelReader::WriteBodies(
 }
 
 void vtkOpenSimModelReader::WritePaths(const std::vector<double>& coordinates,
-  const std::vector<md::RigidTransform>& poses, vtkMultiBlockDataSet* tree, const std::string& when) const
+  const std::vector<md::RigidTransform>& poses, vtkMultiBlockDataSet* tree, const std::string& when,
+  const std::vector<SteppedPose>& stepped) const
 {
   const Internals& in = *this->Internal;
   const osim::Model& model = in.model;
-  for (const osim::Path& path : model.paths)
-  {
-    const osim::PathGeometry g =
-      osim::PathAt(model, path, coordinates, poses, this->ConditionalPointFade * M_PI / 180.0);
-    md::Points points = g.points;
+  const double fade = this->ConditionalPointFade * M_PI / 180.0;
+  // A path's points in the output frame and units.
+  const auto placed = [&](md::Points points, const std::string& label) {
     for (Eigen::Index i = 0; i < points.rows(); ++i)
     {
       points.row(i) = this->Scale * in.toOutput.Apply(Eigen::Vector3d(points.row(i).transpose())).transpose();
     }
-    CheckPlaced(points, RigidTransform(), "path '" + path.name + "' " + when);
+    CheckPlaced(points, RigidTransform(), label);
+    return points;
+  };
+  for (const osim::Path& path : model.paths)
+  {
+    const osim::PathGeometry g = osim::PathAt(model, path, coordinates, poses, fade);
+    const md::Points points = placed(g.points, "path '" + path.name + "' " + when);
     auto block = vtkSmartPointer<vtkPolyData>::New();
     block->SetPoints(mdvtk::ToVtkPoints(points));
+    for (const SteppedPose& pose : stepped)
+    {
+      // The frame's conditional points and fades (conditionsAt): as many points as at the frame.
+      const osim::PathGeometry at = osim::PathAt(model, path, pose.coordinates, pose.bodyPoses, fade, &coordinates);
+      vtkSmartPointer<vtkDataArray> array =
+        mdvtk::ToVtkPoints(placed(at.points, "path '" + path.name + "' at pose " + pose.name + " " + when))->GetData();
+      array->SetName(mdvtk::PointsAt(pose.name).c_str());
+      block->GetPointData()->AddArray(array);
+    }
     vtkNew<vtkCellArray> line;
     line->InsertNextCell(static_cast<vtkIdType>(points.rows()));
     auto names = Strings("PathPointName"), onBody = Strings("PathPointBody"),
@@ -705,7 +755,7 @@ void vtkOpenSimModelReader::WriteMomentArms(vtkTable* table)
 }
 
 void vtkOpenSimModelReader::WriteTransforms(const std::vector<md::RigidTransform>& poses,
-  const std::vector<double>& coordinates, double time, vtkTable* table) const
+  const std::vector<double>& coordinates, double time, const std::vector<SteppedPose>& stepped, vtkTable* table) const
 {
   const Internals& in = *this->Internal;
   const osim::Model& model = in.model;
@@ -719,18 +769,30 @@ void vtkOpenSimModelReader::WriteTransforms(const std::vector<md::RigidTransform
     table->AddColumn(column);
     columns.push_back(column);
   }
-  for (size_t b = 0; b < model.bodies.size(); ++b)
+  // The frame's rows, then those of each stepped pose, named in column Pose.
+  auto poseNames = Strings(mdvtk::array::Pose);
+  for (size_t s = 0; s <= stepped.size(); ++s)
   {
-    const RigidTransform motion = Motion(this->Placed(poses, b), this->Placed(in.restPoses, b));
-    bodyNames->InsertNextValue(model.bodies[b].name);
-    for (int i = 0; i < 9; ++i)
+    const std::vector<RigidTransform>& at = s == 0 ? poses : stepped[s - 1].bodyPoses;
+    for (size_t b = 0; b < model.bodies.size(); ++b)
     {
-      columns[i]->InsertNextValue(motion.rotation(i / 3, i % 3));
+      const RigidTransform motion = Motion(this->Placed(at, b), this->Placed(in.restPoses, b));
+      bodyNames->InsertNextValue(model.bodies[b].name);
+      poseNames->InsertNextValue(s == 0 ? std::string() : stepped[s - 1].name);
+      for (int i = 0; i < 9; ++i)
+      {
+        columns[i]->InsertNextValue(motion.rotation(i / 3, i % 3));
+      }
+      for (int i = 0; i < 3; ++i)
+      {
+        columns[9 + i]->InsertNextValue(this->Scale * motion.translation[i]);
+      }
     }
-    for (int i = 0; i < 3; ++i)
-    {
-      columns[9 + i]->InsertNextValue(this->Scale * motion.translation[i]);
-    }
+  }
+  if (!stepped.empty())
+  {
+    table->AddColumn(poseNames);
+    mdvtk::AddFieldValue(table->GetFieldData(), mdvtk::array::MomentArmStep, this->MomentArmStep);
   }
   mdvtk::AddFieldValue(table->GetFieldData(), mdvtk::array::Time, time);
   auto rotationalNames = Strings(mdvtk::array::RotationalCoordinates);
@@ -763,4 +825,5 @@ void vtkOpenSimModelReader::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "IgnoreUnknownColumns: " << this->IgnoreUnknownColumns << "\n";
   os << indent << "LoadGeometry: " << this->LoadGeometry << "\n";
   os << indent << "ConditionalPointFade: " << this->ConditionalPointFade << "\n";
+  os << indent << "MomentArmStep: " << this->MomentArmStep << "\n";
 }

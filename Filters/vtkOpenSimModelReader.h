@@ -125,6 +125,16 @@ public:
   /// the motion makes them jump). The MomentArms table is always OpenSim's.
   vtkSetClampMacro(ConditionalPointFade, double, 0.0, 180.0);
   vtkGetMacro(ConditionalPointFade, double);
+  /// For moment arms from small steps of a pose (MotionMuscleDeformation's fibres): with a motion
+  /// playing and a step > 0 (degrees), every frame also gives its pose stepped by +-MomentArmStep
+  /// in each rotational coordinate the motion moves (a coupled coordinate follows, as in OpenSim):
+  /// BodyTransforms gets a row per body and stepped pose (column Pose: "<coordinate>+" or
+  /// "<coordinate>-"; empty for the frame's own rows) and field data MomentArmStep, and each path
+  /// of MusclePaths a point array PointsAt(<coordinate>+-) with its points there. A stepped path
+  /// keeps the frame's conditional points and how far they have faded: the path as it is at the
+  /// frame, whose moment arm OpenSim gives. Default 0: none.
+  vtkSetClampMacro(MomentArmStep, double, 0.0, 10.0);
+  vtkGetMacro(MomentArmStep, double);
   /// Read the bodies' mesh files. Default on.
   vtkSetMacro(LoadGeometry, bool);
   vtkGetMacro(LoadGeometry, bool);
@@ -158,6 +168,7 @@ protected:
   bool IgnoreUnknownColumns = true;
   bool LoadGeometry = true;
   double ConditionalPointFade = 0.0;
+  double MomentArmStep = 0.0;
   int ModelReadCount = 0;
 
 private:
@@ -166,6 +177,10 @@ private:
 
   struct Internals;
   std::unique_ptr<Internals> Internal;
+  /// A frame's pose stepped in one coordinate (MomentArmStep).
+  struct SteppedPose;
+  /// The stepped poses of the frame at `q` (none without MomentArmStep or a motion playing).
+  std::vector<SteppedPose> SteppedPoses(const std::vector<double>& q) const;
   bool Load(); ///< (re)reads what changed; reports and returns false on failure
   /// The parts of Load, each only when what it reads from changed (throw md::InputError).
   void LoadModel(const std::string& fileName, std::vector<std::string>& warnings);
@@ -177,15 +192,16 @@ private:
   /// md::InputError for a body placed at non-finite coordinates (`when`: "at time 0.5").
   void WriteBodies(
     const std::vector<md::RigidTransform>& poses, vtkMultiBlockDataSet* tree, const std::string& when) const;
-  /// The muscles' paths at `coordinates` as polylines, blocks of `tree` (throws as WriteBodies).
+  /// The muscles' paths at `coordinates` as polylines, blocks of `tree` (throws as WriteBodies),
+  /// with their points at each of `stepped` (point arrays PointsAt(<pose>)).
   void WritePaths(const std::vector<double>& coordinates, const std::vector<md::RigidTransform>& poses,
-    vtkMultiBlockDataSet* tree, const std::string& when) const;
-  /// Outputs WRAP_OBJECTS and BODY_TRANSFORMS at `poses`.
+    vtkMultiBlockDataSet* tree, const std::string& when, const std::vector<SteppedPose>& stepped = {}) const;
+  /// Outputs WRAP_OBJECTS and BODY_TRANSFORMS at `poses` (and `stepped`).
   void WriteWrapsAndTransforms(const std::vector<md::RigidTransform>& poses, const std::vector<double>& q, double time,
-    vtkInformationVector* outputVector) const;
+    const std::vector<SteppedPose>& stepped, vtkInformationVector* outputVector) const;
   /// Output MOMENT_ARMS, computed once per model, motion and Scale.
   void WriteMomentArms(vtkTable* table);
   /// Output BODY_TRANSFORMS: each body's rest-to-current motion; the time and coordinates as field data.
   void WriteTransforms(const std::vector<md::RigidTransform>& poses, const std::vector<double>& coordinates,
-    double time, vtkTable* table) const;
+    double time, const std::vector<SteppedPose>& stepped, vtkTable* table) const;
 };

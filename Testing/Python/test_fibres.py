@@ -36,7 +36,9 @@ class FibresThroughHipFlexion(unittest.TestCase):
             cls.in_bone.append(in_bone)
             cls.counts.append({fibres.GetMetaData(b).Get(fibres.NAME()): fibres.GetBlock(b).GetNumberOfLines()
                                for b in range(fibres.GetNumberOfBlocks())})
-        cls.table = job.table_columns(servermanager.Fetch(cls.motion, idx=5))
+        arms = servermanager.Fetch(cls.motion, idx=5)
+        cls.table = job.table_columns(arms)
+        cls.arms_from = arms.GetFieldData().GetAbstractArray("MomentArmsFrom").GetValue(0)
 
     def test_a_hundred_fibres_a_muscle_inside_it_and_out_of_the_bones_at_every_frame(self):
         for k, counts in enumerate(self.counts):
@@ -87,6 +89,20 @@ class FibresThroughHipFlexion(unittest.TestCase):
                 self.assertTrue(all(sign * v > 0 for v in ours), muscle)
             self.assertLess(statistics.median(differences), 10.0, muscle)
             self.assertLess(max(differences), 25.0, muscle)
+
+    def test_moment_arms_from_stepped_poses_pass_smoothly_through_the_via_points_fades(self):
+        """The main job steps every frame by +-1 degree of flexion (the reader's MomentArmStep):
+        the psoas's and the iliacus's via points, which fade over 40-50 and 54-64 degrees, add
+        nothing to their fibres' median moment arm, which changes between neighbouring frames by
+        under 2 mm (differences between frames put the fade's slope in: the psoas's rose by 8 mm
+        at 44 degrees, 3-5 mm a frame)."""
+        self.assertEqual(self.arms_from, "stepped poses")
+        for muscle in ("psoas_r", "iliacus_r"):
+            arms = self.table["FibreMomentArm(%s, hip_flexion_r)" % muscle]
+            steps = [abs(b - a) for a, b in zip(arms, arms[1:])]
+            print("[ measured ] %s: the fibres' median moment arm changes by at most %.2f mm between frames"
+                  % (muscle, max(steps)))
+            self.assertLess(max(steps), 2.0, muscle)
 
 
 if __name__ == "__main__":

@@ -9,7 +9,9 @@ import unittest
 
 import mdtesting
 import mdexamples
+import numpy
 from paraview import servermanager, simple
+from vtkmodules.util.numpy_support import vtk_to_numpy
 
 mdtesting.load_plugin()
 DATA = mdexamples.data_dir()
@@ -185,6 +187,133 @@ class SmallModel(unittest.TestCase):
         self.assertAlmostEqual(column(table, "MomentArm(deltoid, angle)")[0],
                                0.25 * math.sin(math.radians(30)) / math.sqrt(0.5 + 0.5 * math.cos(math.radians(30))),
                                places=7)
+
+
+class SteppedPoses(unittest.TestCase):
+    """MomentArmStep through the motion filter, on a model written here: a universal joint whose
+    two coordinates move at once, which differences between frames cannot tell apart."""
+
+    MODEL = """<?xml version="1.0"?>
+<OpenSimDocument Version="40000"><Model name="arm">
+ <Ground name="ground"/>
+ <BodySet><objects><Body name="arm"/></objects></BodySet>
+ <JointSet><objects><UniversalJoint name="shoulder"><socket_parent_frame>shoulder_offset</socket_parent_frame><socket_child_frame>/bodyset/arm</socket_child_frame>
+  <coordinates><Coordinate name="rx"><range>-3 3</range></Coordinate><Coordinate name="ry"><range>-3 3</range></Coordinate></coordinates>
+  <frames><PhysicalOffsetFrame name="shoulder_offset"><socket_parent>/ground</socket_parent><translation>0 1 0</translation><orientation>0 0 0</orientation></PhysicalOffsetFrame></frames>
+ </UniversalJoint></objects></JointSet>
+ <ForceSet><objects><Thelen2003Muscle name="belly"><GeometryPath name="path"><PathPointSet><objects>
+  <PathPoint name="o"><socket_parent_frame>/ground</socket_parent_frame><location>0.2 1.6 0.1</location></PathPoint>
+  <PathPoint name="i"><socket_parent_frame>/bodyset/arm</socket_parent_frame><location>0.05 -0.5 0</location></PathPoint>
+ </objects></PathPointSet></GeometryPath></Thelen2003Muscle></objects></ForceSet>
+</Model></OpenSimDocument>
+"""
+    STEP = 1.0  # degrees
+    FRAMES = 5
+
+    @classmethod
+    def setUpClass(cls):
+        import lhdl
+        output = mdtesting.output_dir("test_moment_arms")
+        cls.model = os.path.join(output, "universal.osim")
+        with open(cls.model, "w") as f:
+            f.write(cls.MODEL)
+        cls.motion_file = os.path.join(output, "universal.mot")
+        rows = "".join("%r\t%r\t%r\n" % (0.01 * k, 6.0 * k, 4.0 * k) for k in range(cls.FRAMES))
+        with open(cls.motion_file, "w") as f:
+            f.write("m\nversion=1\nnRows=%d\nnColumns=3\ninDegrees=yes\nendheader\ntime\trx\try\n%s"
+                    % (cls.FRAMES, rows))
+        # In the rest pose (Scale 100): the path from o = (20, 160, 10) to i = (5, 50, 0), the joint
+        # at (0, 100, 0). The belly an ellipsoid around it, tip to tip; a bone beyond each end.
+        origin, insertion = numpy.array([20.0, 160.0, 10.0]), numpy.array([5.0, 50.0, 0.0])
+        axis = (origin - insertion) / numpy.linalg.norm(origin - insertion)
+        belly = cls.ellipsoid((origin + insertion) / 2, axis, numpy.linalg.norm(origin - insertion) / 2, 12.0)
+        base = cls.ellipsoid(origin + 14.0 * axis, axis, 10.0, 10.0)
+        hand = cls.ellipsoid(insertion - 14.0 * axis, axis, 10.0, 10.0)
+        cls.muscles = lhdl.producer(lhdl.named_blocks([("belly", belly)]), "belly")
+        cls.bones = lhdl.producer(lhdl.named_blocks([("base", base), ("hand", hand)]), "bones")
+
+    @staticmethod
+    def ellipsoid(centre, axis, half_length, radius):
+        from vtkmodules.vtkFiltersSources import vtkSphereSource
+        from vtkmodules.vtkCommonDataModel import vtkPolyData
+        sphere = vtkSphereSource()
+        sphere.SetThetaResolution(24)
+        sphere.SetPhiResolution(16)
+        sphere.SetRadius(1.0)
+        sphere.Update()
+        surface = vtkPolyData()
+        surface.DeepCopy(sphere.GetOutput())
+        # z of the unit sphere along `axis`, scaled to the half length; x and y to the radius.
+        side = numpy.cross(axis, [1.0, 0.0, 0.0])
+        side /= numpy.linalg.norm(side)
+        frame = numpy.column_stack([side * radius, numpy.cross(axis, side) * radius, axis * half_length])
+        unit = mdtesting.points(surface)
+        placed = unit @ frame.T + centre
+        for k, p in enumerate(placed):
+            surface.GetPoints().SetPoint(k, *p)
+        return surface
+
+    def run_motion(self, step):
+        reader = simple.OpenSimModelReader(FileName=self.model, MotionFileName=self.motion_file, LoadGeometry=0,
+                                           Scale=100, MomentArmStep=step)
+        moved = simple.MoveWithBodies(Input=self.bones, BodyTransforms=simple.OutputPort(reader, 4),
+                                      BodyOfSurface="base=ground; hand=arm")
+        motion = simple.MotionMuscleDeformation(Input=self.muscles, BonesRest=self.bones, BonesMotion=moved,
+                                                ActionLinesRest=simple.OutputPort(reader, 3),
+                                                ActionLinesMotion=simple.OutputPort(reader, 1), NumberOfFibres=30)
+        motion.UpdatePipelineInformation()
+        times = list(motion.TimestepValues)
+        self.assertEqual(len(times), self.FRAMES)
+        motion.UpdatePipeline(times[-1])
+        table = servermanager.Fetch(motion, idx=5)
+        reader_table = servermanager.Fetch(reader, idx=6)
+        transforms = servermanager.Fetch(reader, idx=4)
+        paths = servermanager.Fetch(reader, idx=1)
+        for proxy in (motion, moved, reader):
+            simple.Delete(proxy)
+        return table, reader_table, transforms, paths
+
+    def test_the_reader_gives_each_frame_stepped_in_each_moving_coordinate(self):
+        _, reader_table, transforms, paths = self.run_motion(self.STEP)
+        self.assertEqual(transforms.GetNumberOfRows(), 2 * 5)  # ground and arm; the frame and 4 stepped poses
+        self.assertEqual(column(transforms, "Pose"), [""] * 2 + [p for p in ("rx+", "rx-", "ry+", "ry-")
+                                                                 for _ in range(2)])
+        self.assertEqual(transforms.GetFieldData().GetArray("MomentArmStep").GetValue(0), self.STEP)
+        # The path's length at +-step: OpenSim's moment arm (the reader's table) to O(step^2).
+        path = mdtesting.block(paths, "belly")
+        last = reader_table.GetNumberOfRows() - 1
+        for coordinate in ("rx", "ry"):
+            at = {}
+            for sign in "+-":
+                ends = vtk_to_numpy(path.GetPointData().GetArray("PointsAt(%s%s)" % (coordinate, sign)))
+                at[sign] = numpy.linalg.norm(ends[1] - ends[0])
+            arm = -(at["+"] - at["-"]) / (2 * math.radians(self.STEP))
+            expected = column(reader_table, "MomentArm(belly, %s)" % coordinate)[last]
+            self.assertAlmostEqual(arm, expected, delta=1e-3 * abs(expected) + 1e-6)
+
+    def test_moment_arms_about_two_coordinates_moving_at_once(self):
+        """Differences between frames cannot tell two coordinates apart (NaN); stepped poses give
+        the action line OpenSim's moment arm about each at every frame, and the fibres theirs."""
+        without, _, _, _ = self.run_motion(0.0)
+        self.assertEqual(without.GetFieldData().GetAbstractArray("MomentArmsFrom").GetValue(0),
+                         "differences between frames")
+        self.assertTrue(all(math.isnan(v) for v in column(without, "MomentArm(belly, rx)")))
+        table, reader_table, _, _ = self.run_motion(self.STEP)
+        self.assertEqual(table.GetFieldData().GetAbstractArray("MomentArmsFrom").GetValue(0), "stepped poses")
+        for coordinate in ("rx", "ry"):
+            line = column(table, "MomentArm(belly, %s)" % coordinate)
+            expected = column(reader_table, "MomentArm(belly, %s)" % coordinate)
+            fibres = column(table, "FibreMomentArm(belly, %s)" % coordinate)
+            low = column(table, "FibreMomentArmMin(belly, %s)" % coordinate)
+            high = column(table, "FibreMomentArmMax(belly, %s)" % coordinate)
+            print("[ measured ] about %s: the line %s, OpenSim %s, the fibres' median %s (mm a radian)" % (
+                coordinate, " ".join("%.2f" % v for v in line), " ".join("%.2f" % v for v in expected),
+                " ".join("%.2f" % v for v in fibres)))
+            for k in range(self.FRAMES):
+                self.assertAlmostEqual(line[k], expected[k], delta=1e-3 * abs(expected[k]) + 1e-6)
+                self.assertTrue(low[k] <= fibres[k] <= high[k])
+                # A straight belly's fibres run beside its line: their median moment arm near it.
+                self.assertAlmostEqual(fibres[k], expected[k], delta=0.25 * abs(expected[k]) + 2.0)
 
 
 if __name__ == "__main__":

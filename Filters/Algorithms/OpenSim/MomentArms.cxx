@@ -8,19 +8,6 @@ namespace md::osim
 {
 namespace
 {
-/// The pose with `coordinate` moved by `delta`, its dependants following.
-std::vector<double> Moved(const Model& model, std::vector<double> coordinates, int coordinate, double delta)
-{
-  coordinates[coordinate] += delta;
-  const bool dependent = std::any_of(model.couplers.begin(), model.couplers.end(),
-    [coordinate](const CoordinateCoupler& c) { return c.dependent == coordinate; });
-  if (!dependent)
-  {
-    ApplyCouplers(model, coordinates);
-  }
-  return coordinates;
-}
-
 /// -dL/dq from the path at q and at q -+ step: central, or one-sided where the active points
 /// differ from those at q on one side.
 double Excursion(const PathGeometry& here, const PathGeometry& low, const PathGeometry& high, double step)
@@ -35,6 +22,18 @@ double Excursion(const PathGeometry& here, const PathGeometry& low, const PathGe
 }
 }
 
+std::vector<double> MovedCoordinate(const Model& model, std::vector<double> coordinates, int coordinate, double delta)
+{
+  coordinates[coordinate] += delta;
+  const bool dependent = std::any_of(model.couplers.begin(), model.couplers.end(),
+    [coordinate](const CoordinateCoupler& c) { return c.dependent == coordinate; });
+  if (!dependent)
+  {
+    ApplyCouplers(model, coordinates);
+  }
+  return coordinates;
+}
+
 double PathLength(const Model& model, const Path& path, const std::vector<double>& coordinates)
 {
   return PolylineLength(PathAt(model, path, coordinates, BodyPoses(model, coordinates)).points);
@@ -43,8 +42,8 @@ double PathLength(const Model& model, const Path& path, const std::vector<double
 double MomentArm(
   const Model& model, const Path& path, const std::vector<double>& coordinates, int coordinate, double step)
 {
-  const std::vector<double> below = Moved(model, coordinates, coordinate, -step);
-  const std::vector<double> above = Moved(model, coordinates, coordinate, step);
+  const std::vector<double> below = MovedCoordinate(model, coordinates, coordinate, -step);
+  const std::vector<double> above = MovedCoordinate(model, coordinates, coordinate, step);
   return Excursion(PathAt(model, path, coordinates, BodyPoses(model, coordinates)),
     PathAt(model, path, below, BodyPoses(model, below)), PathAt(model, path, above, BodyPoses(model, above)), step);
 }
@@ -82,8 +81,8 @@ PathMoments MomentsAt(const Model& model, const std::vector<double>& pose, const
   moments.momentArm.assign(model.paths.size(), std::vector<double>(coordinates.size()));
   for (size_t k = 0; k < coordinates.size(); ++k)
   {
-    const std::vector<double> below = Moved(model, pose, coordinates[k], -kMomentArmStep);
-    const std::vector<double> above = Moved(model, pose, coordinates[k], kMomentArmStep);
+    const std::vector<double> below = MovedCoordinate(model, pose, coordinates[k], -kMomentArmStep);
+    const std::vector<double> above = MovedCoordinate(model, pose, coordinates[k], kMomentArmStep);
     const std::vector<RigidTransform> belowPoses = BodyPoses(model, below), abovePoses = BodyPoses(model, above);
     for (size_t p = 0; p < model.paths.size(); ++p)
     {

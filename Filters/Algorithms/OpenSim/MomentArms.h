@@ -26,6 +26,10 @@ constexpr double kMomentArmStep = 1e-4;
 double MomentArm(const Model& model, const Path& path, const std::vector<double>& coordinates, int coordinate,
   double step = kMomentArmStep);
 
+/// `coordinates` with `coordinate` moved by `delta` and the coordinates coupled to it following
+/// (a coupled coordinate moves alone), as a moment arm moves them.
+std::vector<double> MovedCoordinate(const Model& model, std::vector<double> coordinates, int coordinate, double delta);
+
 /// The coordinates whose value changes over `trajectory` (by more than 1e-12 of its first value,
 /// relative), in the model's order.
 std::vector<int> MovingCoordinates(const CoordinateTrajectory& trajectory);

@@ -83,8 +83,9 @@ double FadeWeight(const PathPoint& point, double value, double fade)
 }
 
 PathGeometry PathAt(const Model& model, const Path& path, const std::vector<double>& coordinates,
-  const std::vector<RigidTransform>& bodyPoses, double conditionalFade)
+  const std::vector<RigidTransform>& bodyPoses, double conditionalFade, const std::vector<double>* conditionsAt)
 {
+  const std::vector<double>& conditions = conditionsAt ? *conditionsAt : coordinates;
   PathGeometry geometry;
   std::vector<Eigen::Vector3d> points;
   std::vector<double> weight; // per point kept: 1, or a fading conditional point's weight
@@ -96,7 +97,7 @@ PathGeometry PathAt(const Model& model, const Path& path, const std::vector<doub
     double w = 1.0;
     if (p.kind == PathPointKind::Conditional)
     {
-      const double value = coordinates[p.coordinate];
+      const double value = conditions[p.coordinate];
       const bool fades = conditionalFade > 0.0 && model.coordinates[p.coordinate].motionType == MotionType::Rotational;
       w = fades ? FadeWeight(p, value, conditionalFade) : (BeyondRange(p, value) > 0.0 ? 0.0 : 1.0);
       if (w == 0.0 && !fades)

@@ -35,8 +35,13 @@ struct PathGeometry
 /// projects on it), and it lies there farther out. The path is then a continuous function of the
 /// coordinates, where OpenSim's jumps as the point goes, and it is OpenSim's wherever the point
 /// is active (docs/DESIGN.md, "Conditional path points"). Translational coordinates keep the jump.
+///
+/// `conditionsAt` (optional): the coordinates that decide which conditional points are active and
+/// how far they have faded, in place of `coordinates`: the path at a nearby pose with the points
+/// and weights of this one, as a moment arm holds them (OpenSim's, of the path as it is).
 PathGeometry PathAt(const Model& model, const Path& path, const std::vector<double>& coordinates,
-  const std::vector<RigidTransform>& bodyPoses, double conditionalFade = 0.0);
+  const std::vector<RigidTransform>& bodyPoses, double conditionalFade = 0.0,
+  const std::vector<double>* conditionsAt = nullptr);
 
 /// How far out of its range a conditional point is, along its coordinate (0 within it).
 double BeyondRange(const PathPoint& point, double value);

@@ -128,3 +128,30 @@ TEST(MomentArms, AFadingConditionalPointMakesThePathContinuous)
   }
   EXPECT_LT(largestStep, 0.001);
 }
+
+TEST(MomentArms, APathAtANearbyPoseCanKeepThePointsAndFadesOfThisOne)
+{
+  // At q = -0.1 the via point (active on [0, 1]) is half faded over 0.2 rad. Stepped by +-0.01
+  // with the conditions of q, the path keeps that weight: its length changes only as the bodies
+  // move, and the central difference is the moment arm of the path as it is at q.
+  const Model model = ParseModel(PinModel("0.1 -0.15 0"), "pin.osim");
+  const int flex = model.FindCoordinate("flex");
+  const double fade = 0.2, step = 0.01;
+  std::vector<double> q = DefaultCoordinates(model);
+  q[flex] = -0.1;
+  const auto lengthAt = [&](double delta, const std::vector<double>* conditionsAt) {
+    const std::vector<double> moved = MovedCoordinate(model, q, flex, delta);
+    return PolylineLength(PathAt(model, model.paths[0], moved, BodyPoses(model, moved), fade, conditionsAt).points);
+  };
+  EXPECT_EQ(lengthAt(0.0, &q), lengthAt(0.0, nullptr));
+  const double held = -(lengthAt(step, &q) - lengthAt(-step, &q)) / (2 * step);
+  const double fading = -(lengthAt(step, nullptr) - lengthAt(-step, nullptr)) / (2 * step);
+  // The held path is the fixed polyline o -> (the point at weight 1/2 on its segment) -> i, its
+  // points on the femur moving rigidly: its excursion, by a finer difference of the same path.
+  const double fine = -(lengthAt(1e-5, &q) - lengthAt(-1e-5, &q)) / 2e-5;
+  EXPECT_NEAR(held, fine, 1e-5);
+  // Letting the weight follow q adds the fade's own slope: a different, larger number here.
+  EXPECT_GT(std::abs(fading - held), 0.01);
+  // The coupled-coordinate rule of MomentArm: a coordinate moved alone.
+  EXPECT_EQ(MovedCoordinate(model, q, flex, 0.25)[flex], -0.1 + 0.25);
+}
