@@ -785,12 +785,7 @@ bool vtkMotionMuscleDeformation::ReadPose(
       missing = true;
       return md::Points(0, 3);
     }
-    md::Points points(at->GetNumberOfTuples(), 3);
-    for (vtkIdType i = 0; i < at->GetNumberOfTuples(); ++i)
-    {
-      at->GetTuple(i, points.row(i).data());
-    }
-    return points;
+    return mdvtk::ToPoints(at);
   };
   std::vector<mdvtk::Leaf> bonesNow;
   std::vector<size_t> partner;
