@@ -760,8 +760,16 @@ bool vtkMotionMuscleDeformation::Start(const Leaves& leaves, vtkDataObject* land
   return true;
 }
 
+/// The moving bones of a frame (input port 2), each leaf paired with its rest leaf.
+struct vtkMotionMuscleDeformation::MovingBones
+{
+  vtkDataObject* input = nullptr;
+  std::vector<mdvtk::Leaf> leaves;
+  std::vector<size_t> partner; ///< per rest bone leaf, its moving leaf
+};
+
 bool vtkMotionMuscleDeformation::ReadPose(
-  vtkDataObject* motionBones, const Leaves& leaves, md::MotionPose& pose, int& result, const std::string& stepped)
+  const MovingBones& bones, const Leaves& leaves, md::MotionPose& pose, int& result, const std::string& stepped)
 {
   Internals& in = *this->In;
   const double time = in.signature.times[in.gather];
@@ -787,19 +795,9 @@ bool vtkMotionMuscleDeformation::ReadPose(
     }
     return mdvtk::ToPoints(at);
   };
-  std::vector<mdvtk::Leaf> bonesNow;
-  std::vector<size_t> partner;
-  std::string error;
-  if (!mdvtk::CollectLeaves(motionBones, PortNames[2], bonesNow, error) ||
-    !mdvtk::PairLeaves(this, leaves.restBones, PortNames[1], bonesNow, PortNames[2], partner, error))
-  {
-    vtkErrorMacro(<< "at time " << time << ": " << error);
-    result = 0;
-    return false;
-  }
   for (size_t leaf : in.boneLeaf)
   {
-    const mdvtk::Leaf& moving = bonesNow[partner[leaf]];
+    const mdvtk::Leaf& moving = bones.leaves[bones.partner[leaf]];
     pose.bones.push_back(moving.data ? pointsOf(moving.data, moving.label) : md::Points(0, 3));
     if (missing)
     {
@@ -858,8 +856,18 @@ bool vtkMotionMuscleDeformation::ComputeFrame(vtkDataObject* motionBones, const 
 {
   Internals& in = *this->In;
   const int k = in.gather;
+  MovingBones bones;
+  bones.input = motionBones;
+  std::string error;
+  if (!mdvtk::CollectLeaves(motionBones, PortNames[2], bones.leaves, error) ||
+    !mdvtk::PairLeaves(this, leaves.restBones, PortNames[1], bones.leaves, PortNames[2], bones.partner, error))
+  {
+    vtkErrorMacro(<< "at time " << in.signature.times[k] << ": " << error);
+    result = 0;
+    return false;
+  }
   md::MotionPose pose;
-  if (!this->ReadPose(motionBones, leaves, pose, result))
+  if (!this->ReadPose(bones, leaves, pose, result))
   {
     return false;
   }
@@ -889,7 +897,7 @@ bool vtkMotionMuscleDeformation::ComputeFrame(vtkDataObject* motionBones, const 
   }
   std::vector<double> coordinates = mdvtk::ReadCoordinates(motionBones, in.coordinates);
   in.Keep(k, std::move(pose), std::move(coordinates), advanced);
-  if (!this->MeasureSteppedPoses(motionBones, leaves, result))
+  if (!this->MeasureSteppedPoses(bones, leaves, result))
   {
     return false;
   }
@@ -897,23 +905,17 @@ bool vtkMotionMuscleDeformation::ComputeFrame(vtkDataObject* motionBones, const 
   return true;
 }
 
-bool vtkMotionMuscleDeformation::MeasureSteppedPoses(vtkDataObject* motionBones, const Leaves& leaves, int& result)
+bool vtkMotionMuscleDeformation::MeasureSteppedPoses(const MovingBones& bones, const Leaves& leaves, int& result)
 {
   // Each stepped pose (OpenSimModelReader's MomentArmStep) is reached from the frame's own state
   // in the method's steps, its lengths measured, and the motion put back where the frame left it.
   Internals& in = *this->In;
   const int k = in.gather;
-  if (in.boneLeaf.empty())
+  if (in.boneLeaf.empty() || bones.leaves.empty())
   {
     return true;
   }
-  std::vector<mdvtk::Leaf> bonesNow;
-  std::string error;
-  if (!mdvtk::CollectLeaves(motionBones, PortNames[2], bonesNow, error) || bonesNow.empty())
-  {
-    return true; // ReadPose read them: not reached
-  }
-  const auto stepped = mdvtk::SteppedPosesOf(motionBones, bonesNow.front().data, in.coordinates);
+  const auto stepped = mdvtk::SteppedPosesOf(bones.input, bones.leaves.front().data, in.coordinates);
   const std::shared_ptr<const md::MotionDeformation::State> frame = in.frames.at(k).state;
   FrameMeasures& measures = in.measures.at(k);
   for (const auto& [name, lengths] : stepped)
@@ -923,7 +925,7 @@ bool vtkMotionMuscleDeformation::MeasureSteppedPoses(vtkDataObject* motionBones,
       continue; // a coordinate the pose does not name: no moment arm about it
     }
     md::MotionPose pose;
-    if (!this->ReadPose(motionBones, leaves, pose, result, name))
+    if (!this->ReadPose(bones, leaves, pose, result, name))
     {
       measures.stepped.clear();
       break; // said, or failed

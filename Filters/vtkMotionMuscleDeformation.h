@@ -142,6 +142,7 @@ private:
   struct Internals;
   struct Signature;
   struct Leaves;
+  struct MovingBones;
   /// What the frames depend on, and the inputs of this pass.
   Signature SignatureOf(vtkInformationVector** inputVector, vtkDataObject* inputs[5]);
   /// Ends the passes over the motion with `result`, or asks the executive for one more.
@@ -149,12 +150,12 @@ private:
   int GoOn(vtkInformation* request);
   /// Reads the rest pose and makes the motion's deformation; false with RequestData's `result`.
   bool Start(const Leaves& leaves, vtkDataObject* landmarks, int& result);
-  /// Reads the pose of frame In->gather (`motionBones`, the lines of `leaves`).
-  bool ReadPose(vtkDataObject* motionBones, const Leaves& leaves, md::MotionPose& pose, int& result,
-    const std::string& stepped = {});
+  /// Reads the pose of frame In->gather (`bones`, the lines of `leaves`), or its pose `stepped`.
+  bool ReadPose(
+    const MovingBones& bones, const Leaves& leaves, md::MotionPose& pose, int& result, const std::string& stepped = {});
   /// The lengths at frame In->gather's stepped poses (OpenSimModelReader's MomentArmStep), each
   /// reached from the frame's own state; the motion stays at the frame.
-  bool MeasureSteppedPoses(vtkDataObject* motionBones, const Leaves& leaves, int& result);
+  bool MeasureSteppedPoses(const MovingBones& bones, const Leaves& leaves, int& result);
   /// Deforms the muscles to frame In->gather and keeps it.
   bool ComputeFrame(vtkDataObject* motionBones, const Leaves& leaves, int& result);
   /// The outputs at the frame asked for: the muscles, the bones and lines, the measures table.
