@@ -406,19 +406,23 @@ void vtkOpenSimModelReader::LoadModel(const std::string& fileName, std::vector<s
   {
     in.wraps.push_back(osim::WrapSurface(w));
   }
-  std::string wrapped;
+  std::string unwrapped;
   for (const osim::Path& p : in.model.paths)
   {
-    if (!p.wrapObjects.empty())
+    for (const osim::PathWrap& w : p.wraps)
     {
-      wrapped += (wrapped.empty() ? "" : ", ") + p.name;
+      if (in.model.wrapObjects[static_cast<size_t>(w.wrapObject)].shape != osim::WrapShape::Cylinder)
+      {
+        unwrapped += (unwrapped.empty() ? "" : ", ") + p.name + " over " + w.name;
+        break;
+      }
     }
   }
-  if (!wrapped.empty())
+  if (!unwrapped.empty())
   {
-    warnings.push_back("paths are not wrapped yet: these muscles have wrap objects and are drawn as "
-                       "straight polylines through their path points: " +
-      wrapped);
+    warnings.push_back("paths over wrap spheres, ellipsoids and tori are not wrapped yet (over cylinders "
+                       "they are): these paths pass through those objects: " +
+      unwrapped);
   }
   in.modelKey = modelKey;
   in.haveModel = true;
@@ -663,8 +667,9 @@ void vtkOpenSimModelReader::WritePaths(const std::vector<double>& coordinates,
     {
       // The frame's conditional points and fades (conditionsAt): as many points as at the frame.
       const osim::PathGeometry at = osim::PathAt(model, path, pose.coordinates, pose.bodyPoses, fade, &coordinates);
-      vtkSmartPointer<vtkDataArray> array =
-        mdvtk::ToVtkPoints(placed(at.points, "path '" + path.name + "' at pose " + pose.name + " " + when))->GetData();
+      vtkSmartPointer<vtkDataArray> array = mdvtk::ToVtkPoints(
+        placed(osim::PointsLike(at, g), "path '" + path.name + "' at pose " + pose.name + " " + when))
+                                              ->GetData();
       array->SetName(mdvtk::PointsAt(pose.name).c_str());
       block->GetPointData()->AddArray(array);
     }
@@ -675,16 +680,27 @@ void vtkOpenSimModelReader::WritePaths(const std::vector<double>& coordinates,
     for (Eigen::Index i = 0; i < points.rows(); ++i)
     {
       line->InsertCellPoint(i);
-      const osim::PathPoint& point = path.points[g.pointIndex[i]];
-      names->InsertNextValue(point.name);
-      onBody->InsertNextValue(model.bodies[point.body].name);
+      // A point over a wrap object takes the object's name and body.
+      const int index = g.pointIndex[static_cast<size_t>(i)];
+      if (index >= 0)
+      {
+        const osim::PathPoint& point = path.points[static_cast<size_t>(index)];
+        names->InsertNextValue(point.name);
+        onBody->InsertNextValue(model.bodies[point.body].name);
+      }
+      else
+      {
+        const osim::WrapObject& wrap = model.wrapObjects[path.wraps[static_cast<size_t>(-1 - index)].wrapObject];
+        names->InsertNextValue(wrap.name);
+        onBody->InsertNextValue(model.bodies[wrap.body].name);
+      }
     }
     lineName->InsertNextValue(path.name);
     block->SetLines(line);
     block->GetPointData()->AddArray(names);
     block->GetPointData()->AddArray(onBody);
     block->GetCellData()->AddArray(lineName);
-    mdvtk::AddFieldValue(block->GetFieldData(), "PathLength", this->Scale * osim::PolylineLength(g.points));
+    mdvtk::AddFieldValue(block->GetFieldData(), "PathLength", this->Scale * g.length);
     mdvtk::AddBlock(tree, path.name, block);
   }
 }
@@ -730,6 +746,7 @@ void vtkOpenSimModelReader::WriteMomentArms(vtkTable* table)
         arms[p].push_back(column("MomentArm(" + model.paths[p].name + ", " + model.coordinates[c].name + ")"));
       }
     }
+    const std::vector<osim::PathMoments> framesMoments = osim::MomentsAt(model, frames, coordinates);
     for (size_t k = 0; k < frames.size(); ++k)
     {
       const auto row = static_cast<vtkIdType>(k);
@@ -739,7 +756,7 @@ void vtkOpenSimModelReader::WriteMomentArms(vtkTable* table)
         const bool rotational = model.coordinates[coordinates[i]].motionType == osim::MotionType::Rotational;
         values[i]->SetValue(row, frames[k][coordinates[i]] * (rotational ? 180.0 / M_PI : 1.0));
       }
-      const osim::PathMoments moments = osim::MomentsAt(model, frames[k], coordinates);
+      const osim::PathMoments& moments = framesMoments[k];
       for (size_t p = 0; p < model.paths.size(); ++p)
       {
         lengths[p]->SetValue(row, this->Scale * moments.length[p]);

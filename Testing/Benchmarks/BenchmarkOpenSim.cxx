@@ -55,7 +55,7 @@ void Measure(const std::string& label, const std::string& model, const std::stri
       const std::vector<md::RigidTransform> poses = osim::BodyPoses(parsed, q);
       for (const osim::Path& path : parsed.paths)
       {
-        total += osim::PolylineLength(osim::PathAt(parsed, path, q, poses).points);
+        total += osim::PathAt(parsed, path, q, poses).length;
       }
     }
     frames.push_back(Seconds(start) / trajectory.frames.size());

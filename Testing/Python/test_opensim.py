@@ -311,6 +311,13 @@ class SmallModel(unittest.TestCase):
             os.rename(os.path.join(self.folder, "geometry", "b.vtp"), os.path.join(self.folder, "geometry", "bone.vtp"))
 
 
+def read_lengths(path):
+    """An OpenSim .sto table: its column labels and its rows of numbers."""
+    with open(path) as f:
+        lines = f.read().split("endheader")[1].strip().splitlines()
+    return lines[0].split("\t"), [[float(v) for v in line.split()] for line in lines[1:]]
+
+
 @unittest.skipIf(DATA is None or not os.path.isdir(os.path.join(DATA or "", "opensim")), "OpenSim data not found")
 class OpenSimData(unittest.TestCase):
     def test_gait10dof18musc_lengths_through_the_reader(self):
@@ -319,10 +326,7 @@ class OpenSimData(unittest.TestCase):
                                            MotionFileName=os.path.join(folder, "walk_gait1018_state_reference.mot"))
         times = list(reader.TimestepValues)
         self.assertEqual(len(times), 151)
-        with open(os.path.join(folder, "std_testGeometryPathWrapping_walk_gait1018_muscle_lengths.sto")) as f:
-            lines = f.read().split("endheader")[1].strip().splitlines()
-        labels = lines[0].split("\t")
-        rows = [[float(v) for v in line.split()] for line in lines[1:]]
+        labels, rows = read_lengths(os.path.join(folder, "std_testGeometryPathWrapping_walk_gait1018_muscle_lengths.sto"))
         worst = 0.0
         for frame in (0, 40, 75, 119, 150):
             reader.UpdatePipeline(times[frame])
@@ -334,6 +338,43 @@ class OpenSimData(unittest.TestCase):
         # Bodies carry their meshes.
         bodies = servermanager.Fetch(reader, idx=0)
         self.assertEqual(block(bodies, "femur_r").GetNumberOfPoints(), 456)
+
+    def test_rajagopal2016_wrapped_paths_through_the_reader(self):
+        """14 of the model's 18 paths wrap over its cylinders: PathLength is OpenSim 4.4's, the drawn
+        points over a cylinder are named after it, and the stepped poses (MomentArmStep) give
+        every path as many points as the frame's, however much of a cylinder they wrap over."""
+        folder = os.path.join(DATA, "opensim", "rajagopal2016_walk_armless_18musc")
+        reader = simple.OpenSimModelReader(FileName=os.path.join(folder, "subject_walk_armless_18musc.osim"),
+                                           MotionFileName=os.path.join(folder, "subject_walk_armless_coordinates.mot"),
+                                           MomentArmStep=1.0)
+        times = list(reader.TimestepValues)
+        self.assertEqual(len(times), 238)
+        labels, rows = read_lengths(os.path.join(folder, "std_testGeometryPathWrapping_subject_walk_armless_muscle_lengths.sto"))
+        worst, wrapped = 0.0, set()
+        reader.UpdatePipeline(times[0])
+        wraps = output(reader, 5)
+        wrap_names = {wraps.GetMetaData(b).Get(wraps.NAME()) for b in range(wraps.GetNumberOfBlocks())}
+        self.assertEqual(len(wrap_names), 40)
+        for frame in (0, 25, 60, 85, 138, 200):
+            reader.UpdatePipeline(times[frame])
+            paths = output(reader, 1)
+            for column, label in enumerate(labels[1:], start=1):
+                name = label.split("/")[-1].split("|")[0]
+                path = block(paths, name)
+                worst = max(worst, abs(field(path, "PathLength") - rows[frame][column]))
+                names = path.GetPointData().GetAbstractArray("PathPointName")
+                if any(names.GetValue(i) in wrap_names for i in range(path.GetNumberOfPoints())):
+                    wrapped.add(name)
+                stepped = [path.GetPointData().GetArray(a) for a in range(path.GetPointData().GetNumberOfArrays())]
+                stepped = [a for a in stepped if a is not None and a.GetName().startswith("PointsAt(")]
+                self.assertGreater(len(stepped), 0, name)  # +-1 degree in each coordinate the motion moves
+                for array in stepped:
+                    self.assertEqual(array.GetNumberOfTuples(), path.GetNumberOfPoints(), name)
+        self.assertLess(worst, 1e-6)
+        self.assertTrue({"med_gas_r", "med_gas_l", "glut_max2_r", "psoas_r", "semimem_r"} <= wrapped, wrapped)
+        with mdtesting.CapturedMessages() as messages:
+            simple.OpenSimModelReader(FileName=os.path.join(folder, "subject_walk_armless_18musc.osim")).UpdatePipeline()
+        self.assertNotIn("not wrapped", messages.text)
 
     def test_gait2392_loads_with_its_meshes_and_plays(self):
         folder = os.path.join(DATA, "opensim", "gait2392_walk_forward")

@@ -3,22 +3,33 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <vector>
 
 namespace md::osim
 {
 namespace
 {
-/// -dL/dq from the path at q and at q -+ step: central, or one-sided where the active points
-/// differ from those at q on one side.
+/// The path points a path has (its points over wrap objects aside: how many there are follows
+/// the length over the surface).
+std::vector<int> ActivePathPoints(const PathGeometry& g)
+{
+  std::vector<int> active;
+  std::copy_if(g.pointIndex.begin(), g.pointIndex.end(), std::back_inserter(active), [](int k) { return k >= 0; });
+  return active;
+}
+
+/// -dL/dq from the path at q and at q -+ step: central, or one-sided where the active path
+/// points differ from those at q on one side.
 double Excursion(const PathGeometry& here, const PathGeometry& low, const PathGeometry& high, double step)
 {
-  const bool lowSame = low.pointIndex == here.pointIndex, highSame = high.pointIndex == here.pointIndex;
+  const std::vector<int> active = ActivePathPoints(here);
+  const bool lowSame = ActivePathPoints(low) == active, highSame = ActivePathPoints(high) == active;
   if (lowSame == highSame) // the usual case; both differ only for a step wider than a range
   {
-    return -(PolylineLength(high.points) - PolylineLength(low.points)) / (2.0 * step);
+    return -(high.length - low.length) / (2.0 * step);
   }
-  const double length = PolylineLength(here.points);
-  return highSame ? -(PolylineLength(high.points) - length) / step : -(length - PolylineLength(low.points)) / step;
+  return highSame ? -(high.length - here.length) / step : -(here.length - low.length) / step;
 }
 }
 
@@ -36,7 +47,7 @@ std::vector<double> MovedCoordinate(const Model& model, std::vector<double> coor
 
 double PathLength(const Model& model, const Path& path, const std::vector<double>& coordinates)
 {
-  return PolylineLength(PathAt(model, path, coordinates, BodyPoses(model, coordinates)).points);
+  return PathAt(model, path, coordinates, BodyPoses(model, coordinates)).length;
 }
 
 double MomentArm(
@@ -76,7 +87,7 @@ PathMoments MomentsAt(const Model& model, const std::vector<double>& pose, const
   for (const Path& path : model.paths)
   {
     here.push_back(PathAt(model, path, pose, poses));
-    moments.length.push_back(PolylineLength(here.back().points));
+    moments.length.push_back(here.back().length);
   }
   moments.momentArm.assign(model.paths.size(), std::vector<double>(coordinates.size()));
   for (size_t k = 0; k < coordinates.size(); ++k)
@@ -90,6 +101,19 @@ PathMoments MomentsAt(const Model& model, const std::vector<double>& pose, const
       moments.momentArm[p][k] = Excursion(
         here[p], PathAt(model, path, below, belowPoses), PathAt(model, path, above, abovePoses), kMomentArmStep);
     }
+  }
+  return moments;
+}
+
+std::vector<PathMoments> MomentsAt(
+  const Model& model, const std::vector<std::vector<double>>& poses, const std::vector<int>& coordinates)
+{
+  std::vector<PathMoments> moments(poses.size());
+  const auto count = static_cast<int>(poses.size());
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int k = 0; k < count; ++k)
+  {
+    moments[static_cast<size_t>(k)] = MomentsAt(model, poses[static_cast<size_t>(k)], coordinates);
   }
   return moments;
 }

@@ -42,4 +42,9 @@ struct PathMoments
 };
 
 PathMoments MomentsAt(const Model& model, const std::vector<double>& pose, const std::vector<int>& coordinates);
+
+/// MomentsAt at each of `poses` (in parallel: a path over several wrap objects costs tens of
+/// microseconds a pose, and a table has three poses a coordinate a frame).
+std::vector<PathMoments> MomentsAt(
+  const Model& model, const std::vector<std::vector<double>>& poses, const std::vector<int>& coordinates);
 }

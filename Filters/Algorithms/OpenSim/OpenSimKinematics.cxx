@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "OpenSim/OpenSimKinematics.h"
+#include "OpenSim/OpenSimWrapping.h"
 
 #include "Geometry/Polyline.h"
 
@@ -149,12 +150,80 @@ PathGeometry PathAt(const Model& model, const Path& path, const std::vector<doub
     const Eigen::Vector3d onSegment = a + t * (b - a);
     points[i] = onSegment + weight[i] * (points[i] - onSegment);
   }
-  geometry.points.resize(static_cast<Eigen::Index>(points.size()), 3);
-  for (size_t i = 0; i < points.size(); ++i)
+  if (path.wraps.empty())
   {
-    geometry.points.row(static_cast<Eigen::Index>(i)) = points[i].transpose();
+    geometry.points.resize(static_cast<Eigen::Index>(points.size()), 3);
+    for (size_t i = 0; i < points.size(); ++i)
+    {
+      geometry.points.row(static_cast<Eigen::Index>(i)) = points[i].transpose();
+    }
+    geometry.length = md::PolylineLength(geometry.points);
+    return geometry;
+  }
+  const std::vector<WrappedPoint> wrapped =
+    WrapPath(model, path, points, geometry.pointIndex, bodyPoses, kWrapPointSpacing, &geometry.length);
+  // The polyline: path points as they are, each wrap by its surface points.
+  std::vector<Eigen::Vector3d> polyline;
+  geometry.pointIndex.clear();
+  for (const WrappedPoint& p : wrapped)
+  {
+    if (p.wrap < 0)
+    {
+      polyline.push_back(p.position);
+      geometry.pointIndex.push_back(p.pathPoint);
+    }
+    else if (p.leaves)
+    {
+      for (Eigen::Index k = 0; k < p.surface.rows(); ++k)
+      {
+        polyline.push_back(p.surface.row(k).transpose());
+        geometry.pointIndex.push_back(-1 - p.wrap);
+      }
+    }
+  }
+  geometry.points.resize(static_cast<Eigen::Index>(polyline.size()), 3);
+  for (size_t i = 0; i < polyline.size(); ++i)
+  {
+    geometry.points.row(static_cast<Eigen::Index>(i)) = polyline[i].transpose();
   }
   return geometry;
+}
+
+Points PointsLike(const PathGeometry& path, const PathGeometry& like)
+{
+  if (path.points.rows() == like.points.rows() || path.points.rows() < 2 || like.points.rows() < 2)
+  {
+    return path.points.rows() == like.points.rows() ? path.points : Points(Points::Zero(like.points.rows(), 3));
+  }
+  // The share of each polyline's length before each of its points.
+  const auto shares = [](const Points& points) {
+    std::vector<double> s(static_cast<size_t>(points.rows()), 0.0);
+    for (Eigen::Index i = 1; i < points.rows(); ++i)
+    {
+      s[static_cast<size_t>(i)] = s[static_cast<size_t>(i) - 1] + (points.row(i) - points.row(i - 1)).norm();
+    }
+    const double total = s.back();
+    for (double& v : s)
+    {
+      v = total > 0 ? v / total : 0.0;
+    }
+    return s;
+  };
+  const std::vector<double> along = shares(path.points), wanted = shares(like.points);
+  Points out(like.points.rows(), 3);
+  size_t segment = 1;
+  for (Eigen::Index k = 0; k < like.points.rows(); ++k)
+  {
+    const double share = wanted[static_cast<size_t>(k)];
+    while (segment + 1 < along.size() && along[segment] < share)
+    {
+      ++segment;
+    }
+    const double span = along[segment] - along[segment - 1];
+    const double t = span > 0 ? std::clamp((share - along[segment - 1]) / span, 0.0, 1.0) : 0.0;
+    out.row(k) = (1.0 - t) * path.points.row(Eigen::Index(segment) - 1) + t * path.points.row(Eigen::Index(segment));
+  }
+  return out;
 }
 
 double PolylineLength(const Points& points)

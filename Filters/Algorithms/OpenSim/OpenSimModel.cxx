@@ -45,6 +45,11 @@ int Model::FindPath(const std::string& pathName) const
   return IndexOfName(this->paths, pathName);
 }
 
+int Model::FindWrapObject(const std::string& wrapName) const
+{
+  return IndexOfName(this->wrapObjects, wrapName);
+}
+
 namespace
 {
 using Node = pugi::xml_node;
@@ -891,6 +896,32 @@ private:
     this->model.joints = ordered;
   }
 
+  /// OpenSim's `quadrant`: x, +x, -x (any case), y, z likewise, all, or none given (all).
+  void ReadQuadrant(Node wrap, WrapObject& w)
+  {
+    Node quadrant = wrap.child("quadrant");
+    std::string name = quadrant ? FirstWord(quadrant.text().get()) : "";
+    if (name.empty() || name == "all" || name == "ALL" || name == "All" || name == "Unassigned")
+    {
+      w.quadrantSign = 0;
+      return;
+    }
+    w.quadrantSign = name[0] == '-' ? -1 : 1;
+    if (name[0] == '-' || name[0] == '+')
+    {
+      name.erase(0, 1);
+    }
+    const std::string axes = "xyzXYZ";
+    const size_t axis = name.size() == 1 ? axes.find(name[0]) : std::string::npos;
+    if (axis == std::string::npos)
+    {
+      this->reader.Fail(quadrant,
+        "quadrant '" + std::string(FirstWord(quadrant.text().get())) +
+          "' is not one of x, +x, -x, y, +y, -y, z, +z, -z or all");
+    }
+    w.quadrantAxis = static_cast<int>(axis % 3);
+  }
+
   void ReadWrapObjects(Node modelNode)
   {
     auto readSet = [&](Node owner, int body) {
@@ -940,6 +971,8 @@ private:
             this->reader.Fail(wrap, "wrap object dimensions must be positive");
           }
         }
+        w.active = FirstWord(wrap.child("active").text().get()) != "false";
+        this->ReadQuadrant(wrap, w);
         this->model.wrapObjects.push_back(w);
       }
     };
@@ -1070,11 +1103,28 @@ private:
     }
     for (Node wrap : geometryPath.child("PathWrapSet").child("objects").children("PathWrap"))
     {
-      const std::string name = FirstWord(wrap.child("wrap_object").text().get());
-      if (!name.empty())
+      PathWrap w;
+      w.name = FirstWord(wrap.child("wrap_object").text().get());
+      if (w.name.empty())
       {
-        path.wrapObjects.push_back(name);
+        continue;
       }
+      w.wrapObject = this->model.FindWrapObject(w.name);
+      if (w.wrapObject < 0)
+      {
+        this->reader.Fail(wrap, "wrap object '" + w.name + "' is not in the model (or is of a type not read)");
+      }
+      if (wrap.child("range"))
+      {
+        const std::vector<double> range = this->reader.Numbers(wrap, "range", 2);
+        w.rangeStart = static_cast<int>(range[0]);
+        w.rangeEnd = static_cast<int>(range[1]);
+      }
+      if (Node method = wrap.child("method"))
+      {
+        w.method = FirstWord(method.text().get());
+      }
+      path.wraps.push_back(w);
     }
     this->model.paths.push_back(path);
   }

@@ -95,6 +95,22 @@ struct WrapObject
   /// Cylinder: radius, length; sphere: radius; ellipsoid: the three radii; torus: the radius of
   /// its centre circle and of its tube.
   std::vector<double> dimensions;
+  bool active = true;
+  /// The quadrant a path wraps over (`quadrant`): the axis (0 x, 1 y, 2 z) and its side (+1, -1),
+  /// or side 0 for all of it.
+  int quadrantAxis = 0;
+  int quadrantSign = 0;
+};
+
+/// A path's use of a wrap object (OpenSim's PathWrap).
+struct PathWrap
+{
+  std::string name;    ///< the wrap object's
+  int wrapObject = -1; ///< index into Model::wrapObjects
+  /// The path points (1-based, as OpenSim's `range`) between which the path may wrap; below 1:
+  /// the first (last) point.
+  int rangeStart = -1, rangeEnd = -1;
+  std::string method = "hybrid"; ///< how an ellipsoid is wrapped (hybrid, midpoint, axial)
 };
 
 enum class PathPointKind
@@ -125,7 +141,7 @@ struct Path
   std::string name;
   std::string type; ///< e.g. Thelen2003Muscle
   std::vector<PathPoint> points;
-  std::vector<std::string> wrapObjects; ///< names of the wrap objects it refers to
+  std::vector<PathWrap> wraps; ///< in the order OpenSim applies them
 };
 
 /// dependent = scale * function(independent)
@@ -154,6 +170,7 @@ struct Model
   int FindBody(const std::string& name) const;
   int FindCoordinate(const std::string& name) const;
   int FindPath(const std::string& name) const;
+  int FindWrapObject(const std::string& name) const;
 };
 
 /// Reads an .osim file. Throws InputError naming the file, the line, the element and the problem

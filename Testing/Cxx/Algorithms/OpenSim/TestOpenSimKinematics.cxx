@@ -45,7 +45,7 @@ LengthComparison CompareLengths(const std::string& folder, const std::string& mo
     for (size_t k = 0; k < trajectory.frames.size(); ++k)
     {
       const std::vector<md::RigidTransform> poses = BodyPoses(model, trajectory.frames[k]);
-      const double ours = PolylineLength(PathAt(model, model.paths[p], trajectory.frames[k], poses).points);
+      const double ours = PathAt(model, model.paths[p], trajectory.frames[k], poses).length;
       result.difference[name].push_back(ours - lengths.rows[k][column]);
     }
   }
@@ -76,7 +76,7 @@ TEST(OpenSimOracle, Gait10dof18muscLengthsEqualOpenSims)
   std::printf("gait10dof18musc: largest |length - OpenSim's| over 18 muscles x 151 frames: %.3g m\n", worst);
 }
 
-TEST(OpenSimOracle, Rajagopal2016LengthsEqualOpenSimsWhereNotWrapping)
+TEST(OpenSimOracle, Rajagopal2016WrappedLengthsEqualOpenSims)
 {
   const std::string file = RealDataFile("opensim/rajagopal2016_walk_armless_18musc/subject_walk_armless_18musc.osim");
   if (file.empty())
@@ -86,34 +86,19 @@ TEST(OpenSimOracle, Rajagopal2016LengthsEqualOpenSimsWhereNotWrapping)
   const LengthComparison c = CompareLengths(file.substr(0, file.rfind('/')), "subject_walk_armless_18musc.osim",
     "subject_walk_armless_coordinates.mot", "std_testGeometryPathWrapping_subject_walk_armless_muscle_lengths.sto");
   ASSERT_EQ(c.difference.size(), 18u);
-  double worst = 0;
+  // 14 of the 18 paths wrap over cylinders, on some frames or all (med_gas over two at once):
+  // every length within 1e-6 m of OpenSim 4.4's (OpenSim's own gate on this file is 1e-6 m).
   for (const auto& [name, differences] : c.difference)
   {
     ASSERT_EQ(differences.size(), 238u);
-    const std::string muscle = name.substr(0, name.size() - 2);
-    size_t equal = 0;
+    double worst = 0;
     for (size_t k = 0; k < differences.size(); ++k)
     {
-      // Wrapping only lengthens a path: the polyline is never longer than OpenSim's path.
-      EXPECT_LE(differences[k], 1e-6) << name << " frame " << k;
-      equal += std::abs(differences[k]) <= 1e-6;
+      EXPECT_LE(std::abs(differences[k]), 1e-6) << name << " frame " << k;
+      worst = std::max(worst, std::abs(differences[k]));
     }
-    if (muscle == "soleus" || muscle == "tib_ant" || muscle == "bifemsh" || muscle == "rect_fem" || muscle == "vas_int")
-    {
-      // No wrap object, or one this motion never touches: equal on every frame.
-      EXPECT_EQ(equal, differences.size()) << name;
-      for (double d : differences)
-      {
-        worst = std::max(worst, std::abs(d));
-      }
-    }
-    else if (muscle != "med_gas")
-    {
-      // glut_max2, psoas, semimem wrap on part of the motion and equal OpenSim's elsewhere.
-      EXPECT_GE(equal, differences.size() / 5) << name;
-    }
+    std::printf("rajagopal2016 %-12s largest |length - OpenSim's| over 238 frames: %.3g m\n", name.c_str(), worst);
   }
-  std::printf("rajagopal2016: largest |length - OpenSim's| where no path wraps: %.3g m\n", worst);
 }
 
 TEST(OpenSimOracle, Gait2392LoadsAndPlays)
@@ -142,7 +127,7 @@ TEST(OpenSimOracle, Gait2392LoadsAndPlays)
       const PathGeometry g = PathAt(model, path, q, poses);
       ASSERT_GE(g.points.rows(), 2) << path.name;
       ASSERT_TRUE(g.points.allFinite()) << path.name;
-      const double length = PolylineLength(g.points);
+      const double length = g.length;
       ASSERT_GT(length, 0.02) << path.name;
       ASSERT_LT(length, 1.0) << path.name;
     }

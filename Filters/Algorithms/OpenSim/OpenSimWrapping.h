@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Muscle paths over OpenSim's wrap objects, as OpenSim 4.x computes them: the wrap objects of a
+// path tried in turn on every segment of its range, the one that lengthens the path least (or
+// the first the straight path cuts through) kept, and several wrap objects iterated until the
+// length settles (opensim-core's GeometryPath::applyWrapObjects and WrapCylinder::wrapLine,
+// whose algorithms this follows; the code is ours). Cylinders only, so far.
+#pragma once
+
+#include "OpenSim/OpenSimModel.h"
+
+#include <vector>
+
+namespace md::osim
+{
+/// What wrapping one segment over one wrap object found (OpenSim's WrapAction).
+enum class WrapAction
+{
+  NoWrap,       ///< the segment misses the object (or its active quadrant)
+  InsideRadius, ///< an end of the segment is inside the object
+  Wrapped,      ///< the segment wraps, but another segment may wrap with a smaller change
+  Mandatory     ///< the straight segment cuts through the object: it must wrap here
+};
+
+/// A segment wrapped over a wrap object, in the object's frame.
+struct WrapResult
+{
+  Eigen::Vector3d r1 = Eigen::Vector3d::Zero(); ///< where the path meets the surface
+  Eigen::Vector3d r2 = Eigen::Vector3d::Zero(); ///< where it leaves it
+  double length = 0.0;                          ///< along the surface from r1 to r2
+  /// The helix from r1 to r2: how far it turns about the axis (radians, signed) and rises along it.
+  double turn = 0.0, rise = 0.0;
+};
+
+/// The segment p1-p2 (in the cylinder's frame: its axis z, centred at the origin) over a
+/// cylinder of `radius` and `length` (only tangent points beyond both ends miss it), on the side
+/// `quadrantSign` of axis `quadrantAxis` (sign 0: all round). The path over the surface is a
+/// helix. `adjustTangents`: slide the tangent points along the axis until the lines from p1 and
+/// p2 meet the helix at a tangent (within 0.1 degree), as OpenSim does for a path with several
+/// wrap objects; without, the tangent points are OpenSim's first estimate, as it keeps them for a
+/// path with one (where it computes lengths without drawing).
+WrapAction WrapCylinderSegment(const Eigen::Vector3d& p1, const Eigen::Vector3d& p2, double radius, double length,
+  int quadrantAxis, int quadrantSign, bool adjustTangents, WrapResult& result);
+
+/// Points on a cylinder's helix from r1 to r2 (both included), at most `spacing` apart.
+Points CylinderSurfacePoints(const WrapResult& wrap, double spacing);
+
+/// One point of a wrapped path (in ground): a path point, or where it meets or leaves a wrap
+/// object.
+struct WrappedPoint
+{
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  int pathPoint = -1;         ///< index into Path::points; -1 for a wrap point
+  int wrap = -1;              ///< for a wrap point: index into Path::wraps
+  bool leaves = false;        ///< the second of a wrap's two points, after the surface
+  double surfaceLength = 0.0; ///< on the second: the length over the surface from the first
+  Points surface;             ///< on the second: the surface points from the first to it (ground)
+};
+
+/// The path through `points` (its active points in ground, in order, each with its index into
+/// Path::points) wrapped over the path's wrap objects at the body poses `bodyPoses`, as OpenSim
+/// does. `spacing`: the largest distance between drawn surface points (model units).
+/// `openSimLength` (optional): the path's length as OpenSim reports it. Where several wrap objects
+/// take more than one pass, OpenSim measures a wrap point's straight segments from where the
+/// first pass put it (a cached place it does not renew), so that its length differs from the
+/// path's own (WrappedLength) by up to millimetres; elsewhere the two are equal.
+std::vector<WrappedPoint> WrapPath(const Model& model, const Path& path, const std::vector<Eigen::Vector3d>& points,
+  const std::vector<int>& pathPoints, const std::vector<RigidTransform>& bodyPoses, double spacing,
+  double* openSimLength = nullptr);
+
+/// The length of a wrapped path: straight between its points, over the surface between a wrap's
+/// two points.
+double WrappedLength(const std::vector<WrappedPoint>& path);
+}

@@ -1,0 +1,253 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Paths over OpenSim's wrap cylinders against closed forms; the model's wrap settings read and
+// honoured; bad wrap settings named. (OpenSim's own lengths: TestOpenSimKinematics.cxx.)
+#include "OpenSim/MomentArms.h"
+#include "OpenSim/OpenSimKinematics.h"
+#include "OpenSim/OpenSimWrapping.h"
+#include "OpenSimTestModels.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <tuple>
+#include <vector>
+
+using namespace md::osim;
+using md::osim::test::ExpectInputError;
+using md::osim::test::kSmallModel;
+
+namespace
+{
+/// The segment from p1 to p2 around the cylinder about z of radius r: a straight line from p1 to
+/// its tangent point, the helix, the line from the other tangent point to p2. Built from the
+/// helix: r1 = (r, 0, 0), turning by `angle` while rising `rise`; p1 and p2 lie back and on
+/// along the helix's tangents at its ends, `out1` and `out2` away (near enough that the straight
+/// segment cuts the cylinder on the helix's side: then the helix is the shorter way round).
+struct HelixCase
+{
+  Eigen::Vector3d p1, p2;
+  double length;
+};
+
+HelixCase Helix(double r, double angle, double rise, double out1, double out2)
+{
+  const double arc = std::hypot(r * angle, rise);
+  const auto tangent = [&](double phi) -> Eigen::Vector3d {
+    return Eigen::Vector3d(-r * angle * std::sin(phi), r * angle * std::cos(phi), rise) / arc;
+  };
+  const Eigen::Vector3d r1(r, 0, 0), r2(r * std::cos(angle), r * std::sin(angle), rise);
+  return { r1 - out1 * tangent(0), r2 + out2 * tangent(angle), out1 + arc + out2 };
+}
+}
+
+TEST(OpenSimWrapping, APathAcrossACylinderIsAnArcOfItsCircle)
+{
+  // Across the axis (no rise), OpenSim's tangent points are exact: the length is the two
+  // tangents and the arc, with or without sliding the tangent points.
+  for (double angle : { 0.3, 1.0, 2.0, 3.0 })
+  {
+    const double reach = 0.05 / std::tan(0.5 * angle); // beyond it the straight segment misses
+    const HelixCase c = Helix(0.05, angle, 0.0, 0.5 * reach, 0.3 * reach);
+    for (bool adjust : { false, true })
+    {
+      WrapResult result;
+      const WrapAction action = WrapCylinderSegment(c.p1, c.p2, 0.05, 1.0, 0, 0, adjust, result);
+      EXPECT_EQ(action, WrapAction::Mandatory) << angle;
+      const double length = (result.r1 - c.p1).norm() + result.length + (c.p2 - result.r2).norm();
+      EXPECT_NEAR(length, c.length, 1e-12) << angle << " " << adjust;
+      EXPECT_NEAR(result.length, 0.05 * angle, 1e-12);
+      // The surface points lie on the cylinder, from r1 to r2, no farther apart than asked.
+      const md::Points surface = CylinderSurfacePoints(result, 0.002);
+      ASSERT_GE(surface.rows(), 2);
+      for (Eigen::Index i = 0; i < surface.rows(); ++i)
+      {
+        EXPECT_NEAR(surface.row(i).head<2>().norm(), 0.05, 1e-12);
+        if (i > 0)
+        {
+          EXPECT_LE((surface.row(i) - surface.row(i - 1)).norm(), 0.002);
+        }
+      }
+      EXPECT_LT((surface.row(0).transpose() - result.r1).norm(), 1e-12);
+      EXPECT_LT((surface.bottomRows<1>().transpose() - result.r2).norm(), 1e-12);
+    }
+  }
+}
+
+TEST(OpenSimWrapping, APathAlongACylinderIsAHelix)
+{
+  // Rising along the axis the path is a helix: length sqrt((r angle)^2 + rise^2) over the
+  // surface. OpenSim's first estimate of the tangent points (a path with one wrap object) is
+  // close; slid to tangency within 0.1 degree (several wrap objects) it is closer.
+  const HelixCase c = Helix(0.04, 1.5, 0.03, 0.02, 0.015);
+  WrapResult first, slid;
+  ASSERT_EQ(WrapCylinderSegment(c.p1, c.p2, 0.04, 1.0, 0, 0, false, first), WrapAction::Mandatory);
+  ASSERT_EQ(WrapCylinderSegment(c.p1, c.p2, 0.04, 1.0, 0, 0, true, slid), WrapAction::Mandatory);
+  const auto total = [&](const WrapResult& w) {
+    return (w.r1 - c.p1).norm() + w.length + (c.p2 - w.r2).norm();
+  };
+  // The surface length is the helix's between the tangent points.
+  const Eigen::Vector2d u = slid.r1.head<2>(), v = slid.r2.head<2>();
+  const double turned = std::atan2(u.x() * v.y() - u.y() * v.x(), u.dot(v));
+  EXPECT_NEAR(slid.length, std::hypot(0.04 * turned, slid.r2.z() - slid.r1.z()), 1e-12);
+  EXPECT_NEAR(total(first), c.length, 1e-3 * c.length);
+  EXPECT_NEAR(total(slid), c.length, 1e-5 * c.length);
+  EXPECT_LT(std::abs(total(slid) - c.length), std::abs(total(first) - c.length));
+  // The true path is the shortest over the surface: no estimate is shorter.
+  EXPECT_GE(total(first), c.length - 1e-12);
+  EXPECT_GE(total(slid), c.length - 1e-12);
+}
+
+TEST(OpenSimWrapping, QuadrantEndsAndInsideDecideWhetherAPathWraps)
+{
+  // A segment passing the cylinder on its -y side, clear of it.
+  const Eigen::Vector3d below1(-0.3, -0.08, 0), below2(0.3, -0.08, 0);
+  WrapResult result;
+  EXPECT_EQ(WrapCylinderSegment(below1, below2, 0.05, 1.0, 0, 0, false, result), WrapAction::NoWrap);
+  // Constrained to +y, it goes over the +y side all the same (OpenSim's rule: with both ends
+  // off the wrapping side, the path may be taken over it; the least lengthening decides).
+  EXPECT_EQ(WrapCylinderSegment(below1, below2, 0.05, 1.0, 1, 1, false, result), WrapAction::Wrapped);
+  EXPECT_GT(CylinderSurfacePoints(result, 0.002).col(1).maxCoeff(), 0.049);
+  // Ends on either side of y = 0, the segment passing below, clear: over +y it may wrap (the
+  // segment with the least lengthening is chosen among those that may), over -y it does not.
+  const Eigen::Vector3d a(-0.3, 0.02, 0), b(0.3, -0.2, 0);
+  EXPECT_EQ(WrapCylinderSegment(a, b, 0.05, 1.0, 1, 1, false, result), WrapAction::Wrapped);
+  EXPECT_GT(CylinderSurfacePoints(result, 0.002).col(1).maxCoeff(), 0.049);
+  EXPECT_EQ(WrapCylinderSegment(a, b, 0.05, 1.0, 1, -1, false, result), WrapAction::NoWrap);
+  // Cutting through: mandatory over all of it and over its side the segment cuts.
+  const Eigen::Vector3d c1(-0.3, 0.01, 0), c2(0.3, 0.01, 0);
+  EXPECT_EQ(WrapCylinderSegment(c1, c2, 0.05, 1.0, 0, 0, false, result), WrapAction::Mandatory);
+  EXPECT_GT(result.r1.y(), 0.0);
+  EXPECT_EQ(WrapCylinderSegment(c1, c2, 0.05, 1.0, 1, 1, false, result), WrapAction::Mandatory);
+  // An end inside; tangent points beyond both ends of a short cylinder.
+  EXPECT_EQ(
+    WrapCylinderSegment(Eigen::Vector3d(0.01, 0, 0), c2, 0.05, 1.0, 0, 0, false, result), WrapAction::InsideRadius);
+  EXPECT_EQ(WrapCylinderSegment(
+              Eigen::Vector3d(-0.3, 0.01, 0.5), Eigen::Vector3d(0.3, 0.01, 0.5), 0.05, 0.2, 0, 0, false, result),
+    WrapAction::NoWrap);
+}
+
+TEST(OpenSimWrapping, TheSmallModelsPathWrapsOverItsCylinderUnlessInactive)
+{
+  Model model = ParseModel(kSmallModel, "small.osim");
+  const Path& path = model.paths[0];
+  std::vector<double> q = DefaultCoordinates(model);
+  // A pose whose straight path cuts the tibia's cylinder (radius 0.1 about the tibia's z).
+  const std::vector<md::RigidTransform> poses = BodyPoses(model, q);
+  const PathGeometry wrapped = PathAt(model, path, q, poses);
+  model.wrapObjects[0].active = false;
+  const PathGeometry straight = PathAt(model, path, q, poses);
+  EXPECT_EQ(std::count(straight.pointIndex.begin(), straight.pointIndex.end(), -1), 0);
+  EXPECT_NEAR(straight.length, md::osim::PolylineLength(straight.points), 1e-15);
+  const auto over = std::count(wrapped.pointIndex.begin(), wrapped.pointIndex.end(), -1);
+  if (over > 0)
+  {
+    // Wrapping only lengthens the path, and the drawn points measure what is reported.
+    EXPECT_GT(wrapped.length, straight.length);
+    EXPECT_NEAR(md::osim::PolylineLength(wrapped.points), wrapped.length, 1e-4 * wrapped.length);
+  }
+  else
+  {
+    EXPECT_NEAR(wrapped.length, straight.length, 1e-15);
+  }
+}
+
+TEST(OpenSimWrapping, BadWrapSettingsAreNamed)
+{
+  std::string text = kSmallModel;
+  text.replace(text.find("<radius>0.1</radius>"), 20, "<radius>0.1</radius><quadrant>w</quadrant>");
+  std::string e = ExpectInputError([&] { ParseModel(text, "small.osim"); });
+  EXPECT_NE(e.find("quadrant 'w'"), std::string::npos) << e;
+  EXPECT_NE(e.find("'cyl'"), std::string::npos) << e;
+
+  text = kSmallModel;
+  text.replace(text.find("<radius>0.1</radius>"), 20, "<radius>-0.1</radius>");
+  e = ExpectInputError([&] { ParseModel(text, "small.osim"); });
+  EXPECT_NE(e.find("must be positive"), std::string::npos) << e;
+  EXPECT_NE(e.find("'cyl'"), std::string::npos) << e;
+
+  text = kSmallModel;
+  text.replace(text.find("<wrap_object>cyl</wrap_object>"), 30, "<wrap_object>cylinder</wrap_object>");
+  e = ExpectInputError([&] { ParseModel(text, "small.osim"); });
+  EXPECT_NE(e.find("wrap object 'cylinder' is not in the model"), std::string::npos) << e;
+  EXPECT_NE(e.find("PathWrap 'w'"), std::string::npos) << e;
+
+  // Each quadrant name OpenSim accepts.
+  for (const auto& [name, axis, sign] : std::vector<std::tuple<std::string, int, int>>{
+         { "x", 0, 1 }, { "+X", 0, 1 }, { "-y", 1, -1 }, { "Z", 2, 1 }, { "-z", 2, -1 }, { "all", 0, 0 } })
+  {
+    text = kSmallModel;
+    text.replace(text.find("<radius>0.1</radius>"), 20, "<radius>0.1</radius><quadrant>" + name + "</quadrant>");
+    const Model m = ParseModel(text, "small.osim");
+    EXPECT_EQ(m.wrapObjects[0].quadrantSign, sign) << name;
+    if (sign != 0)
+    {
+      EXPECT_EQ(m.wrapObjects[0].quadrantAxis, axis) << name;
+    }
+  }
+}
+
+TEST(OpenSimWrapping, ANearbyPosesPathTakesTheOthersPointCount)
+{
+  PathGeometry path, like;
+  path.points.resize(3, 3);
+  path.points << 0, 0, 0, 1, 0, 0, 1, 1, 0; // length 2
+  like.points.resize(5, 3);
+  like.points << 0, 0, 0, 0.5, 0, 0, 1, 0, 0, 2, 0, 0, 4, 0, 0; // shares 0, 1/8, 1/4, 1/2, 1
+  const md::Points same = PointsLike(path, path);
+  EXPECT_EQ(same, path.points);
+  const md::Points moved = PointsLike(path, like);
+  ASSERT_EQ(moved.rows(), 5);
+  const Eigen::Vector3d expected[5] = { { 0, 0, 0 }, { 0.25, 0, 0 }, { 0.5, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 } };
+  for (int k = 0; k < 5; ++k)
+  {
+    EXPECT_LT((moved.row(k).transpose() - expected[k]).norm(), 1e-15) << k;
+  }
+}
+
+TEST(OpenSimWrapping, APathOverAPulleyOnTheJointAxisHasItsRadiusAsMomentArm)
+{
+  // A cylinder of radius 0.05 on ground about the pin joint's axis (z through the origin), the
+  // path from ground over it to the turning arm: each radian of the joint winds 0.05 of the path
+  // on or off the pulley, wherever the tangent points are. Positive (shortening as q grows) where
+  // the path goes round the +x side, negative round the -x side.
+  const std::string model = R"(<?xml version="1.0"?>
+<OpenSimDocument Version="40000"><Model name="pulley"><Ground name="ground">
+  <WrapObjectSet><objects><WrapCylinder name="pulley"><radius>0.05</radius><length>0.5</length></WrapCylinder></objects></WrapObjectSet>
+ </Ground>
+ <BodySet><objects><Body name="arm"/></objects></BodySet>
+ <JointSet><objects><PinJoint name="pin"><socket_parent_frame>/ground</socket_parent_frame><socket_child_frame>/bodyset/arm</socket_child_frame>
+  <coordinates><Coordinate name="q"><range>-3 3</range></Coordinate></coordinates></PinJoint></objects></JointSet>
+ <ForceSet><objects><PathSpring name="s"><GeometryPath name="path"><PathPointSet><objects>
+  <PathPoint name="o"><socket_parent_frame>/ground</socket_parent_frame><location>0 0.3 0</location></PathPoint>
+  <PathPoint name="i"><socket_parent_frame>/bodyset/arm</socket_parent_frame><location>0.02 -0.3 0</location></PathPoint>
+ </objects></PathPointSet>
+ <PathWrapSet><objects><PathWrap name="w"><wrap_object>pulley</wrap_object></PathWrap></objects></PathWrapSet>
+ </GeometryPath></PathSpring></objects></ForceSet>
+</Model></OpenSimDocument>)";
+  const Model m = ParseModel(model, "pulley.osim");
+  ASSERT_EQ(m.paths.size(), 1u);
+  const int q = m.FindCoordinate("q");
+  const auto at = [&](double angle) {
+    std::vector<double> coordinates = DefaultCoordinates(m);
+    coordinates[static_cast<size_t>(q)] = angle;
+    return coordinates;
+  };
+  for (double angle : { -0.4, -0.1, 0.0, 0.1, 0.2 })
+  {
+    const std::vector<double> coordinates = at(angle);
+    const PathGeometry g = PathAt(m, m.paths[0], coordinates, BodyPoses(m, coordinates));
+    double side = 0;
+    for (size_t i = 0; i < g.pointIndex.size(); ++i)
+    {
+      side += g.pointIndex[i] == -1 ? g.points(Eigen::Index(i), 0) : 0.0;
+    }
+    ASSERT_NE(side, 0.0) << angle; // it wraps
+    EXPECT_NEAR(MomentArm(m, m.paths[0], coordinates, q, 1e-4), side > 0 ? 0.05 : -0.05, 1e-9) << angle;
+  }
+  // Turned far enough, the straight path clears the pulley.
+  const PathGeometry clear = PathAt(m, m.paths[0], at(0.5), BodyPoses(m, at(0.5)));
+  EXPECT_EQ(std::count(clear.pointIndex.begin(), clear.pointIndex.end(), -1), 0);
+  EXPECT_NEAR(clear.length, md::osim::PolylineLength(clear.points), 1e-15);
+}
