@@ -411,7 +411,8 @@ void vtkOpenSimModelReader::LoadModel(const std::string& fileName, std::vector<s
   {
     for (const osim::PathWrap& w : p.wraps)
     {
-      if (in.model.wrapObjects[static_cast<size_t>(w.wrapObject)].shape != osim::WrapShape::Cylinder)
+      const osim::WrapShape shape = in.model.wrapObjects[static_cast<size_t>(w.wrapObject)].shape;
+      if (shape != osim::WrapShape::Cylinder && shape != osim::WrapShape::Sphere)
       {
         unwrapped += (unwrapped.empty() ? "" : ", ") + p.name + " over " + w.name;
         break;
@@ -420,8 +421,8 @@ void vtkOpenSimModelReader::LoadModel(const std::string& fileName, std::vector<s
   }
   if (!unwrapped.empty())
   {
-    warnings.push_back("paths over wrap spheres, ellipsoids and tori are not wrapped yet (over cylinders "
-                       "they are): these paths pass through those objects: " +
+    warnings.push_back("paths over wrap ellipsoids and tori are not wrapped yet (over cylinders and "
+                       "spheres they are): these paths pass through those objects: " +
       unwrapped);
   }
   in.modelKey = modelKey;

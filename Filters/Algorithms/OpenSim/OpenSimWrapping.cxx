@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "OpenSim/OpenSimWrapping.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -108,6 +109,20 @@ bool SegmentMeetsPlane(const Vector& a, const Vector& b, const Vector& n, double
 const Vector kAxisPoint(0.0, 0.0, -1.0);
 const Vector kAxis(0.0, 0.0, 1.0);
 
+/// Of the tangent points r1a, r1b of one end and r2a, r2b of the other, the pair whose directions
+/// from their centres (c1, c2: on a cylinder's axis, or a sphere's centre) are nearest each other.
+void NearestPair(const Vector& r1a, const Vector& r1b, const Vector& r2a, const Vector& r2b, const Vector& c1,
+  const Vector& c2, WrapResult& result)
+{
+  const Vector r1am = NormalizeOrZero(r1a - c1), r1bm = NormalizeOrZero(r1b - c1), r2am = NormalizeOrZero(r2a - c2),
+               r2bm = NormalizeOrZero(r2b - c2);
+  const double dot1 = r1am.dot(r2am), dot2 = r1am.dot(r2bm), dot3 = r1bm.dot(r2am), dot4 = r1bm.dot(r2bm);
+  const bool firstA = (dot1 > dot2 && dot1 > dot3 && dot1 > dot4) || (dot2 > dot3 && dot2 > dot4);
+  const bool secondA = (dot1 > dot2 && dot1 > dot3 && dot1 > dot4) || (!firstA && dot3 > dot4);
+  result.r1 = firstA ? r1a : r1b;
+  result.r2 = secondA ? r2a : r2b;
+}
+
 /// Slides tangent point `r` along the axis so that the line from `p` to it meets the surface at
 /// the angle the helix leaves it (towards `onHelix`, the helix's next point); false when it
 /// already does to within kTangencyThreshold.
@@ -172,20 +187,123 @@ void SpiralPath(const Vector& p1, const Vector& p2, double radius, bool longWrap
       break;
     }
   }
+  result.axis = kAxis;
   result.turn = sense * theta;
   result.rise = axial;
 }
 }
 
-Points CylinderSurfacePoints(const WrapResult& wrap, double spacing)
+Points SurfacePoints(const WrapResult& wrap, double spacing)
 {
   const int drawn = std::max(1, static_cast<int>(std::ceil(wrap.length / spacing)));
   Points surface(drawn + 1, 3);
   for (int i = 0; i <= drawn; ++i)
   {
-    surface.row(i) = OnHelix(wrap.r1, wrap.turn, wrap.rise, static_cast<double>(i) / drawn).transpose();
+    const double t = static_cast<double>(i) / drawn;
+    surface.row(i) = (Eigen::AngleAxisd(t * wrap.turn, wrap.axis) * wrap.r1 + t * wrap.rise * wrap.axis).transpose();
   }
+  surface.row(drawn) = wrap.r2.transpose(); // exactly where the path leaves the surface
   return surface;
+}
+
+WrapAction WrapSphereSegment(
+  const Vector& p1, const Vector& p2, double radius, int quadrantAxis, int quadrantSign, WrapResult& result)
+{
+  result = WrapResult();
+  if (p1.norm() < radius || p2.norm() < radius)
+  {
+    return WrapAction::InsideRadius;
+  }
+  // Where the segment's line meets the sphere: both crossings within the segment, in order.
+  const Vector ri = p1 - p2, mp = -p2;
+  const double a = ri.dot(ri), b = -2.0 * mp.dot(ri), c = mp.dot(mp) - radius * radius;
+  const double disc = b * b - 4.0 * a * c;
+  if (disc < 0.0)
+  {
+    return WrapAction::NoWrap;
+  }
+  const double l1 = (-b + std::sqrt(disc)) / (2.0 * a), l2 = (-b - std::sqrt(disc)) / (2.0 * a);
+  if (!(0.0 < l1 && l1 < 1.0) || !(0.0 < l2 && l2 < 1.0) || l1 < l2)
+  {
+    return WrapAction::NoWrap;
+  }
+  WrapAction action = WrapAction::Wrapped;
+  const Vector along = NormalizeOrZero(p1 - p2);
+  Vector planeNormal = along.cross(NormalizeOrZero(p2));
+  if (planeNormal.norm() < 1e-5)
+  {
+    // Through the centre: any plane holds the line (OpenSim reuses its last answer).
+    planeNormal = along.cross(std::abs(along.z()) < 0.9 ? Vector::UnitZ() : Vector::UnitX());
+  }
+  const Vector n = NormalizeOrZero(planeNormal);
+  // Each end's two tangent points, in the plane through the ends and the centre.
+  const auto tangents = [&](const Vector& p, Vector& ta, Vector& tb) {
+    const Vector y = NormalizeOrZero(-p), z = n.cross(y);
+    const double half = std::asin(radius / p.norm()), reach = p.norm() * std::cos(half);
+    ta = p + (std::cos(half) * y - std::sin(half) * z) * reach;
+    tb = p + (std::cos(half) * y + std::sin(half) * z) * reach;
+  };
+  Vector r1a, r1b, r2a, r2b;
+  tangents(p1, r1a, r1b);
+  tangents(p2, r2a, r2b);
+  const Vector r1am = NormalizeOrZero(r1a), r1bm = NormalizeOrZero(r1b), r2am = NormalizeOrZero(r2a),
+               r2bm = NormalizeOrZero(r2b);
+  NearestPair(r1a, r1b, r2a, r2b, Vector::Zero(), Vector::Zero(), result);
+  bool farSide = false;
+  if (quadrantSign != 0)
+  {
+    const int axis = quadrantAxis;
+    const auto onSide = [&](const Vector& x) {
+      return Sign(x[axis]) == quadrantSign;
+    };
+    if (onSide(p1) || onSide(p2))
+    {
+      // The line's point nearest the centre: the wrap is mandatory where it is inside the sphere
+      // (and, as OpenSim has it, its distance from p1 in model units is between 0 and 1),
+      // possible where the ends are on opposite sides and it is on the other.
+      const double fromP1 = (-p1).dot(-along);
+      const Vector nearest = p1 - fromP1 * along;
+      if (nearest.squaredNorm() < radius * radius && fromP1 > 0.0 && fromP1 < 1.0)
+      {
+        action = WrapAction::Mandatory;
+      }
+      else if (Sign(p1[axis]) != Sign(p2[axis]) && !onSide(nearest))
+      {
+        action = WrapAction::Wrapped;
+      }
+      else
+      {
+        return WrapAction::NoWrap;
+      }
+    }
+    if (!onSide(p1) || !onSide(p2))
+    {
+      // The tangent points facing the centre from the ends, or the other pair where the path
+      // would leave the wrapping side; the far way round where it runs against its radii.
+      const Vector toCentre = NormalizeOrZero(-p1 - p2);
+      const bool a1 = r1am.dot(toCentre) > r1bm.dot(toCentre), a2 = r2am.dot(toCentre) > r2bm.dot(toCentre);
+      result.r1 = a1 ? r1a : r1b;
+      result.r2 = a2 ? r2a : r2b;
+      const Vector side = Vector::Unit(axis) * quadrantSign;
+      if (NormalizeOrZero((result.r1 - p1) + (result.r2 - p2)).dot(side) < 0.0)
+      {
+        result.r1 = a1 ? r1b : r1a;
+        result.r2 = a2 ? r2b : r2a;
+      }
+      farSide = (result.r1 + result.r2).dot((result.r1 - p1) + (result.r2 - p2)) < 0.0;
+    }
+  }
+  const Vector r1n = NormalizeOrZero(result.r1), r2n = NormalizeOrZero(result.r2);
+  double angle = std::acos(std::clamp(r1n.dot(r2n), -1.0, 1.0));
+  if (farSide)
+  {
+    angle = -(2.0 * M_PI - angle);
+  }
+  result.axis = NormalizeOrZero(r1n.cross(r2n));
+  result.turn = angle;
+  result.rise = 0.0;
+  result.length = radius * std::abs(angle);
+  return action;
 }
 
 WrapAction WrapCylinderSegment(const Vector& p1, const Vector& p2, double radius, double length, int quadrantAxis,
@@ -291,30 +409,7 @@ WrapAction WrapCylinderSegment(const Vector& p1, const Vector& p2, double radius
   }
   else
   {
-    // The pair of tangent points nearest each other round the axis.
-    const Vector r1am = NormalizeOrZero(r1a - p11), r1bm = NormalizeOrZero(r1b - p11),
-                 r2am = NormalizeOrZero(r2a - p22), r2bm = NormalizeOrZero(r2b - p22);
-    const double dot1 = r1am.dot(r2am), dot2 = r1am.dot(r2bm), dot3 = r1bm.dot(r2am), dot4 = r1bm.dot(r2bm);
-    if (dot1 > dot2 && dot1 > dot3 && dot1 > dot4)
-    {
-      result.r1 = r1a;
-      result.r2 = r2a;
-    }
-    else if (dot2 > dot3 && dot2 > dot4)
-    {
-      result.r1 = r1a;
-      result.r2 = r2b;
-    }
-    else if (dot3 > dot4)
-    {
-      result.r1 = r1b;
-      result.r2 = r2a;
-    }
-    else
-    {
-      result.r1 = r1b;
-      result.r2 = r2b;
-    }
+    NearestPair(r1a, r1b, r2a, r2b, p11, p22, result);
   }
   // The apex: where the plane through p1, p2 and the axis point between them leaves the
   // cylinder on the wrapping side. The tangent points slide along the axis onto the plane
@@ -473,9 +568,18 @@ bool ApplyWrap(const Model& model, const Path& path, int w, const std::vector<Ri
     }
     WrapResult result;
     const Vector p1 = fromGround.Apply(pa.position), p2 = fromGround.Apply(pb.position);
-    last = object.shape == WrapShape::Cylinder ? WrapCylinderSegment(p1, p2, object.dimensions[0], object.dimensions[1],
-                                                   object.quadrantAxis, object.quadrantSign, !single, result)
-                                               : WrapAction::NoWrap;
+    switch (object.shape)
+    {
+      case WrapShape::Cylinder:
+        last = WrapCylinderSegment(p1, p2, object.dimensions[0], object.dimensions[1], object.quadrantAxis,
+          object.quadrantSign, !single, result);
+        break;
+      case WrapShape::Sphere:
+        last = WrapSphereSegment(p1, p2, object.dimensions[0], object.quadrantAxis, object.quadrantSign, result);
+        break;
+      default:
+        last = WrapAction::NoWrap; // not wrapped yet: the reader says so
+    }
     if (last == WrapAction::Mandatory)
     {
       best = std::move(result);
@@ -504,7 +608,7 @@ bool ApplyWrap(const Model& model, const Path& path, int w, const std::vector<Ri
     leaves.wrap = w;
     leaves.leaves = true;
     leaves.surfaceLength = best.length;
-    leaves.surface = toGround.Apply(CylinderSurfacePoints(best, spacing));
+    leaves.surface = toGround.Apply(SurfacePoints(best, spacing));
     points.insert(points.begin() + bestEnd, { meets, leaves });
   }
   return true;

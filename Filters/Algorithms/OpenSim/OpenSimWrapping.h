@@ -2,8 +2,9 @@
 // Muscle paths over OpenSim's wrap objects, as OpenSim 4.x computes them: the wrap objects of a
 // path tried in turn on every segment of its range, the one that lengthens the path least (or
 // the first the straight path cuts through) kept, and several wrap objects iterated until the
-// length settles (opensim-core's GeometryPath::applyWrapObjects and WrapCylinder::wrapLine,
-// whose algorithms this follows; the code is ours). Cylinders only, so far.
+// length settles (opensim-core's GeometryPath::applyWrapObjects, WrapCylinder::wrapLine and
+// WrapSphere::wrapLine, whose algorithms this follows; the code is ours). Cylinders and spheres,
+// so far.
 #pragma once
 
 #include "OpenSim/OpenSimModel.h"
@@ -27,7 +28,10 @@ struct WrapResult
   Eigen::Vector3d r1 = Eigen::Vector3d::Zero(); ///< where the path meets the surface
   Eigen::Vector3d r2 = Eigen::Vector3d::Zero(); ///< where it leaves it
   double length = 0.0;                          ///< along the surface from r1 to r2
-  /// The helix from r1 to r2: how far it turns about the axis (radians, signed) and rises along it.
+  /// The path over the surface from r1 to r2: r1 turned about `axis` (through the origin) by up to
+  /// `turn` (radians, signed) while rising along it by up to `rise` (a helix on a cylinder, a
+  /// great circle's arc on a sphere).
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
   double turn = 0.0, rise = 0.0;
 };
 
@@ -41,8 +45,18 @@ struct WrapResult
 WrapAction WrapCylinderSegment(const Eigen::Vector3d& p1, const Eigen::Vector3d& p2, double radius, double length,
   int quadrantAxis, int quadrantSign, bool adjustTangents, WrapResult& result);
 
-/// Points on a cylinder's helix from r1 to r2 (both included), at most `spacing` apart.
-Points CylinderSurfacePoints(const WrapResult& wrap, double spacing);
+/// The segment p1-p2 (in the sphere's frame: centred at the origin) over a sphere of `radius`,
+/// on the side `quadrantSign` of axis `quadrantAxis` (sign 0: all of it), as OpenSim computes it:
+/// the tangent points in the plane through p1, p2 and the centre, the arc of the great circle
+/// between them (the far way round where the quadrant asks). Where the segment runs through the
+/// centre (the plane undefined) OpenSim reuses its last answer; here the plane through the
+/// sphere's z axis (or x axis) is taken. OpenSim reports a far-way-round arc's length negative
+/// (a sign slip); here it is the arc's length.
+WrapAction WrapSphereSegment(const Eigen::Vector3d& p1, const Eigen::Vector3d& p2, double radius, int quadrantAxis,
+  int quadrantSign, WrapResult& result);
+
+/// Points on the surface path from r1 to r2 (both included), at most `spacing` apart.
+Points SurfacePoints(const WrapResult& wrap, double spacing);
 
 /// One point of a wrapped path (in ground): a path point, or where it meets or leaves a wrap
 /// object.

@@ -59,7 +59,7 @@ TEST(OpenSimWrapping, APathAcrossACylinderIsAnArcOfItsCircle)
       EXPECT_NEAR(length, c.length, 1e-12) << angle << " " << adjust;
       EXPECT_NEAR(result.length, 0.05 * angle, 1e-12);
       // The surface points lie on the cylinder, from r1 to r2, no farther apart than asked.
-      const md::Points surface = CylinderSurfacePoints(result, 0.002);
+      const md::Points surface = SurfacePoints(result, 0.002);
       ASSERT_GE(surface.rows(), 2);
       for (Eigen::Index i = 0; i < surface.rows(); ++i)
       {
@@ -108,12 +108,12 @@ TEST(OpenSimWrapping, QuadrantEndsAndInsideDecideWhetherAPathWraps)
   // Constrained to +y, it goes over the +y side all the same (OpenSim's rule: with both ends
   // off the wrapping side, the path may be taken over it; the least lengthening decides).
   EXPECT_EQ(WrapCylinderSegment(below1, below2, 0.05, 1.0, 1, 1, false, result), WrapAction::Wrapped);
-  EXPECT_GT(CylinderSurfacePoints(result, 0.002).col(1).maxCoeff(), 0.049);
+  EXPECT_GT(SurfacePoints(result, 0.002).col(1).maxCoeff(), 0.049);
   // Ends on either side of y = 0, the segment passing below, clear: over +y it may wrap (the
   // segment with the least lengthening is chosen among those that may), over -y it does not.
   const Eigen::Vector3d a(-0.3, 0.02, 0), b(0.3, -0.2, 0);
   EXPECT_EQ(WrapCylinderSegment(a, b, 0.05, 1.0, 1, 1, false, result), WrapAction::Wrapped);
-  EXPECT_GT(CylinderSurfacePoints(result, 0.002).col(1).maxCoeff(), 0.049);
+  EXPECT_GT(SurfacePoints(result, 0.002).col(1).maxCoeff(), 0.049);
   EXPECT_EQ(WrapCylinderSegment(a, b, 0.05, 1.0, 1, -1, false, result), WrapAction::NoWrap);
   // Cutting through: mandatory over all of it and over its side the segment cuts.
   const Eigen::Vector3d c1(-0.3, 0.01, 0), c2(0.3, 0.01, 0);
@@ -250,4 +250,101 @@ TEST(OpenSimWrapping, APathOverAPulleyOnTheJointAxisHasItsRadiusAsMomentArm)
   const PathGeometry clear = PathAt(m, m.paths[0], at(0.5), BodyPoses(m, at(0.5)));
   EXPECT_EQ(std::count(clear.pointIndex.begin(), clear.pointIndex.end(), -1), 0);
   EXPECT_NEAR(clear.length, md::osim::PolylineLength(clear.points), 1e-15);
+}
+
+TEST(OpenSimWrapping, OpenSimsOwnPerpendicularCasesHaveTheirGoldenValues)
+{
+  // opensim-core's testGeometryPathWrapping, "WrapCylinder" and "WrapSphere"
+  // (testSingleWrapObjectPerpendicular): a wrap object of radius 0.5 on ground, turned as that
+  // test turns it, and with quadrant +y; a path from ground (r - 0.1, r, 0) to a pin-jointed
+  // body's (-r, r, 0). Over a quarter turn of the pin its moment arm is -r (OpenSim asserts to
+  // 1e-4) and its length 2r - 0.1 plus the part of a quarter circle wound on (to 1e-6).
+  const double r = 0.5;
+  const std::string cylinder = "<WrapCylinder name=\"pulley1\"><radius>0.5</radius><length>1</length>";
+  const std::string sphere = "<WrapSphere name=\"pulley1\"><radius>0.5</radius>";
+  const std::vector<std::string> aboutZ = { "0 0 0", "0 0 1.5707963267948966", "0 0 3.141592653589793",
+    "0 0 -1.5707963267948966" };
+  std::vector<std::tuple<std::string, std::string, std::string>> cases;
+  for (const std::string& rotation : aboutZ)
+  {
+    cases.emplace_back(cylinder, rotation, "all");
+    cases.emplace_back(sphere, rotation, "all");
+  }
+  for (const std::string& rotation : { "0 1.5707963267948966 0", "0 3.141592653589793 0", "0 -1.5707963267948966 0",
+         "1.5707963267948966 0 0", "3.141592653589793 0 0", "-1.5707963267948966 0 0" })
+  {
+    cases.emplace_back(sphere, rotation, "all");
+  }
+  cases.emplace_back(cylinder, "0 0 0", "+y");
+  cases.emplace_back(sphere, "0 0 0", "+y");
+  for (const auto& [object, rotation, quadrant] : cases)
+  {
+    const std::string type = object.substr(1, object.find(' ') - 1);
+    const std::string text = R"(<?xml version="1.0"?>
+<OpenSimDocument Version="40000"><Model name="perpendicular"><Ground name="ground">
+  <WrapObjectSet><objects>)" +
+      object + "<xyz_body_rotation>" + rotation + "</xyz_body_rotation><quadrant>" + quadrant + "</quadrant></" + type +
+      R"(></objects></WrapObjectSet>
+ </Ground>
+ <BodySet><objects><Body name="body"/></objects></BodySet>
+ <JointSet><objects><PinJoint name="pin"><socket_parent_frame>/ground</socket_parent_frame><socket_child_frame>/bodyset/body</socket_child_frame>
+  <coordinates><Coordinate name="q_pin"/></coordinates></PinJoint></objects></JointSet>
+ <ForceSet><objects><PathSpring name="spring1"><GeometryPath name="path"><PathPointSet><objects>
+  <PathPoint name="origin"><socket_parent_frame>/ground</socket_parent_frame><location>0.4 0.5 0</location></PathPoint>
+  <PathPoint name="insert"><socket_parent_frame>/bodyset/body</socket_parent_frame><location>-0.5 0.5 0</location></PathPoint>
+ </objects></PathPointSet>
+ <PathWrapSet><objects><PathWrap name="w"><wrap_object>pulley1</wrap_object></PathWrap></objects></PathWrapSet>
+ </GeometryPath></PathSpring></objects></ForceSet>
+</Model></OpenSimDocument>)";
+    const Model m = ParseModel(text, "perpendicular.osim");
+    const int q = m.FindCoordinate("q_pin");
+    constexpr int kSteps = 50;
+    for (int i = 0; i <= kSteps; ++i)
+    {
+      std::vector<double> coordinates = DefaultCoordinates(m);
+      coordinates[static_cast<size_t>(q)] = i * M_PI / (2 * kSteps);
+      const double length = PathAt(m, m.paths[0], coordinates, BodyPoses(m, coordinates)).length;
+      const std::string what = type + " " + rotation + " " + quadrant + " step " + std::to_string(i);
+      EXPECT_NEAR(length, 2 * r - 0.1 + 0.25 * 2 * M_PI * r * i / kSteps, 1e-6) << what;
+      EXPECT_NEAR(MomentArm(m, m.paths[0], coordinates, q, 1e-6), -r, 1e-4) << what;
+    }
+  }
+}
+
+TEST(OpenSimWrapping, APathOverASphereIsAnArcOfAGreatCircle)
+{
+  // A great circle in a tilted plane: r1 on it, the arc turning by `angle`, the ends back and on
+  // along its tangents (near enough that the segment cuts the sphere on the arc's side). The
+  // tangent points are exact: the length is the tangents' and the arc's, R angle.
+  const double radius = 0.03;
+  const Eigen::Vector3d normal = Eigen::Vector3d(0.3, -0.5, 0.8).normalized();
+  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+  for (double angle : { 0.4, 1.2, 2.5 })
+  {
+    const double reach = radius / std::tan(0.5 * angle);
+    const auto at = [&](double phi) -> Eigen::Vector3d {
+      return radius * (std::cos(phi) * u + std::sin(phi) * v);
+    };
+    const auto tangent = [&](double phi) -> Eigen::Vector3d {
+      return -std::sin(phi) * u + std::cos(phi) * v;
+    };
+    const Eigen::Vector3d p1 = at(0) - 0.6 * reach * tangent(0), p2 = at(angle) + 0.4 * reach * tangent(angle);
+    WrapResult result;
+    ASSERT_EQ(WrapSphereSegment(p1, p2, radius, 0, 0, result), WrapAction::Wrapped) << angle;
+    EXPECT_LT((result.r1 - at(0)).norm(), 1e-12) << angle;
+    EXPECT_LT((result.r2 - at(angle)).norm(), 1e-12) << angle;
+    EXPECT_NEAR(result.length, radius * angle, 1e-12) << angle;
+    const md::Points surface = SurfacePoints(result, 0.002);
+    for (Eigen::Index i = 0; i < surface.rows(); ++i)
+    {
+      EXPECT_NEAR(surface.row(i).norm(), radius, 1e-12);
+      EXPECT_NEAR(surface.row(i).dot(normal), 0.0, 1e-12);
+    }
+  }
+  // An end inside; a segment clear of the sphere.
+  WrapResult result;
+  EXPECT_EQ(WrapSphereSegment(Eigen::Vector3d(0.01, 0, 0), Eigen::Vector3d(0.3, 0, 0), radius, 0, 0, result),
+    WrapAction::InsideRadius);
+  EXPECT_EQ(WrapSphereSegment(Eigen::Vector3d(-0.3, 0.05, 0), Eigen::Vector3d(0.3, 0.05, 0), radius, 0, 0, result),
+    WrapAction::NoWrap);
 }
