@@ -924,7 +924,8 @@ private:
 
   void ReadWrapObjects(Node modelNode)
   {
-    auto readSet = [&](Node owner, int body) {
+    // The wrap objects of a body, of ground or of an offset frame (`offset` from its body).
+    auto readSet = [&](Node owner, int body, const RigidTransform& offset) {
       for (Node wrap : owner.child("WrapObjectSet").child("objects").children())
       {
         if (wrap.type() != pugi::node_element)
@@ -935,8 +936,9 @@ private:
         WrapObject w;
         w.name = wrap.attribute("name").value();
         w.body = body;
-        w.placement = Offset(this->reader.Vector(wrap, "translation", Eigen::Vector3d::Zero()),
-          this->reader.Vector(wrap, "xyz_body_rotation", Eigen::Vector3d::Zero()));
+        w.placement = Compose(offset,
+          Offset(this->reader.Vector(wrap, "translation", Eigen::Vector3d::Zero()),
+            this->reader.Vector(wrap, "xyz_body_rotation", Eigen::Vector3d::Zero())));
         if (type == "WrapCylinder")
         {
           w.shape = WrapShape::Cylinder;
@@ -976,10 +978,21 @@ private:
         this->model.wrapObjects.push_back(w);
       }
     };
-    readSet(modelNode.child("Ground"), 0);
+    readSet(modelNode.child("Ground"), 0, RigidTransform());
     for (Node body : modelNode.child("BodySet").child("objects").children("Body"))
     {
-      readSet(body, std::max(0, this->model.FindBody(body.attribute("name").value())));
+      readSet(body, std::max(0, this->model.FindBody(body.attribute("name").value())), RigidTransform());
+    }
+    // 4.x: offset frames may hold wrap objects too (each frame once: the map has it by name
+    // and by path).
+    std::set<const void*> seen;
+    for (const auto& [name, frame] : this->frameNodes)
+    {
+      if (frame.child("WrapObjectSet") && seen.insert(frame.internal_object()).second)
+      {
+        const FrameOnBody placed = this->ResolveFrame(frame, name, Node());
+        readSet(frame, placed.body, placed.offset);
+      }
     }
   }
 

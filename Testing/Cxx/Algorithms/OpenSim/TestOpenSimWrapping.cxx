@@ -246,6 +246,27 @@ TEST(OpenSimWrapping, APathOverAPulleyOnTheJointAxisHasItsRadiusAsMomentArm)
     ASSERT_NE(side, 0.0) << angle; // it wraps
     EXPECT_NEAR(MomentArm(m, m.paths[0], coordinates, q, 1e-4), side > 0 ? 0.05 : -0.05, 1e-9) << angle;
   }
+  // The same pulley on an offset frame of the arm (moved along its axis, turned about it: the
+  // same surface) gives the same path.
+  std::string onFrame = model;
+  onFrame.replace(
+    onFrame.find("<WrapObjectSet>"), onFrame.find("</WrapObjectSet>") + 16 - onFrame.find("<WrapObjectSet>"), "");
+  onFrame.replace(onFrame.find("<Body name=\"arm\"/>"), 18,
+    "<Body name=\"arm\"><components><PhysicalOffsetFrame "
+    "name=\"arm_offset\"><socket_parent>/bodyset/arm</socket_parent>"
+    "<translation>0 0 0.05</translation><orientation>0 0 0.3</orientation><WrapObjectSet><objects><WrapCylinder "
+    "name=\"pulley\"><radius>0.05</radius><length>0.5</length></WrapCylinder></objects></WrapObjectSet>"
+    "</PhysicalOffsetFrame></components></Body>");
+  const Model framed = ParseModel(onFrame, "pulley_on_frame.osim");
+  ASSERT_EQ(framed.wrapObjects.size(), 1u);
+  EXPECT_EQ(framed.wrapObjects[0].body, framed.FindBody("arm"));
+  for (double angle : { -0.4, 0.0, 0.2 })
+  {
+    const std::vector<double> coordinates = at(angle);
+    EXPECT_NEAR(PathAt(framed, framed.paths[0], coordinates, BodyPoses(framed, coordinates)).length,
+      PathAt(m, m.paths[0], coordinates, BodyPoses(m, coordinates)).length, 1e-12)
+      << angle;
+  }
   // Turned far enough, the straight path clears the pulley.
   const PathGeometry clear = PathAt(m, m.paths[0], at(0.5), BodyPoses(m, at(0.5)));
   EXPECT_EQ(std::count(clear.pointIndex.begin(), clear.pointIndex.end(), -1), 0);
