@@ -412,7 +412,7 @@ void vtkOpenSimModelReader::LoadModel(const std::string& fileName, std::vector<s
     for (const osim::PathWrap& w : p.wraps)
     {
       const osim::WrapShape shape = in.model.wrapObjects[static_cast<size_t>(w.wrapObject)].shape;
-      if (shape != osim::WrapShape::Cylinder && shape != osim::WrapShape::Sphere)
+      if (shape == osim::WrapShape::Ellipsoid)
       {
         unwrapped += (unwrapped.empty() ? "" : ", ") + p.name + " over " + w.name;
         break;
@@ -421,8 +421,8 @@ void vtkOpenSimModelReader::LoadModel(const std::string& fileName, std::vector<s
   }
   if (!unwrapped.empty())
   {
-    warnings.push_back("paths over wrap ellipsoids and tori are not wrapped yet (over cylinders and "
-                       "spheres they are): these paths pass through those objects: " +
+    warnings.push_back("paths over wrap ellipsoids are not wrapped yet (over cylinders, spheres and tori "
+                       "they are): these paths pass through the ellipsoids: " +
       unwrapped);
   }
   in.modelKey = modelKey;

@@ -14,6 +14,8 @@ namespace
 using Vector = Eigen::Vector3d;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+/// The length of the cylinder OpenSim puts along a torus's ring (model units).
+constexpr double kTorusCylinderLength = 10000.0;
 /// OpenSim's segment length on a wrap surface when it places tangent points (metres).
 constexpr double kTangencySegment = 0.002;
 /// How far a line to a tangent point may be from tangent to the helix, and how many times a
@@ -200,7 +202,9 @@ Points SurfacePoints(const WrapResult& wrap, double spacing)
   for (int i = 0; i <= drawn; ++i)
   {
     const double t = static_cast<double>(i) / drawn;
-    surface.row(i) = (Eigen::AngleAxisd(t * wrap.turn, wrap.axis) * wrap.r1 + t * wrap.rise * wrap.axis).transpose();
+    surface.row(i) =
+      (wrap.centre + Eigen::AngleAxisd(t * wrap.turn, wrap.axis) * (wrap.r1 - wrap.centre) + t * wrap.rise * wrap.axis)
+        .transpose();
   }
   surface.row(drawn) = wrap.r2.transpose(); // exactly where the path leaves the surface
   return surface;
@@ -446,6 +450,99 @@ WrapAction WrapCylinderSegment(const Vector& p1, const Vector& p2, double radius
 
 namespace
 {
+/// The length along the line from `from` towards `to` at which OpenSim's residual for the point
+/// nearest a ring of `radius` (about z, at z = 0) vanishes, from 0, by Newton's method on it.
+/// (OpenSim's residual is the derivative of the squared distance to a ring of twice the radius.)
+double RingResidualRoot(const Vector& from, const Vector& to, double radius)
+{
+  const Vector n = NormalizeOrZero(to - from);
+  const double c2 = 2.0 * from.dot(n), c3 = from.x() * n.x() + from.y() * n.y(), c4 = n.x() * n.x() + n.y() * n.y();
+  const double c5 = from.x() * from.x() + from.y() * from.y();
+  const auto residual = [&](double u) {
+    return c2 + 2.0 * u - 2.0 * radius * (2.0 * c4 * u + 2.0 * c3) / std::sqrt(u * u * c4 + 2.0 * c3 * u + c5);
+  };
+  double u = 0.0;
+  const double scale = std::max({ radius, from.norm(), 1e-12 });
+  for (int iteration = 0; iteration < 100; ++iteration)
+  {
+    const double h = 1e-7 * scale, f = residual(u);
+    const double slope = (residual(u + h) - residual(u - h)) / (2.0 * h);
+    if (!std::isfinite(f) || !std::isfinite(slope) || slope == 0.0)
+    {
+      break;
+    }
+    const double step = std::clamp(-f / slope, -scale, scale);
+    u += step;
+    if (std::abs(step) <= 1e-14 * scale)
+    {
+      break;
+    }
+  }
+  return u;
+}
+}
+
+WrapAction WrapTorusSegment(const Vector& p1, const Vector& p2, double ringRadius, double tubeRadius, int quadrantAxis,
+  int quadrantSign, bool adjustTangents, WrapResult& result)
+{
+  result = WrapResult();
+  // The point of the line nearest the ring from each end; the nearer (or the one on the
+  // quadrant's side), and the ring point beside it.
+  const auto nearRing = [&](const Vector& from, const Vector& to) {
+    return Vector(from + RingResidualRoot(from, to, ringRadius) * NormalizeOrZero(to - from));
+  };
+  const auto ringDistance = [&](const Vector& a) {
+    return std::sqrt(std::max(0.0, a.squaredNorm() + ringRadius * ringRadius - 2.0 * ringRadius * a.head<2>().norm()));
+  };
+  const Vector a1 = nearRing(p1, p2), a2 = nearRing(p2, p1);
+  bool first = ringDistance(a1) < ringDistance(a2);
+  if (quadrantSign != 0)
+  {
+    const bool on1 = Sign(a1[quadrantAxis]) == quadrantSign, on2 = Sign(a2[quadrantAxis]) == quadrantSign;
+    if (!on1 && !on2)
+    {
+      return WrapAction::NoWrap;
+    }
+    first = on1 && on2 ? first : on1;
+  }
+  const Vector chosen = first ? a1 : a2;
+  if (chosen.head<2>().norm() == 0.0)
+  {
+    return WrapAction::NoWrap;
+  }
+  const Vector ringPoint(
+    chosen.x() * ringRadius / chosen.head<2>().norm(), chosen.y() * ringRadius / chosen.head<2>().norm(), 0.0);
+  // The cylinder's frame: x towards the torus's centre, y down the torus's axis, z along the ring.
+  Eigen::Matrix3d toCylinder;
+  const Vector x = NormalizeOrZero(-ringPoint), y(0.0, 0.0, -1.0);
+  toCylinder.row(0) = x.transpose();
+  toCylinder.row(1) = y.transpose();
+  toCylinder.row(2) = x.cross(y).transpose();
+  const auto into = [&](const Vector& p) {
+    return Vector(toCylinder * (p - ringPoint));
+  };
+  const auto back = [&](const Vector& p) {
+    return Vector(toCylinder.transpose() * p + ringPoint);
+  };
+  WrapResult onCylinder;
+  const WrapAction action =
+    WrapCylinderSegment(into(p1), into(p2), tubeRadius, kTorusCylinderLength, 0, 1, adjustTangents, onCylinder);
+  if (action != WrapAction::Wrapped && action != WrapAction::Mandatory)
+  {
+    return action;
+  }
+  result = onCylinder;
+  result.r1 = back(onCylinder.r1);
+  result.r2 = back(onCylinder.r2);
+  result.axis = toCylinder.transpose() * onCylinder.axis;
+  // The surface path turns about the cylinder's axis through the ring point, not the origin:
+  // SurfacePoints draws about the origin, so the points are drawn in the cylinder's frame.
+  result.centre = ringPoint;
+  return action;
+}
+
+namespace
+{
 /// Removes wrap `w`'s two points from `path`, if there.
 void RemoveWrapPoints(std::vector<WrappedPoint>& path, int w)
 {
@@ -576,6 +673,10 @@ bool ApplyWrap(const Model& model, const Path& path, int w, const std::vector<Ri
         break;
       case WrapShape::Sphere:
         last = WrapSphereSegment(p1, p2, object.dimensions[0], object.quadrantAxis, object.quadrantSign, result);
+        break;
+      case WrapShape::Torus:
+        last = WrapTorusSegment(p1, p2, object.dimensions[0], object.dimensions[1], object.quadrantAxis,
+          object.quadrantSign, !single, result);
         break;
       default:
         last = WrapAction::NoWrap; // not wrapped yet: the reader says so

@@ -3,8 +3,8 @@
 // path tried in turn on every segment of its range, the one that lengthens the path least (or
 // the first the straight path cuts through) kept, and several wrap objects iterated until the
 // length settles (opensim-core's GeometryPath::applyWrapObjects, WrapCylinder::wrapLine and
-// WrapSphere::wrapLine, whose algorithms this follows; the code is ours). Cylinders and spheres,
-// so far.
+// WrapSphere::wrapLine and WrapTorus::wrapLine, whose algorithms this follows; the code is
+// ours). Cylinders, spheres and tori; not ellipsoids yet.
 #pragma once
 
 #include "OpenSim/OpenSimModel.h"
@@ -28,10 +28,11 @@ struct WrapResult
   Eigen::Vector3d r1 = Eigen::Vector3d::Zero(); ///< where the path meets the surface
   Eigen::Vector3d r2 = Eigen::Vector3d::Zero(); ///< where it leaves it
   double length = 0.0;                          ///< along the surface from r1 to r2
-  /// The path over the surface from r1 to r2: r1 turned about `axis` (through the origin) by up to
+  /// The path over the surface from r1 to r2: r1 turned about `axis` (through `centre`) by up to
   /// `turn` (radians, signed) while rising along it by up to `rise` (a helix on a cylinder, a
   /// great circle's arc on a sphere).
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero(); ///< a point on the axis
   double turn = 0.0, rise = 0.0;
 };
 
@@ -54,6 +55,16 @@ WrapAction WrapCylinderSegment(const Eigen::Vector3d& p1, const Eigen::Vector3d&
 /// (a sign slip); here it is the arc's length.
 WrapAction WrapSphereSegment(const Eigen::Vector3d& p1, const Eigen::Vector3d& p2, double radius, int quadrantAxis,
   int quadrantSign, WrapResult& result);
+
+/// The segment p1-p2 (in the torus's frame: its centre circle of radius `ringRadius` about z at
+/// z = 0, its tube of radius `tubeRadius`) over the inside of the tube, as OpenSim computes it: a
+/// cylinder of the tube's radius along the ring's tangent at the ring point nearest the segment,
+/// wrapped over on the side facing the torus's centre. OpenSim finds that point by a
+/// Levenberg-Marquardt search to 1e-4 from the segment's two ends; here it is found to rounding.
+/// OpenSim reports every segment as wrapped, also one that misses; here one that misses does not
+/// wrap.
+WrapAction WrapTorusSegment(const Eigen::Vector3d& p1, const Eigen::Vector3d& p2, double ringRadius, double tubeRadius,
+  int quadrantAxis, int quadrantSign, bool adjustTangents, WrapResult& result);
 
 /// Points on the surface path from r1 to r2 (both included), at most `spacing` apart.
 Points SurfacePoints(const WrapResult& wrap, double spacing);

@@ -369,3 +369,45 @@ TEST(OpenSimWrapping, APathOverASphereIsAnArcOfAGreatCircle)
   EXPECT_EQ(WrapSphereSegment(Eigen::Vector3d(-0.3, 0.05, 0), Eigen::Vector3d(0.3, 0.05, 0), radius, 0, 0, result),
     WrapAction::NoWrap);
 }
+
+TEST(OpenSimWrapping, APathThroughATorusWrapsTheInsideOfItsTube)
+{
+  // A ring of radius 0.1 about z with a tube of 0.02; a segment in the plane y = 0 from above to
+  // below, passing through the tube near its inner side. In that plane the tube's section is a
+  // circle about (0.1, 0, 0), and OpenSim's cylinder along the ring's tangent there is exact: the
+  // path is the two tangents to the circle and the arc between them on the side facing the
+  // torus's centre.
+  const Eigen::Vector3d centre(0.1, 0, 0);
+  const double tube = 0.02;
+  for (const double x : { 0.085, 0.09, 0.095 })
+  {
+    const Eigen::Vector3d p1(x, 0, 0.1), p2(x, 0, -0.12);
+    WrapResult result;
+    ASSERT_EQ(WrapTorusSegment(p1, p2, 0.1, tube, 0, 0, false, result), WrapAction::Mandatory) << x;
+    const auto tangentLength = [&](const Eigen::Vector3d& p) {
+      return std::sqrt((p - centre).squaredNorm() - tube * tube);
+    };
+    // The arc: the angle between the ends' directions from the centre (the short way, here
+    // through -x, the inner side), less each end's tangent angle.
+    const Eigen::Vector3d d1 = (p1 - centre).normalized(), d2 = (p2 - centre).normalized();
+    const double between = std::acos(d1.dot(d2));
+    const double arc = between - std::acos(tube / (p1 - centre).norm()) - std::acos(tube / (p2 - centre).norm());
+    const double expected = tangentLength(p1) + tube * arc + tangentLength(p2);
+    const double length = (result.r1 - p1).norm() + result.length + (p2 - result.r2).norm();
+    EXPECT_NEAR(length, expected, 1e-12) << x;
+    EXPECT_NEAR(result.length, tube * arc, 1e-12) << x;
+    // On the tube, on its inner side, in the plane.
+    const md::Points surface = SurfacePoints(result, 0.002);
+    for (Eigen::Index i = 0; i < surface.rows(); ++i)
+    {
+      EXPECT_NEAR((surface.row(i).transpose() - centre).norm(), tube, 1e-12);
+      EXPECT_LT(surface(i, 0), 0.1 + 1e-12);
+      EXPECT_NEAR(surface(i, 1), 0.0, 1e-12);
+    }
+  }
+  // A segment through the hole, clear of the tube, does not wrap.
+  WrapResult result;
+  EXPECT_EQ(
+    WrapTorusSegment(Eigen::Vector3d(0.02, 0, 0.1), Eigen::Vector3d(0.02, 0, -0.1), 0.1, tube, 0, 0, false, result),
+    WrapAction::NoWrap);
+}
