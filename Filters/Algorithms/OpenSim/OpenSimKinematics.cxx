@@ -150,34 +150,31 @@ PathGeometry PathAt(const Model& model, const Path& path, const std::vector<doub
     const Eigen::Vector3d onSegment = a + t * (b - a);
     points[i] = onSegment + weight[i] * (points[i] - onSegment);
   }
+  // The polyline: the path points as they are, each wrap by its surface points.
+  std::vector<Eigen::Vector3d> polyline;
   if (path.wraps.empty())
   {
-    geometry.points.resize(static_cast<Eigen::Index>(points.size()), 3);
-    for (size_t i = 0; i < points.size(); ++i)
-    {
-      geometry.points.row(static_cast<Eigen::Index>(i)) = points[i].transpose();
-    }
-    geometry.length = md::PolylineLength(geometry.points);
-    return geometry;
+    polyline = std::move(points);
   }
-  const std::vector<WrappedPoint> wrapped =
-    WrapPath(model, path, points, geometry.pointIndex, bodyPoses, kWrapPointSpacing, &geometry.length);
-  // The polyline: path points as they are, each wrap by its surface points.
-  std::vector<Eigen::Vector3d> polyline;
-  geometry.pointIndex.clear();
-  for (const WrappedPoint& p : wrapped)
+  else
   {
-    if (p.wrap < 0)
+    const std::vector<WrappedPoint> wrapped =
+      WrapPath(model, path, points, geometry.pointIndex, bodyPoses, kWrapPointSpacing, &geometry.length);
+    geometry.pointIndex.clear();
+    for (const WrappedPoint& p : wrapped)
     {
-      polyline.push_back(p.position);
-      geometry.pointIndex.push_back(p.pathPoint);
-    }
-    else if (p.leaves)
-    {
-      for (Eigen::Index k = 0; k < p.surface.rows(); ++k)
+      if (p.wrap < 0)
       {
-        polyline.push_back(p.surface.row(k).transpose());
-        geometry.pointIndex.push_back(-1 - p.wrap);
+        polyline.push_back(p.position);
+        geometry.pointIndex.push_back(p.pathPoint);
+      }
+      else if (p.leaves)
+      {
+        for (Eigen::Index k = 0; k < p.surface.rows(); ++k)
+        {
+          polyline.push_back(p.surface.row(k).transpose());
+          geometry.pointIndex.push_back(-1 - p.wrap);
+        }
       }
     }
   }
@@ -185,6 +182,10 @@ PathGeometry PathAt(const Model& model, const Path& path, const std::vector<doub
   for (size_t i = 0; i < polyline.size(); ++i)
   {
     geometry.points.row(static_cast<Eigen::Index>(i)) = polyline[i].transpose();
+  }
+  if (path.wraps.empty())
+  {
+    geometry.length = md::PolylineLength(geometry.points);
   }
   return geometry;
 }

@@ -775,16 +775,4 @@ std::vector<WrappedPoint> WrapPath(const Model& model, const Path& path, const s
   }
   return done();
 }
-
-double WrappedLength(const std::vector<WrappedPoint>& path)
-{
-  double length = 0.0;
-  for (size_t i = 1; i < path.size(); ++i)
-  {
-    const WrappedPoint& a = path[i - 1];
-    const WrappedPoint& b = path[i];
-    length += a.wrap >= 0 && a.wrap == b.wrap ? b.surfaceLength : (b.position - a.position).norm();
-  }
-  return length;
-}
 }

@@ -87,12 +87,9 @@ struct WrappedPoint
 /// `openSimLength` (optional): the path's length as OpenSim reports it. Where several wrap objects
 /// take more than one pass, OpenSim measures a wrap point's straight segments from where the
 /// first pass put it (a cached place it does not renew), so that its length differs from the
-/// path's own (WrappedLength) by up to millimetres; elsewhere the two are equal.
+/// returned path's own (straight between its points, over the surface between a wrap's two) by up
+/// to millimetres; elsewhere the two are equal.
 std::vector<WrappedPoint> WrapPath(const Model& model, const Path& path, const std::vector<Eigen::Vector3d>& points,
   const std::vector<int>& pathPoints, const std::vector<RigidTransform>& bodyPoses, double spacing,
   double* openSimLength = nullptr);
-
-/// The length of a wrapped path: straight between its points, over the surface between a wrap's
-/// two points.
-double WrappedLength(const std::vector<WrappedPoint>& path);
 }
