@@ -27,6 +27,9 @@ the lines move continuously. The LHDL muscles are attached to their bones by the
 at those landmarks over the motion (the muscle surface point next to each landmark against where
 the landmark's bone carries it), and the largest step of a muscle point between two frames
 against the median of those steps.
+With --paths-over-bones the LHDL paths are first kept out of the scanned bones (PathsOverBones,
+--path-points-per-segment points between each two of a path's own): no action line then runs
+through a bone; off by default (docs/DESIGN.md, "Paths over the bones", says what it costs).
 """
 import argparse
 import csv
@@ -74,8 +77,18 @@ def lhdl_pipeline(data, motion_name):
                             "LHDL muscles")
     moved = simple.MoveWithBodies(registrationName="LHDL bones (motion)", Input=bones,
                                   BodyTransforms=simple.OutputPort(reader, 4), BodyOfSurface=lhdl.BODY_OF_SURFACE)
+    paths_rest, paths_now = simple.OutputPort(reader, 3), simple.OutputPort(reader, 1)
+    if PATHS_OVER_BONES[0]:
+        # The paths kept out of the bones (at rest over the rest pose's bones, in the motion over
+        # the moved ones): no action line then runs through a bone.
+        paths_rest = simple.PathsOverBones(registrationName="LHDL paths over the bones (rest pose)",
+                                           Input=paths_rest, Bones=bones,
+                                           PointsPerSegment=PATHS_OVER_BONES[1])
+        paths_now = simple.PathsOverBones(registrationName="LHDL paths over the bones (motion)",
+                                          Input=paths_now, Bones=moved,
+                                          PointsPerSegment=PATHS_OVER_BONES[1])
     lines = simple.ActionLineGrouping(registrationName="LHDL action lines", Input=muscles,
-                                      Paths=simple.OutputPort(reader, 3), PathsCurrent=simple.OutputPort(reader, 1))
+                                      Paths=paths_rest, PathsCurrent=paths_now)
     motion = simple.MotionMuscleDeformation(registrationName="LHDL " + motion_name, Input=muscles, BonesRest=bones,
                                             BonesMotion=moved, ActionLinesRest=simple.OutputPort(lines, 0),
                                             ActionLinesMotion=simple.OutputPort(lines, 1),
@@ -89,6 +102,7 @@ LANDMARKS = "attachment_areas_rp_mm.csv"
 READERS = {}  # motion name: the model reader playing it (its MomentArms table)
 CONDITIONAL_POINT_FADE = 10.0  # degrees
 MOMENT_ARM_STEP = [1.0]  # degrees (--moment-arm-step)
+PATHS_OVER_BONES = [False, 15]  # --paths-over-bones, --path-points-per-segment
 # The data set's names for the muscles and the bones its landmarks lie on (the iliotibial tract's,
 # on the tibia, is on no bone of the scan and left out).
 LANDMARK_MUSCLES = {"R_Glut_Max": "gluteus_maximus_r", "R_Glut_Med": "gluteus_medius_r", "R_Iliacus": "iliacus_r",
@@ -499,8 +513,13 @@ def main(argv=None):
     parser.add_argument("--moment-arm-step", type=float, default=MOMENT_ARM_STEP[0],
                         help="degrees: the LHDL fibres' moment arms from each frame stepped by +- this much in "
                              "its coordinate (OpenSimModelReader's MomentArmStep); 0: from differences between frames")
+    parser.add_argument("--paths-over-bones", action="store_true",
+                        help="the LHDL paths kept out of the bones (PathsOverBones) before they become action lines")
+    parser.add_argument("--path-points-per-segment", type=int, default=PATHS_OVER_BONES[1],
+                        help="with --paths-over-bones: PathsOverBones' PointsPerSegment")
     args = parser.parse_args(argv)
     MOMENT_ARM_STEP[0] = args.moment_arm_step
+    PATHS_OVER_BONES[:] = [args.paths_over_bones, args.path_points_per_segment]
     mdexamples.load_plugin(explicit=args.plugin)
     results = []
     if args.case in ("all", "phantom"):

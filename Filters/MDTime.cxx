@@ -14,6 +14,15 @@
 
 namespace mdvtk
 {
+std::vector<double> TimesOf(vtkInformation* info)
+{
+  if (!info || !info->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS()))
+  {
+    return {};
+  }
+  const double* values = info->Get(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+  return std::vector<double>(values, values + info->Length(vtkStreamingDemandDrivenPipeline::TIME_STEPS()));
+}
 
 std::vector<double> StepTimes(int steps)
 {

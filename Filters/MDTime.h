@@ -12,6 +12,8 @@ class vtkInformationVector;
 
 namespace mdvtk
 {
+/// The time steps (TIME_STEPS) `info` advertises; none for none or a null `info`.
+std::vector<double> TimesOf(vtkInformation* info);
 /// Advertises the time steps and range of `from` (an input's information) on `to` (an output's),
 /// or none when `from` has none.
 void CopyTimeSteps(vtkInformation* from, vtkInformation* to);

@@ -70,15 +70,6 @@ struct vtkMotionMuscleDeformation::Signature
 namespace
 {
 /// The time steps advertised on an input (none: empty).
-std::vector<double> TimesOf(vtkInformation* info)
-{
-  if (!info || !info->Has(SDDP::TIME_STEPS()))
-  {
-    return {};
-  }
-  const double* values = info->Get(SDDP::TIME_STEPS());
-  return std::vector<double>(values, values + info->Length(SDDP::TIME_STEPS()));
-}
 
 double Bytes(const md::Points& p)
 {
@@ -397,8 +388,8 @@ int vtkMotionMuscleDeformation::RequestDataObject(
 int vtkMotionMuscleDeformation::RequestInformation(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  const std::vector<double> bones = TimesOf(inputVector[2]->GetInformationObject(0));
-  const std::vector<double> lines = TimesOf(inputVector[4]->GetInformationObject(0));
+  const std::vector<double> bones = mdvtk::TimesOf(inputVector[2]->GetInformationObject(0));
+  const std::vector<double> lines = mdvtk::TimesOf(inputVector[4]->GetInformationObject(0));
   mdvtk::AdvertiseTimes(outputVector, {});
   if (bones.empty() || lines.empty())
   {
@@ -446,7 +437,7 @@ int vtkMotionMuscleDeformation::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   Internals& in = *this->In;
-  const std::vector<double> times = TimesOf(inputVector[2]->GetInformationObject(0));
+  const std::vector<double> times = mdvtk::TimesOf(inputVector[2]->GetInformationObject(0));
   if (!in.looping && !times.empty())
   {
     mdvtk::ClearOutputs(outputVector);
@@ -598,7 +589,7 @@ vtkMotionMuscleDeformation::Signature vtkMotionMuscleDeformation::SignatureOf(
       signature.motionPipeline = std::max(signature.motionPipeline, executive->GetPipelineMTime());
     }
   }
-  signature.times = TimesOf(inputVector[2]->GetInformationObject(0));
+  signature.times = mdvtk::TimesOf(inputVector[2]->GetInformationObject(0));
   signature.numberOfSteps = this->NumberOfSteps;
   signature.maximumStepDisplacement = this->MaximumStepDisplacement;
   signature.interpolationMode = this->BoneInterpolationMode;

@@ -15,6 +15,7 @@
 #include "vtkMuscleDeformation.h"
 #include "vtkMusculoskeletalPhantom.h"
 #include "vtkOpenSimModelReader.h"
+#include "vtkPathsOverBones.h"
 
 #include <vtkSmartPointer.h>
 #include <vtkType.h>
@@ -53,6 +54,7 @@ const std::map<std::string, std::function<vtkSmartPointer<vtkObject>()>> Classes
   { "vtkMuscleDeformation", Make<vtkMuscleDeformation> },
   { "vtkMusculoskeletalPhantom", Make<vtkMusculoskeletalPhantom> },
   { "vtkOpenSimModelReader", Make<vtkOpenSimModelReader> },
+  { "vtkPathsOverBones", Make<vtkPathsOverBones> },
 };
 
 std::map<std::string, std::string> Attributes(const std::string& tag)

@@ -9,7 +9,7 @@ of the wrong kind, point arrays of the wrong length or width, blocks that are no
 duplicate block names, huge or tiny coordinates, a malformed OpenSim model or motion, a body mesh
 file of random bytes, of counts it does not hold or of a cell beyond its points, a model nested deep
 or of huge numbers, a body-transform table of NaN, scalings, reflections or missing columns, the
-phantom's properties at their extremes) and runs the filter: each of the eleven proxies. A filter may refuse the input with a message or compute a result; it must not crash,
+phantom's properties at their extremes) and runs the filter: each of the twelve proxies. A filter may refuse the input with a message or compute a result; it must not crash,
 and a result must not hold non-finite coordinates. Before each case the script prints
 "case K: <what>" so that a crash names the case; at the end it prints "fuzz: N cases, R refused,
 A accepted". Exit code 0 when every case ended cleanly.
@@ -251,6 +251,7 @@ FILTERS = [
      {"NumberOfSteps": 1, "HullTargetNumberOfPoints": 40, "MaximumNumberOfIterations": 10}),
     ("ActionLineGrouping", [("Input", "muscles", False), ("Paths", "lines_rest", False)], {}),
     ("MoveWithBodies", [("Input", "bones_rest", False), ("BodyTransforms", "transforms", False)], {}),
+    ("PathsOverBones", [("Input", "lines_current", False), ("Bones", "bones_current", False)], {}),
     # The bones and the lines of the motion: BoneInterpolation from the rest to the current pose.
     ("MotionMuscleDeformation", [("Input", "muscles", False), ("BonesRest", "bones_rest", False),
                                  ("BonesMotion", ("bones_rest", "bones_current"), False),

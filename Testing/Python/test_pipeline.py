@@ -23,7 +23,7 @@ class ServerManagerXML(unittest.TestCase):
         proxies = []
         for file_name in sorted(os.listdir(folder)):
             proxies += ElementTree.parse(os.path.join(folder, file_name)).getroot().findall("./ProxyGroup/SourceProxy")
-        self.assertEqual(len(proxies), 11)
+        self.assertEqual(len(proxies), 12)
         for proxy in proxies:
             name = proxy.get("name")
             self.assertTrue((proxy.findtext("Documentation") or "").strip(), name)
