@@ -62,6 +62,30 @@ def lhdl_data_dir(explicit=None, what=None):
     return data
 
 
+def named_leaves(data):
+    """The leaves of a multiblock by block name."""
+    from vtkmodules.vtkCommonDataModel import vtkCompositeDataSet
+    result, iterator = {}, data.NewIterator()
+    iterator.InitTraversal()
+    while not iterator.IsDoneWithTraversal():
+        result[iterator.GetCurrentMetaData().Get(vtkCompositeDataSet.NAME())] = iterator.GetCurrentDataObject()
+        iterator.GoToNextItem()
+    return result
+
+
+def inside(points, surface):
+    """Which points of the dataset `points` lie inside the closed `surface`, by VTK's own test
+    (vtkSelectEnclosedPoints), apart from the plugin's: a boolean numpy array."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkFiltersModeling import vtkSelectEnclosedPoints
+    select = vtkSelectEnclosedPoints()
+    select.SetInputData(points)
+    select.SetSurfaceData(surface)
+    select.SetTolerance(1e-9)
+    select.Update()
+    return vtk_to_numpy(select.GetOutput().GetPointData().GetArray("SelectedPoints")).astype(bool)
+
+
 def make_view(size=(900, 900)):
     """A render view with a white background and no orientation axes."""
     view = simple.CreateView("RenderView")

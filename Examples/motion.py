@@ -112,15 +112,8 @@ LANDMARK_BONES = {"pelvis": "iliac_r", "femur_r": "femur_r"}
 
 def leaf_points(data):
     """{block name: its points as a numpy array} of a multiblock."""
-    from vtkmodules.vtkCommonDataModel import vtkCompositeDataSet
-    result = {}
-    iterator = data.NewIterator()
-    iterator.InitTraversal()
-    while not iterator.IsDoneWithTraversal():
-        name = iterator.GetCurrentMetaData().Get(vtkCompositeDataSet.NAME())
-        result[name] = vtk_to_numpy(iterator.GetCurrentDataObject().GetPoints().GetData()).astype(float)
-        iterator.GoToNextItem()
-    return result
+    return {name: vtk_to_numpy(leaf.GetPoints().GetData()).astype(float)
+            for name, leaf in mdexamples.named_leaves(data).items()}
 
 
 def rigid_fit(rest, now):
@@ -354,25 +347,7 @@ def fibre_length_figures(table):
 def fibre_check(fibres, muscles, bones):
     """Fibre points outside their muscle and inside a bone at one frame, by VTK's own test
     (vtkSelectEnclosedPoints), apart from the plugin's."""
-    from vtkmodules.vtkCommonDataModel import vtkCompositeDataSet
-    from vtkmodules.vtkFiltersModeling import vtkSelectEnclosedPoints
-
-    def leaves(data):
-        result, iterator = {}, data.NewIterator()
-        iterator.InitTraversal()
-        while not iterator.IsDoneWithTraversal():
-            result[iterator.GetCurrentMetaData().Get(vtkCompositeDataSet.NAME())] = iterator.GetCurrentDataObject()
-            iterator.GoToNextItem()
-        return result
-
-    def inside(points, surface):
-        select = vtkSelectEnclosedPoints()
-        select.SetInputData(points)
-        select.SetSurfaceData(surface)
-        select.SetTolerance(1e-9)
-        select.Update()
-        return vtk_to_numpy(select.GetOutput().GetPointData().GetArray("SelectedPoints")).astype(bool)
-
+    leaves, inside = mdexamples.named_leaves, mdexamples.inside
     outside, in_bone = {}, {}
     muscle_leaves, bone_leaves = leaves(muscles), leaves(bones)
     for name, polylines in leaves(fibres).items():

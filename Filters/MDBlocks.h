@@ -150,6 +150,14 @@ inline std::string PointsAt(const std::string& pose)
 {
   return "PointsAt(" + pose + ")";
 }
+/// The pose of a point array named PointsAt(<pose>) (PointsAt's inverse); empty for another name.
+inline std::string PoseOfPointsAt(const std::string& name)
+{
+  const std::string opening = "PointsAt(";
+  const bool named =
+    name.size() > opening.size() + 1 && name.compare(0, opening.size(), opening) == 0 && name.back() == ')';
+  return named ? name.substr(opening.size(), name.size() - opening.size() - 1) : std::string();
+}
 
 /// Writes `role` as the cell array Role of every polydata leaf of `data` (in leaf order: muscle
 /// k gets shade k modulo MuscleShades), the active cell scalars unless the leaf has other active

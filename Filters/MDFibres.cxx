@@ -76,17 +76,14 @@ std::vector<std::pair<std::string, SteppedLengths>> SteppedPosesOf(
   {
     return poses;
   }
-  const std::string prefix = PointsAt("");
-  const std::string opening = prefix.substr(0, prefix.size() - 1); // "PointsAt("
   vtkPointData* data = bone->GetPointData();
   for (int a = 0; a < data->GetNumberOfArrays(); ++a)
   {
-    const std::string name = data->GetArrayName(a) ? data->GetArrayName(a) : "";
-    if (name.size() < opening.size() + 3 || name.compare(0, opening.size(), opening) != 0 || name.back() != ')')
+    const std::string pose = PoseOfPointsAt(data->GetArrayName(a) ? data->GetArrayName(a) : "");
+    if (pose.size() < 2)
     {
-      continue;
+      continue; // not a stepped pose: "<coordinate>+" or "<coordinate>-"
     }
-    const std::string pose = name.substr(opening.size(), name.size() - opening.size() - 1);
     const char sign = pose.back();
     if (sign != '+' && sign != '-')
     {

@@ -66,29 +66,17 @@ std::vector<std::vector<vtkIdType>> PolylineIds(vtkPolyData* data)
   return polylines;
 }
 
-md::Points Gather(const md::Points& all, const std::vector<vtkIdType>& ids)
-{
-  md::Points points(static_cast<Eigen::Index>(ids.size()), 3);
-  for (size_t k = 0; k < ids.size(); ++k)
-  {
-    points.row(static_cast<Eigen::Index>(k)) = all.row(ids[k]);
-  }
-  return points;
-}
-
 /// The names of the stepped poses `data` carries (point arrays PointsAt(<pose>)).
 std::vector<std::string> SteppedPoses(vtkPolyData* data)
 {
   std::vector<std::string> poses;
-  const std::string prefix = mdvtk::PointsAt(""), suffix = ")";
   vtkPointData* pd = data ? data->GetPointData() : nullptr;
   for (int a = 0; pd && a < pd->GetNumberOfArrays(); ++a)
   {
-    const char* name = pd->GetArrayName(a);
-    const std::string n = name ? name : "";
-    if (n.size() > prefix.size() && n.compare(0, prefix.size() - 1, prefix, 0, prefix.size() - 1) == 0)
+    const std::string pose = mdvtk::PoseOfPointsAt(pd->GetArrayName(a) ? pd->GetArrayName(a) : "");
+    if (!pose.empty())
     {
-      poses.push_back(n.substr(prefix.size() - 1, n.size() - prefix.size()));
+      poses.push_back(pose);
     }
   }
   return poses;
@@ -108,8 +96,7 @@ struct vtkPathsOverBones::Internals
   int asked = -1;  ///< the frame the inputs were last asked for
   bool looping = false;
 
-  // The bones as last read: names, bodies, and trees moved to the pose being computed.
-  std::vector<std::string> boneNames, boneBodies;
+  // The bones as last read, and their trees moved to the pose being computed.
   std::vector<md::TriangleMesh> boneMeshes;
   std::vector<std::unique_ptr<md::TriangleTree>> trees;
   std::vector<std::unique_ptr<md::TriangleTree>> steppedTrees; ///< moved to a stepped pose in turn
@@ -206,8 +193,7 @@ int vtkPathsOverBones::RequestData(
   }
   // The bones: each a closed surface; its trees moved to the pose when only its points changed.
   const bool sameBones = bones.size() == in.boneMeshes.size();
-  in.boneNames.clear();
-  in.boneBodies.clear();
+  std::vector<std::string> boneNames, boneBodies; // what the points on each bone are named
   in.boneMeshes.resize(bones.size());
   if (!sameBones)
   {
@@ -222,9 +208,9 @@ int vtkPathsOverBones::RequestData(
       vtkErrorMacro(<< bones[b].label << " has no triangles: the bones must be closed surfaces");
       return stop(0);
     }
-    in.boneNames.push_back(mdvtk::NameOf(bones[b]));
+    boneNames.push_back(mdvtk::NameOf(bones[b]));
     auto* body = vtkStringArray::SafeDownCast(bones[b].data->GetFieldData()->GetAbstractArray(mdvtk::array::Body));
-    in.boneBodies.push_back(body && body->GetNumberOfValues() > 0 ? body->GetValue(0) : std::string());
+    boneBodies.push_back(body && body->GetNumberOfValues() > 0 ? body->GetValue(0) : std::string());
     if (!in.trees[b] || in.boneMeshes[b].triangles.rows() != mesh.triangles.rows() ||
       in.boneMeshes[b].points.rows() != mesh.points.rows() || in.boneMeshes[b].triangles != mesh.triangles)
     {
@@ -285,12 +271,12 @@ int vtkPathsOverBones::RequestData(
       {
         continue; // no path in this block
       }
-      const md::Points all = mdvtk::ToPoints(paths[p].data->GetPoints());
-      for (size_t l = 0; l < leaves[p].polylines.size(); ++l)
+      const std::vector<md::Points> polylines = mdvtk::ToPolylines(paths[p].data);
+      for (size_t l = 0; l < polylines.size(); ++l)
       {
         const bool before = last && last->paths.size() == paths.size() && last->paths[p].size() > l;
         const md::Points* start = before ? &last->paths[p][l].points : nullptr;
-        answer.paths[p].push_back(md::PathOverBones(Gather(all, leaves[p].polylines[l]), trees, parameters, start));
+        answer.paths[p].push_back(md::PathOverBones(polylines[l], trees, parameters, start));
       }
     }
     // The stepped poses the paths and the bones carry, each from the frame's answer.
@@ -339,12 +325,12 @@ int vtkPathsOverBones::RequestData(
         {
           continue;
         }
-        const md::Points all = mdvtk::ToPoints(paths[p].data->GetPointData()->GetArray(name.c_str()));
-        for (size_t l = 0; l < leaves[p].polylines.size(); ++l)
+        const md::Points values = mdvtk::ToPoints(paths[p].data->GetPointData()->GetArray(name.c_str()));
+        const std::vector<md::Points> polylines = mdvtk::ToPolylines(paths[p].data, &values);
+        for (size_t l = 0; l < polylines.size(); ++l)
         {
           stepped[p].push_back(
-            md::PathOverBones(Gather(all, leaves[p].polylines[l]), steppedTrees, parameters, &answer.paths[p][l].points)
-              .points);
+            md::PathOverBones(polylines[l], steppedTrees, parameters, &answer.paths[p][l].points).points);
         }
       }
     }
@@ -462,8 +448,8 @@ int vtkPathsOverBones::RequestData(
           const int b = boneOf[i];
           copy->InsertNextValue(from[i] >= 0 ? strings->GetValue(from[i])
               : b < 0                        ? std::string()
-              : body                         ? in.boneBodies[static_cast<size_t>(b)]
-                                             : in.boneNames[static_cast<size_t>(b)]);
+              : body                         ? boneBodies[static_cast<size_t>(b)]
+                                             : boneNames[static_cast<size_t>(b)]);
         }
         out->GetPointData()->AddArray(copy);
       }

@@ -45,6 +45,14 @@ def points(data):
     return vtk_to_numpy(data.GetPoints().GetData()).astype(numpy.float64)
 
 
+def field(data, name):
+    """The value of a one-value field-data array of `data`."""
+    array = data.GetFieldData().GetArray(name)
+    if array is None:
+        raise KeyError(name)
+    return array.GetValue(0)
+
+
 def block(data, name):
     """The block of a multiblock named `name`."""
     for index in range(data.GetNumberOfBlocks()):

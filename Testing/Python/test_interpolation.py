@@ -16,11 +16,7 @@ points = mdtesting.points
 block = mdtesting.block
 
 
-def field(data, name):
-    array = data.GetFieldData().GetArray(name)
-    if array is None:
-        raise KeyError(name)
-    return array.GetValue(0)
+field = mdtesting.field
 
 
 class Interpolation(unittest.TestCase):

@@ -78,8 +78,7 @@ def output(proxy, port=0):
     return proxy.GetClientSideObject().GetOutputDataObject(port)
 
 
-def field(data, name):
-    return data.GetFieldData().GetArray(name).GetValue(0)
+field = mdtesting.field
 
 
 def small_model_folder():

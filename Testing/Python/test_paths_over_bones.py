@@ -12,7 +12,6 @@ import mdexamples
 import numpy
 from paraview import servermanager, simple
 from vtkmodules.vtkCommonDataModel import vtkPolyData
-from vtkmodules.vtkFiltersModeling import vtkSelectEnclosedPoints
 
 mdtesting.load_plugin()
 DATA = mdexamples.data_dir()
@@ -20,28 +19,19 @@ BONES = ("iliac_r", "sacrum", "femur_r")
 PER = 16  # PointsPerSegment + 1
 
 
-def leaves(data):
-    return {data.GetMetaData(i).Get(data.NAME()): data.GetBlock(i) for i in range(data.GetNumberOfBlocks())}
-
-
-def field(data, name):
-    return data.GetFieldData().GetArray(name).GetValue(0)
+leaves = mdexamples.named_leaves
+field = mdtesting.field
 
 
 def inside(points, surface):
     """Which of `points` (n x 3) lie inside the closed `surface`."""
-    cloud = vtkPolyData()
     from vtkmodules.util.numpy_support import numpy_to_vtk
     from vtkmodules.vtkCommonCore import vtkPoints
     vtk_points = vtkPoints()
     vtk_points.SetData(numpy_to_vtk(numpy.ascontiguousarray(points), deep=True))
+    cloud = vtkPolyData()
     cloud.SetPoints(vtk_points)
-    select = vtkSelectEnclosedPoints()
-    select.SetInputData(cloud)
-    select.SetSurfaceData(surface)
-    select.SetTolerance(1e-9)
-    select.Update()
-    return numpy.array([select.IsInside(i) for i in range(len(points))], dtype=bool)
+    return mdexamples.inside(cloud, surface)
 
 
 def polyline_length(points):

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Motion/PathOverBones.h"
 
+#include "Geometry/Polyline.h"
+
 #include <Eigen/Cholesky>
 #include <Eigen/SVD>
 
@@ -449,16 +451,6 @@ void CheckPath(const Points& fixed, const PathOverBonesParameters& parameters)
     throw InputError("a path over the bones needs at least one point per segment; asked " +
       std::to_string(parameters.pointsPerSegment));
   }
-}
-
-double PolylineLength(const Points& points)
-{
-  double length = 0;
-  for (Eigen::Index i = 1; i < points.rows(); ++i)
-  {
-    length += (points.row(i) - points.row(i - 1)).norm();
-  }
-  return length;
 }
 }
 
