@@ -406,25 +406,6 @@ void vtkOpenSimModelReader::LoadModel(const std::string& fileName, std::vector<s
   {
     in.wraps.push_back(osim::WrapSurface(w));
   }
-  std::string unwrapped;
-  for (const osim::Path& p : in.model.paths)
-  {
-    for (const osim::PathWrap& w : p.wraps)
-    {
-      const osim::WrapShape shape = in.model.wrapObjects[static_cast<size_t>(w.wrapObject)].shape;
-      if (shape == osim::WrapShape::Ellipsoid)
-      {
-        unwrapped += (unwrapped.empty() ? "" : ", ") + p.name + " over " + w.name;
-        break;
-      }
-    }
-  }
-  if (!unwrapped.empty())
-  {
-    warnings.push_back("paths over wrap ellipsoids are not wrapped yet (over cylinders, spheres and tori "
-                       "they are): these paths pass through the ellipsoids: " +
-      unwrapped);
-  }
   in.modelKey = modelKey;
   in.haveModel = true;
 }

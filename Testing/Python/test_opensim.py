@@ -277,6 +277,41 @@ class SmallModel(unittest.TestCase):
         self.assertEqual(grouped_tension(), 2.0)
         simple.Delete(grouping)
 
+    def test_a_path_over_a_wrap_ellipsoid(self):
+        """opensim-core's ellipsoid length case read as a user would: a path along y = r over a
+        quarter of the ellipsoid's section (radii 1, 0.5, 1) and down x = -1 has the tangents' and
+        the quarter ellipse's length, draws its points over the ellipsoid on it, named after it, and
+        the reader warns of nothing."""
+        a, r = 1.0, 0.5
+        text = """<?xml version="1.0"?>
+<OpenSimDocument Version="40000"><Model name="ellipse"><Ground name="ground">
+  <WrapObjectSet><objects><WrapEllipsoid name="pulley1"><dimensions>1 0.5 1</dimensions></WrapEllipsoid></objects></WrapObjectSet>
+ </Ground>
+ <ForceSet><objects><PathSpring name="spring1"><GeometryPath name="path"><PathPointSet><objects>
+  <PathPoint name="origin"><socket_parent_frame>/ground</socket_parent_frame><location>0.4 0.5 0</location></PathPoint>
+  <PathPoint name="insert"><socket_parent_frame>/ground</socket_parent_frame><location>-1 -0.5 0</location></PathPoint>
+ </objects></PathPointSet>
+ <PathWrapSet><objects><PathWrap name="w"><wrap_object>pulley1</wrap_object></PathWrap></objects></PathWrapSet>
+ </GeometryPath></PathSpring></objects></ForceSet>
+</Model></OpenSimDocument>"""
+        with mdtesting.CapturedMessages() as messages:
+            reader = simple.OpenSimModelReader(FileName=write(self.folder, "ellipse.osim", text), Scale=1000)
+            reader.UpdatePipeline()
+        self.assertNotIn("WARN", messages.text)
+        self.assertNotIn("ERR", messages.text)
+        path = block(output(reader, 1), "spring1")
+        t = numpy.linspace(0.0, 0.5 * math.pi, 20001)
+        speed = numpy.hypot(a * numpy.cos(t), r * numpy.sin(t))
+        quarter = (t[1] - t[0]) / 3 * (speed[0] + speed[-1] + 4 * speed[1:-1:2].sum() + 2 * speed[2:-1:2].sum())
+        self.assertAlmostEqual(field(path, "PathLength"), 1000 * (2 * r - 0.1 + quarter), delta=1e-6)
+        names = path.GetPointData().GetAbstractArray("PathPointName")
+        on = [names.GetValue(i) == "pulley1" for i in range(path.GetNumberOfPoints())]
+        over = points(path)[numpy.array(on)] / 1000
+        self.assertGreater(len(over), 10)
+        numpy.testing.assert_allclose((over[:, 0] / a) ** 2 + (over[:, 1] / r) ** 2, 1.0, atol=1e-9)
+        numpy.testing.assert_allclose(over[:, 2], 0.0, atol=1e-12)
+        simple.Delete(reader)
+
     def test_bad_input_is_named(self):
         for text, expected in (
                 (SMALL_MODEL.replace("</Model>", ""), "malformed XML"),

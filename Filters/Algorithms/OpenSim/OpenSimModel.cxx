@@ -4,6 +4,7 @@
 #include <pugixml.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -1135,7 +1136,30 @@ private:
       }
       if (Node method = wrap.child("method"))
       {
-        w.method = FirstWord(method.text().get());
+        // As OpenSim: the three names in lower case, capitalised or upper case; "Unassigned" is
+        // the default.
+        const std::string name = FirstWord(method.text().get());
+        const auto is = [&](const std::string& lower) {
+          std::string capital = lower, upper = lower;
+          const auto toUpper = [](char c) {
+            return static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+          };
+          capital[0] = toUpper(capital[0]);
+          std::transform(upper.begin(), upper.end(), upper.begin(), toUpper);
+          return name == lower || name == capital || name == upper;
+        };
+        if (is("midpoint"))
+        {
+          w.method = EllipsoidWrapMethod::Midpoint;
+        }
+        else if (is("axial"))
+        {
+          w.method = EllipsoidWrapMethod::Axial;
+        }
+        else if (!is("hybrid") && name != "Unassigned")
+        {
+          this->reader.Fail(wrap, "wrapping method '" + name + "' is not one of hybrid, midpoint or axial");
+        }
       }
       path.wraps.push_back(w);
     }

@@ -102,6 +102,16 @@ struct WrapObject
   int quadrantSign = 0;
 };
 
+/// How a path finds the plane it wraps an ellipsoid in (OpenSim's PathWrap `method`): from the
+/// coordinate axis most nearly along the path, from the ellipsoid's points nearest the straight
+/// segment, or a blend of the two (hybrid, OpenSim's default); from the segment's midpoint.
+enum class EllipsoidWrapMethod
+{
+  Hybrid,
+  Midpoint,
+  Axial
+};
+
 /// A path's use of a wrap object (OpenSim's PathWrap).
 struct PathWrap
 {
@@ -110,7 +120,7 @@ struct PathWrap
   /// The path points (1-based, as OpenSim's `range`) between which the path may wrap; below 1:
   /// the first (last) point.
   int rangeStart = -1, rangeEnd = -1;
-  std::string method = "hybrid"; ///< how an ellipsoid is wrapped (hybrid, midpoint, axial)
+  EllipsoidWrapMethod method = EllipsoidWrapMethod::Hybrid; ///< how an ellipsoid is wrapped
 };
 
 enum class PathPointKind

@@ -195,16 +195,27 @@ void SpiralPath(const Vector& p1, const Vector& p2, double radius, bool longWrap
 }
 }
 
+Vector SurfacePointAt(const WrapResult& wrap, double t)
+{
+  const Vector turned = Eigen::AngleAxisd(t * wrap.turn, wrap.axis) * (wrap.r1 - wrap.centre);
+  if (wrap.radii.isZero())
+  {
+    return wrap.centre + turned + t * wrap.rise * wrap.axis;
+  }
+  // Along the turned direction from the centre to the ellipsoid: the quadratic's positive root.
+  const Vector f1 = turned.cwiseQuotient(wrap.radii), f2 = wrap.centre.cwiseQuotient(wrap.radii);
+  const double a = f1.squaredNorm(), b = 2.0 * f1.dot(f2), c = f2.squaredNorm() - 1.0;
+  const double along = (-b + std::sqrt(std::max(0.0, b * b - 4.0 * a * c))) / (2.0 * a);
+  return wrap.centre + along * turned;
+}
+
 Points SurfacePoints(const WrapResult& wrap, double spacing)
 {
   const int drawn = std::max(1, static_cast<int>(std::ceil(wrap.length / spacing)));
   Points surface(drawn + 1, 3);
   for (int i = 0; i <= drawn; ++i)
   {
-    const double t = static_cast<double>(i) / drawn;
-    surface.row(i) =
-      (wrap.centre + Eigen::AngleAxisd(t * wrap.turn, wrap.axis) * (wrap.r1 - wrap.centre) + t * wrap.rise * wrap.axis)
-        .transpose();
+    surface.row(i) = SurfacePointAt(wrap, static_cast<double>(i) / drawn).transpose();
   }
   surface.row(drawn) = wrap.r2.transpose(); // exactly where the path leaves the surface
   return surface;
@@ -678,8 +689,10 @@ bool ApplyWrap(const Model& model, const Path& path, int w, const std::vector<Ri
         last = WrapTorusSegment(p1, p2, object.dimensions[0], object.dimensions[1], object.quadrantAxis,
           object.quadrantSign, !single, result);
         break;
-      default:
-        last = WrapAction::NoWrap; // not wrapped yet: the reader says so
+      case WrapShape::Ellipsoid:
+        last = WrapEllipsoidSegment(p1, p2, Vector(object.dimensions[0], object.dimensions[1], object.dimensions[2]),
+          object.quadrantAxis, object.quadrantSign, wrap.method, result);
+        break;
     }
     if (last == WrapAction::Mandatory)
     {

@@ -3,8 +3,8 @@
 // path tried in turn on every segment of its range, the one that lengthens the path least (or
 // the first the straight path cuts through) kept, and several wrap objects iterated until the
 // length settles (opensim-core's GeometryPath::applyWrapObjects, WrapCylinder::wrapLine and
-// WrapSphere::wrapLine and WrapTorus::wrapLine, whose algorithms this follows; the code is
-// ours). Cylinders, spheres and tori; not ellipsoids yet.
+// WrapSphere::wrapLine, WrapTorus::wrapLine and WrapEllipsoid::wrapLine, whose algorithms this
+// follows; the code is ours).
 #pragma once
 
 #include "OpenSim/OpenSimModel.h"
@@ -34,6 +34,9 @@ struct WrapResult
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d centre = Eigen::Vector3d::Zero(); ///< a point on the axis
   double turn = 0.0, rise = 0.0;
+  /// On an ellipsoid (centred at the origin) its radii, else zero: the turned point is then
+  /// carried from `centre` along its direction onto the ellipsoid (a planar section's arc).
+  Eigen::Vector3d radii = Eigen::Vector3d::Zero();
 };
 
 /// The segment p1-p2 (in the cylinder's frame: its axis z, centred at the origin) over a
@@ -65,6 +68,25 @@ WrapAction WrapSphereSegment(const Eigen::Vector3d& p1, const Eigen::Vector3d& p
 /// wrap.
 WrapAction WrapTorusSegment(const Eigen::Vector3d& p1, const Eigen::Vector3d& p2, double ringRadius, double tubeRadius,
   int quadrantAxis, int quadrantSign, bool adjustTangents, WrapResult& result);
+
+/// The segment p1-p2 (in the ellipsoid's frame: centred at the origin, its axes along x, y, z)
+/// over an ellipsoid of `radii`, on the side `quadrantSign` of axis `quadrantAxis` (sign 0: all
+/// of it), as OpenSim computes it: only a straight segment that cuts the ellipsoid wraps; the
+/// wrap's plane holds p1, p2 and a point c1 of the ellipsoid found by `method` (and moved to the
+/// quadrant's side); the tangent points are where the lines from p1 and p2 in that plane touch
+/// the ellipsoid, on c1's side of the segment; the path between them is the plane's section,
+/// the far way round where the quadrant asks. Two differences, both below OpenSim's own
+/// accuracy: OpenSim finds the tangent points by a Levenberg-Marquardt search from c1 (to its
+/// residual 1e-4); here they are exact (the ellipsoid's points on the polar plane of p1, or p2,
+/// and in the wrap's plane). OpenSim's length is that of a polyline over the section, its points
+/// about 1 mm apart (at most 500), shorter than the arc by up to micrometres on a muscle's
+/// ellipsoid and stepping when its count changes; here it is the arc's, so that a moment arm by
+/// difference of lengths does not step.
+WrapAction WrapEllipsoidSegment(const Eigen::Vector3d& p1, const Eigen::Vector3d& p2, const Eigen::Vector3d& radii,
+  int quadrantAxis, int quadrantSign, EllipsoidWrapMethod method, WrapResult& result);
+
+/// The point of the surface path at `t` (0 at r1, 1 at r2).
+Eigen::Vector3d SurfacePointAt(const WrapResult& wrap, double t);
 
 /// Points on the surface path from r1 to r2 (both included), at most `spacing` apart.
 Points SurfacePoints(const WrapResult& wrap, double spacing);

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <map>
+#include <random>
 
 using namespace md::osim;
 
@@ -20,13 +21,24 @@ struct LengthComparison
   std::map<std::string, std::vector<double>> difference; ///< ours - OpenSim's, per frame
 };
 
+/// `noise` > 0: every coordinate of every frame moved by up to that much (uniform, seeded by
+/// `seed`), as input noise.
 LengthComparison CompareLengths(const std::string& folder, const std::string& modelFile, const std::string& motionFile,
-  const std::string& lengthsFile)
+  const std::string& lengthsFile, double noise = 0.0, unsigned seed = 0)
 {
   const Model model = ReadModel(folder + "/" + modelFile);
   MotionOptions options;
   options.ignoreUnknownColumns = true;
-  const CoordinateTrajectory trajectory = MapMotion(model, ReadMotion(folder + "/" + motionFile), options);
+  CoordinateTrajectory trajectory = MapMotion(model, ReadMotion(folder + "/" + motionFile), options);
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> jitter(-noise, noise);
+  for (std::vector<double>& frame : trajectory.frames)
+  {
+    for (double& q : frame)
+    {
+      q += noise > 0.0 ? jitter(random) : 0.0;
+    }
+  }
   const MotionTable lengths = ReadMotion(folder + "/" + lengthsFile);
   EXPECT_EQ(lengths.times.size(), trajectory.times.size());
   LengthComparison result;
@@ -83,21 +95,35 @@ TEST(OpenSimOracle, Rajagopal2016WrappedLengthsEqualOpenSims)
   {
     GTEST_SKIP() << "OpenSim data not found: set MUSCLEDEFORMATION_DATA_DIR to the folder holding opensim/";
   }
-  const LengthComparison c = CompareLengths(file.substr(0, file.rfind('/')), "subject_walk_armless_18musc.osim",
-    "subject_walk_armless_coordinates.mot", "std_testGeometryPathWrapping_subject_walk_armless_muscle_lengths.sto");
-  ASSERT_EQ(c.difference.size(), 18u);
   // 14 of the 18 paths wrap over cylinders, on some frames or all (med_gas over two at once):
-  // every length within 1e-6 m of OpenSim 4.4's (OpenSim's own gate on this file is 1e-6 m).
-  for (const auto& [name, differences] : c.difference)
+  // every length within 1e-6 m of OpenSim 4.4's (OpenSim's own gate on this file is 1e-6 m), as
+  // read and under 1e-7 noise on every coordinate (three seeds): the figure is a spread.
+  std::map<std::string, std::pair<double, double>> spread; // per muscle: least and most of the largest
+  for (const unsigned seed : { 0u, 1u, 2u, 3u })
   {
-    ASSERT_EQ(differences.size(), 238u);
-    double worst = 0;
-    for (size_t k = 0; k < differences.size(); ++k)
+    const double noise = seed == 0 ? 0.0 : 1e-7;
+    const LengthComparison c = CompareLengths(file.substr(0, file.rfind('/')), "subject_walk_armless_18musc.osim",
+      "subject_walk_armless_coordinates.mot", "std_testGeometryPathWrapping_subject_walk_armless_muscle_lengths.sto",
+      noise, seed);
+    ASSERT_EQ(c.difference.size(), 18u);
+    for (const auto& [name, differences] : c.difference)
     {
-      EXPECT_LE(std::abs(differences[k]), 1e-6) << name << " frame " << k;
-      worst = std::max(worst, std::abs(differences[k]));
+      ASSERT_EQ(differences.size(), 238u);
+      double worst = 0;
+      for (size_t k = 0; k < differences.size(); ++k)
+      {
+        EXPECT_LE(std::abs(differences[k]), 1e-6) << name << " frame " << k << " noise " << noise;
+        worst = std::max(worst, std::abs(differences[k]));
+      }
+      auto [it, fresh] = spread.try_emplace(name, worst, worst);
+      it->second = { std::min(it->second.first, worst), std::max(it->second.second, worst) };
     }
-    std::printf("rajagopal2016 %-12s largest |length - OpenSim's| over 238 frames: %.3g m\n", name.c_str(), worst);
+  }
+  for (const auto& [name, range] : spread)
+  {
+    std::printf("rajagopal2016 %-12s largest |length - OpenSim's| over 238 frames, as read and under 1e-7 noise "
+                "(3 seeds): %.3g-%.3g m\n",
+      name.c_str(), range.first, range.second);
   }
 }
 

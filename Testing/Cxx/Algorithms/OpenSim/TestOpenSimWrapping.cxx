@@ -10,6 +10,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -128,23 +130,32 @@ TEST(OpenSimWrapping, QuadrantEndsAndInsideDecideWhetherAPathWraps)
     WrapAction::NoWrap);
 }
 
-TEST(OpenSimWrapping, TheSmallModelsPathWrapsOverItsCylinderUnlessInactive)
+TEST(OpenSimWrapping, TheSmallModelsPathWrapsOverItsCylinderOrEllipsoidUnlessInactive)
 {
-  Model model = ParseModel(kSmallModel, "small.osim");
-  const Path& path = model.paths[0];
-  std::vector<double> q = DefaultCoordinates(model);
-  // A pose whose straight path cuts the tibia's cylinder (radius 0.1 about the tibia's z).
-  const std::vector<md::RigidTransform> poses = BodyPoses(model, q);
-  const PathGeometry wrapped = PathAt(model, path, q, poses);
-  model.wrapObjects[0].active = false;
-  const PathGeometry straight = PathAt(model, path, q, poses);
-  EXPECT_EQ(std::count(straight.pointIndex.begin(), straight.pointIndex.end(), -1), 0);
-  EXPECT_NEAR(straight.length, md::osim::PolylineLength(straight.points), 1e-15);
-  // Active, it wraps: wrapping only lengthens the path, and the drawn points measure what is
-  // reported.
-  EXPECT_GT(std::count(wrapped.pointIndex.begin(), wrapped.pointIndex.end(), -1), 1);
-  EXPECT_GT(wrapped.length, straight.length);
-  EXPECT_NEAR(md::osim::PolylineLength(wrapped.points), wrapped.length, 1e-4 * wrapped.length);
+  std::string withEllipsoid = kSmallModel;
+  const std::string cylinder = "<radius>0.1</radius><length>0.5</length></WrapCylinder>";
+  withEllipsoid.replace(
+    withEllipsoid.find(cylinder), cylinder.size(), "<dimensions>0.1 0.1 0.25</dimensions></WrapEllipsoid>");
+  withEllipsoid.replace(withEllipsoid.find("<WrapCylinder "), 14, "<WrapEllipsoid ");
+  for (const std::string& text : { std::string(kSmallModel), withEllipsoid })
+  {
+    Model model = ParseModel(text, "small.osim");
+    const std::string what = model.wrapObjects[0].shape == WrapShape::Ellipsoid ? "ellipsoid" : "cylinder";
+    const Path& path = model.paths[0];
+    std::vector<double> q = DefaultCoordinates(model);
+    // A pose whose straight path cuts the tibia's wrap object (radius 0.1 about the tibia's z).
+    const std::vector<md::RigidTransform> poses = BodyPoses(model, q);
+    const PathGeometry wrapped = PathAt(model, path, q, poses);
+    model.wrapObjects[0].active = false;
+    const PathGeometry straight = PathAt(model, path, q, poses);
+    EXPECT_EQ(std::count(straight.pointIndex.begin(), straight.pointIndex.end(), -1), 0) << what;
+    EXPECT_NEAR(straight.length, md::osim::PolylineLength(straight.points), 1e-15) << what;
+    // Active, it wraps: wrapping only lengthens the path, and the drawn points measure what is
+    // reported.
+    EXPECT_GT(std::count(wrapped.pointIndex.begin(), wrapped.pointIndex.end(), -1), 1) << what;
+    EXPECT_GT(wrapped.length, straight.length) << what;
+    EXPECT_NEAR(md::osim::PolylineLength(wrapped.points), wrapped.length, 1e-4 * wrapped.length) << what;
+  }
 }
 
 TEST(OpenSimWrapping, BadWrapSettingsAreNamed)
@@ -166,6 +177,22 @@ TEST(OpenSimWrapping, BadWrapSettingsAreNamed)
   e = ExpectInputError([&] { ParseModel(text, "small.osim"); });
   EXPECT_NE(e.find("wrap object 'cylinder' is not in the model"), std::string::npos) << e;
   EXPECT_NE(e.find("PathWrap 'w'"), std::string::npos) << e;
+
+  text = kSmallModel;
+  text.replace(
+    text.find("<wrap_object>cyl</wrap_object>"), 30, "<wrap_object>cyl</wrap_object><method>spiral</method>");
+  e = ExpectInputError([&] { ParseModel(text, "small.osim"); });
+  EXPECT_NE(e.find("wrapping method 'spiral' is not one of hybrid, midpoint or axial"), std::string::npos) << e;
+  EXPECT_NE(e.find("PathWrap 'w'"), std::string::npos) << e;
+  for (const auto& [name, method] : std::vector<std::pair<std::string, EllipsoidWrapMethod>>{
+         { "hybrid", EllipsoidWrapMethod::Hybrid }, { "Unassigned", EllipsoidWrapMethod::Hybrid },
+         { "Midpoint", EllipsoidWrapMethod::Midpoint }, { "AXIAL", EllipsoidWrapMethod::Axial } })
+  {
+    text = kSmallModel;
+    text.replace(
+      text.find("<wrap_object>cyl</wrap_object>"), 30, "<wrap_object>cyl</wrap_object><method>" + name + "</method>");
+    EXPECT_EQ(ParseModel(text, "small.osim").paths[0].wraps[0].method, method) << name;
+  }
 
   // Each quadrant name OpenSim accepts.
   for (const auto& [name, axis, sign] : std::vector<std::tuple<std::string, int, int>>{
@@ -267,9 +294,38 @@ TEST(OpenSimWrapping, APathOverAPulleyOnTheJointAxisHasItsRadiusAsMomentArm)
   EXPECT_NEAR(clear.length, md::osim::PolylineLength(clear.points), 1e-15);
 }
 
+namespace
+{
+/// opensim-core's testGeometryPathWrapping model: `object` (an opening tag and its size; closed
+/// here) on ground, turned by `rotation`, with `quadrant`; a pin joint about z at the origin; a
+/// path from ground (0.4, 0.5, 0) to the pinned body's `insert`, over the object.
+std::string PulleyModel(
+  const std::string& object, const std::string& rotation, const std::string& quadrant, const std::string& insert)
+{
+  const std::string type = object.substr(1, object.find(' ') - 1);
+  return R"(<?xml version="1.0"?>
+<OpenSimDocument Version="40000"><Model name="perpendicular"><Ground name="ground">
+  <WrapObjectSet><objects>)" +
+    object + "<xyz_body_rotation>" + rotation + "</xyz_body_rotation><quadrant>" + quadrant + "</quadrant></" + type +
+    R"(></objects></WrapObjectSet>
+ </Ground>
+ <BodySet><objects><Body name="body"/></objects></BodySet>
+ <JointSet><objects><PinJoint name="pin"><socket_parent_frame>/ground</socket_parent_frame><socket_child_frame>/bodyset/body</socket_child_frame>
+  <coordinates><Coordinate name="q_pin"/></coordinates></PinJoint></objects></JointSet>
+ <ForceSet><objects><PathSpring name="spring1"><GeometryPath name="path"><PathPointSet><objects>
+  <PathPoint name="origin"><socket_parent_frame>/ground</socket_parent_frame><location>0.4 0.5 0</location></PathPoint>
+  <PathPoint name="insert"><socket_parent_frame>/bodyset/body</socket_parent_frame><location>)" +
+    insert + R"(</location></PathPoint>
+ </objects></PathPointSet>
+ <PathWrapSet><objects><PathWrap name="w"><wrap_object>pulley1</wrap_object></PathWrap></objects></PathWrapSet>
+ </GeometryPath></PathSpring></objects></ForceSet>
+</Model></OpenSimDocument>)";
+}
+}
+
 TEST(OpenSimWrapping, OpenSimsOwnPerpendicularCasesHaveTheirGoldenValues)
 {
-  // opensim-core's testGeometryPathWrapping, "WrapCylinder" and "WrapSphere"
+  // opensim-core's testGeometryPathWrapping, "WrapCylinder", "WrapSphere" and "WrapEllipsoid"
   // (testSingleWrapObjectPerpendicular): a wrap object of radius 0.5 on ground, turned as that
   // test turns it, and with quadrant +y; a path from ground (r - 0.1, r, 0) to a pin-jointed
   // body's (-r, r, 0). Over a quarter turn of the pin its moment arm is -r (OpenSim asserts to
@@ -277,6 +333,7 @@ TEST(OpenSimWrapping, OpenSimsOwnPerpendicularCasesHaveTheirGoldenValues)
   const double r = 0.5;
   const std::string cylinder = "<WrapCylinder name=\"pulley1\"><radius>0.5</radius><length>1</length>";
   const std::string sphere = "<WrapSphere name=\"pulley1\"><radius>0.5</radius>";
+  const std::string ellipsoid = "<WrapEllipsoid name=\"pulley1\"><dimensions>0.5 0.5 0.5</dimensions>";
   const std::vector<std::string> aboutZ = { "0 0 0", "0 0 1.5707963267948966", "0 0 3.141592653589793",
     "0 0 -1.5707963267948966" };
   std::vector<std::tuple<std::string, std::string, std::string>> cases;
@@ -284,6 +341,7 @@ TEST(OpenSimWrapping, OpenSimsOwnPerpendicularCasesHaveTheirGoldenValues)
   {
     cases.emplace_back(cylinder, rotation, "all");
     cases.emplace_back(sphere, rotation, "all");
+    cases.emplace_back(ellipsoid, rotation, "all");
   }
   for (const std::string& rotation : { "0 1.5707963267948966 0", "0 3.141592653589793 0", "0 -1.5707963267948966 0",
          "1.5707963267948966 0 0", "3.141592653589793 0 0", "-1.5707963267948966 0 0" })
@@ -292,26 +350,11 @@ TEST(OpenSimWrapping, OpenSimsOwnPerpendicularCasesHaveTheirGoldenValues)
   }
   cases.emplace_back(cylinder, "0 0 0", "+y");
   cases.emplace_back(sphere, "0 0 0", "+y");
+  cases.emplace_back(ellipsoid, "0 0 0", "+y");
   for (const auto& [object, rotation, quadrant] : cases)
   {
     const std::string type = object.substr(1, object.find(' ') - 1);
-    const std::string text = R"(<?xml version="1.0"?>
-<OpenSimDocument Version="40000"><Model name="perpendicular"><Ground name="ground">
-  <WrapObjectSet><objects>)" +
-      object + "<xyz_body_rotation>" + rotation + "</xyz_body_rotation><quadrant>" + quadrant + "</quadrant></" + type +
-      R"(></objects></WrapObjectSet>
- </Ground>
- <BodySet><objects><Body name="body"/></objects></BodySet>
- <JointSet><objects><PinJoint name="pin"><socket_parent_frame>/ground</socket_parent_frame><socket_child_frame>/bodyset/body</socket_child_frame>
-  <coordinates><Coordinate name="q_pin"/></coordinates></PinJoint></objects></JointSet>
- <ForceSet><objects><PathSpring name="spring1"><GeometryPath name="path"><PathPointSet><objects>
-  <PathPoint name="origin"><socket_parent_frame>/ground</socket_parent_frame><location>0.4 0.5 0</location></PathPoint>
-  <PathPoint name="insert"><socket_parent_frame>/bodyset/body</socket_parent_frame><location>-0.5 0.5 0</location></PathPoint>
- </objects></PathPointSet>
- <PathWrapSet><objects><PathWrap name="w"><wrap_object>pulley1</wrap_object></PathWrap></objects></PathWrapSet>
- </GeometryPath></PathSpring></objects></ForceSet>
-</Model></OpenSimDocument>)";
-    const Model m = ParseModel(text, "perpendicular.osim");
+    const Model m = ParseModel(PulleyModel(object, rotation, quadrant, "-0.5 0.5 0"), "perpendicular.osim");
     const int q = m.FindCoordinate("q_pin");
     constexpr int kSteps = 50;
     for (int i = 0; i <= kSteps; ++i)
@@ -323,6 +366,42 @@ TEST(OpenSimWrapping, OpenSimsOwnPerpendicularCasesHaveTheirGoldenValues)
       EXPECT_NEAR(length, 2 * r - 0.1 + 0.25 * 2 * M_PI * r * i / kSteps, 1e-6) << what;
       EXPECT_NEAR(MomentArm(m, m.paths[0], coordinates, q, 1e-6), -r, 1e-4) << what;
     }
+  }
+}
+
+TEST(OpenSimWrapping, OpenSimsEllipsoidLengthCaseIsAQuarterOfTheEllipse)
+{
+  // opensim-core's testGeometryPathWrapping, "WrapEllipsoid", "Wrapping length": an ellipsoid of
+  // radii (r / cos(angle), r, 1), r = 0.5, for angles from 0 to 80 degrees; the path from
+  // (r - 0.1, r, 0) to (-a, -r, 0) runs along y = r to the ellipse's top, over a quarter of the
+  // ellipse x^2/a^2 + y^2/r^2 = 1 and down x = -a. OpenSim asserts Ramanujan's perimeter to 1e-4;
+  // here the quarter is also integrated, to 1e-9.
+  const double r = 0.5;
+  for (int degrees = 0; degrees <= 80; degrees += 5)
+  {
+    const double a = r / std::cos(degrees * M_PI / 180);
+    std::ostringstream object, insert;
+    object.precision(17);
+    insert.precision(17);
+    object << "<WrapEllipsoid name=\"pulley1\"><dimensions>" << a << " " << r << " 1</dimensions>";
+    insert << -a << " " << -r << " 0";
+    const Model m = ParseModel(PulleyModel(object.str(), "0 0 0", "all", insert.str()), "ellipse.osim");
+    const std::vector<double> q = DefaultCoordinates(m);
+    const double length = PathAt(m, m.paths[0], q, BodyPoses(m, q)).length;
+    const double h = (a - r) * (a - r) / ((a + r) * (a + r));
+    const double ramanujan = M_PI * (a + r) * (1 + 3 * h / (10 + std::sqrt(4 - 3 * h)));
+    EXPECT_NEAR(length, 2 * r - 0.1 + ramanujan / 4, 1e-4) << degrees;
+    // The quarter's length by Simpson's rule over the parameter (x, y) = (a sin t, r cos t).
+    constexpr int kIntervals = 20000;
+    double quarter = 0.0;
+    for (int i = 0; i <= kIntervals; ++i)
+    {
+      const double t = 0.5 * M_PI * i / kIntervals;
+      const double weight = i == 0 || i == kIntervals ? 1.0 : i % 2 == 1 ? 4.0 : 2.0;
+      quarter += weight * std::hypot(a * std::cos(t), r * std::sin(t));
+    }
+    quarter *= 0.5 * M_PI / kIntervals / 3.0;
+    EXPECT_NEAR(length, 2 * r - 0.1 + quarter, 1e-9) << degrees;
   }
 }
 
@@ -362,6 +441,139 @@ TEST(OpenSimWrapping, APathOverASphereIsAnArcOfAGreatCircle)
     WrapAction::InsideRadius);
   EXPECT_EQ(WrapSphereSegment(Eigen::Vector3d(-0.3, 0.05, 0), Eigen::Vector3d(0.3, 0.05, 0), radius, 0, 0, result),
     WrapAction::NoWrap);
+}
+
+namespace
+{
+/// Segments that cut the ellipsoid of `radii` about the origin: from a point 1.5-3 of its
+/// largest radius out, through a point inside it (at `least` to `most` of the way out from the
+/// centre), to a point outside beyond (deterministic).
+std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> CuttingSegments(
+  const Eigen::Vector3d& radii, int count, double least = 0.0, double most = 0.6)
+{
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const auto direction = [&]() {
+    Eigen::Vector3d d;
+    do
+    {
+      d = Eigen::Vector3d(unit(random), unit(random), unit(random));
+    }
+    while (d.norm() < 0.1 || d.norm() > 1.0);
+    return Eigen::Vector3d(d.normalized());
+  };
+  const auto outside = [&](const Eigen::Vector3d& x) {
+    return x.cwiseQuotient(radii).squaredNorm() > 1.1;
+  };
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> segments;
+  while (static_cast<int>(segments.size()) < count)
+  {
+    const Eigen::Vector3d p1 = (2.25 + 0.75 * unit(random)) * radii.maxCoeff() * direction();
+    const Eigen::Vector3d through = (least + (most - least) * std::abs(unit(random))) * radii.cwiseProduct(direction());
+    const Eigen::Vector3d p2 = p1 + (2.0 + 0.5 * unit(random)) * (through - p1);
+    if (outside(p1) && outside(p2))
+    {
+      segments.emplace_back(p1, p2);
+    }
+  }
+  return segments;
+}
+}
+
+TEST(OpenSimWrapping, AnEllipsoidOfEqualRadiiWrapsAsASphere)
+{
+  // Each method finds the plane through the centre (the great circle's): the tangent points and
+  // the arc are the sphere's.
+  const double radius = 0.04;
+  for (const EllipsoidWrapMethod method :
+    { EllipsoidWrapMethod::Hybrid, EllipsoidWrapMethod::Midpoint, EllipsoidWrapMethod::Axial })
+  {
+    for (const auto& [p1, p2] : CuttingSegments(Eigen::Vector3d::Constant(radius), 40))
+    {
+      WrapResult sphere, ellipsoid;
+      ASSERT_NE(WrapSphereSegment(p1, p2, radius, 0, 0, sphere), WrapAction::NoWrap);
+      ASSERT_EQ(WrapEllipsoidSegment(p1, p2, Eigen::Vector3d::Constant(radius), 0, 0, method, ellipsoid),
+        WrapAction::Mandatory);
+      EXPECT_LT((ellipsoid.r1 - sphere.r1).norm(), 1e-12);
+      EXPECT_LT((ellipsoid.r2 - sphere.r2).norm(), 1e-12);
+      EXPECT_NEAR(ellipsoid.length, sphere.length, 1e-12);
+      const md::Points surface = SurfacePoints(ellipsoid, 0.002);
+      for (Eigen::Index i = 0; i < surface.rows(); ++i)
+      {
+        EXPECT_NEAR(surface.row(i).norm(), radius, 1e-12);
+      }
+    }
+  }
+}
+
+TEST(OpenSimWrapping, APathOverAnEllipsoidFollowsItsSectionFromTangentToTangent)
+{
+  // A triaxial ellipsoid; segments that cut it in any direction, by each method. The tangent
+  // points are on the ellipsoid, in one plane with p1 and p2 (the wrap's), and the lines to them
+  // touch it; the surface path lies on the ellipsoid in that plane, its drawn points measure the
+  // length, and the wrapped path is longer than the straight one. Where the segment cuts the
+  // ellipsoid no deeper than halfway to its centre, a small move of an end moves the length by at
+  // most that much. (Deeper, the wrap's plane may turn fast with the ends, in OpenSim as here:
+  // the ellipsoid's point nearest a point near an ellipse's medial axis does.)
+  const Eigen::Vector3d radii(0.05, 0.03, 0.02);
+  const auto level = [&](const Eigen::Vector3d& x) {
+    return x.cwiseQuotient(radii).squaredNorm() - 1.0;
+  };
+  const auto normalAt = [&](const Eigen::Vector3d& x) {
+    return Eigen::Vector3d(x.cwiseQuotient(radii.cwiseAbs2()).normalized());
+  };
+  int shallow = 0;
+  for (const EllipsoidWrapMethod method :
+    { EllipsoidWrapMethod::Hybrid, EllipsoidWrapMethod::Midpoint, EllipsoidWrapMethod::Axial })
+  {
+    int index = 0;
+    for (const auto& [p1, p2] : CuttingSegments(radii, 60, 0.0, 0.95))
+    {
+      const std::string what =
+        "method " + std::to_string(static_cast<int>(method)) + " segment " + std::to_string(index++);
+      WrapResult result;
+      ASSERT_EQ(WrapEllipsoidSegment(p1, p2, radii, 0, 0, method, result), WrapAction::Mandatory) << what;
+      EXPECT_NEAR(level(result.r1), 0.0, 1e-12) << what;
+      EXPECT_NEAR(level(result.r2), 0.0, 1e-12) << what;
+      const Eigen::Vector3d plane = (p1 - p2).cross(result.r1 - p2).normalized();
+      EXPECT_NEAR(plane.dot(result.r2 - p2), 0.0, 1e-12) << what;
+      EXPECT_NEAR(normalAt(result.r1).dot((p1 - result.r1).normalized()), 0.0, 1e-9) << what;
+      EXPECT_NEAR(normalAt(result.r2).dot((p2 - result.r2).normalized()), 0.0, 1e-9) << what;
+      const md::Points surface = SurfacePoints(result, 0.0001);
+      double drawn = 0.0;
+      for (Eigen::Index i = 0; i < surface.rows(); ++i)
+      {
+        const Eigen::Vector3d x = surface.row(i).transpose();
+        EXPECT_NEAR(level(x), 0.0, 1e-12) << what;
+        EXPECT_NEAR(plane.dot(x - p2), 0.0, 1e-12) << what;
+        drawn += i > 0 ? (surface.row(i) - surface.row(i - 1)).norm() : 0.0;
+      }
+      EXPECT_NEAR(drawn, result.length, 1e-4 * result.length) << what;
+      const double wrapped = (result.r1 - p1).norm() + result.length + (p2 - result.r2).norm();
+      EXPECT_GT(wrapped, (p2 - p1).norm()) << what;
+      // How near the segment's line comes to the centre, in radii.
+      const Eigen::Vector3d s1 = p1.cwiseQuotient(radii), s2 = p2.cwiseQuotient(radii);
+      if ((s1 - s1.dot((s2 - s1).normalized()) * (s2 - s1).normalized()).norm() < 0.5)
+      {
+        continue;
+      }
+      ++shallow;
+      WrapResult moved;
+      const Eigen::Vector3d nudge(1e-7, -1e-7, 1e-7);
+      ASSERT_EQ(WrapEllipsoidSegment(p1 + nudge, p2, radii, 0, 0, method, moved), WrapAction::Mandatory) << what;
+      const double movedWrapped = (moved.r1 - p1 - nudge).norm() + moved.length + (p2 - moved.r2).norm();
+      EXPECT_NEAR(movedWrapped, wrapped, 1e-6) << what;
+    }
+  }
+  EXPECT_GE(shallow, 60);
+  // An end inside; a segment clear of the ellipsoid; p1 and p2 in one direction from its centre.
+  WrapResult result;
+  const auto wrap = [&](const Eigen::Vector3d& p1, const Eigen::Vector3d& p2) {
+    return WrapEllipsoidSegment(p1, p2, radii, 0, 0, EllipsoidWrapMethod::Hybrid, result);
+  };
+  EXPECT_EQ(wrap(Eigen::Vector3d(0.04, 0, 0), Eigen::Vector3d(0.3, 0.1, 0)), WrapAction::InsideRadius);
+  EXPECT_EQ(wrap(Eigen::Vector3d(-0.3, 0.035, 0), Eigen::Vector3d(0.3, 0.035, 0)), WrapAction::NoWrap);
+  EXPECT_EQ(wrap(Eigen::Vector3d(0.1, 0, 0), Eigen::Vector3d(0.2, 0, 0)), WrapAction::NoWrap);
 }
 
 TEST(OpenSimWrapping, APathThroughATorusWrapsTheInsideOfItsTube)
