@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // OpenSim models: loading and updating to a new time, in the core and through the reader
 // (vtkOpenSimModelReader, as ParaView runs it), on gait2392 (23 coordinates, 92 muscles, 20
-// meshes) and the other models of ../shared/data/opensim. Prints figures; asserts nothing.
+// meshes) and the other models of ../shared/data/opensim; one segment over each kind of wrap
+// object (no data needed). Prints figures; asserts nothing.
 //
 //   BenchmarkOpenSim [data folder]
 #include "OpenSim/OpenSimKinematics.h"
 #include "OpenSim/OpenSimMotion.h"
+#include "OpenSim/OpenSimWrapping.h"
 #include "RealData.h"
 #include "vtkOpenSimModelReader.h"
 
@@ -15,6 +17,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <functional>
 #include <vector>
 
 namespace
@@ -92,10 +95,65 @@ void Measure(const std::string& label, const std::string& model, const std::stri
     label.c_str(), parsed.bodies.size(), parsed.coordinates.size(), parsed.paths.size(), trajectory.frames.size(),
     1e3 * Median(reads), 1e3 * Median(frames), 1e3 * Median(loads), 1e3 * Median(updates));
 }
+
+/// One segment over each kind of wrap object, sized as a muscle's: a segment 20 cm long passing
+/// 1 cm from the centre of an object of radius 2 cm (an ellipsoid 3.5 x 2 x 2 cm, as arm26's;
+/// a torus of ring 5 cm and tube 2 cm, the segment through its ring). Microseconds a segment.
+void MeasureWrapObjects()
+{
+  namespace osim = md::osim;
+  using Vector = Eigen::Vector3d;
+  const Vector p1(-0.1, 0.01, 0.004), p2(0.1, 0.008, -0.003);
+  const auto time = [&](const char* label, const std::function<double(const Vector&)>& wrap) {
+    std::vector<double> runs;
+    double total = 0;
+    constexpr int kSegments = 20000;
+    for (int run = 0; run < 5; ++run)
+    {
+      const auto start = std::chrono::steady_clock::now();
+      for (int i = 0; i < kSegments; ++i)
+      {
+        total += wrap(p1 + Vector(1e-9 * i, 0, 0)); // a new segment each time
+      }
+      runs.push_back(Seconds(start) / kSegments);
+    }
+    std::printf("  %-36s %6.2f us a segment (median of 5 runs of %d)%s\n", label, 1e6 * Median(runs), kSegments,
+      total < 0 ? " impossible" : "");
+  };
+  std::printf("One segment over a wrap object:\n");
+  osim::WrapResult result;
+  time("cylinder (one wrap object)", [&](const Vector& p) {
+    osim::WrapCylinderSegment(p, p2, 0.02, 0.2, 0, 0, false, result);
+    return result.length;
+  });
+  time("cylinder (tangent points slid)", [&](const Vector& p) {
+    osim::WrapCylinderSegment(p, p2, 0.02, 0.2, 0, 0, true, result);
+    return result.length;
+  });
+  time("sphere", [&](const Vector& p) {
+    osim::WrapSphereSegment(p, p2, 0.02, 0, 0, result);
+    return result.length;
+  });
+  for (const auto& [label, method] : { std::pair{ "ellipsoid, hybrid", osim::EllipsoidWrapMethod::Hybrid },
+         std::pair{ "ellipsoid, midpoint", osim::EllipsoidWrapMethod::Midpoint },
+         std::pair{ "ellipsoid, axial", osim::EllipsoidWrapMethod::Axial } })
+  {
+    time(label, [&, method = method](const Vector& p) {
+      osim::WrapEllipsoidSegment(p, p2, Vector(0.035, 0.02, 0.02), 0, 0, method, result);
+      return result.length;
+    });
+  }
+  const Vector r1(0.05 - 0.1, 0.001, 0.004), r2(0.05 + 0.1, -0.002, -0.003);
+  time("torus", [&](const Vector& p) {
+    osim::WrapTorusSegment(p - p1 + r1, r2, 0.05, 0.02, 0, 0, false, result);
+    return result.length;
+  });
+}
 }
 
 int main(int argc, char** argv)
 {
+  MeasureWrapObjects();
   const std::string folder = argc > 1 ? argv[1] : "";
   struct Case
   {

@@ -304,6 +304,11 @@ WrapAction WrapEllipsoidSegment(const Vector& point1, const Vector& point2, cons
   const double d = -n.dot(c1);
   result.r1 = std::abs(p1e) < 1e-4 ? p1 : TangentPoint(p1, p2, c1, n, d, a);
   result.r2 = std::abs(p2e) < 1e-4 ? p2 : TangentPoint(p2, p1, c1, n, d, a);
+  if (!result.r1.allFinite() || !result.r2.allFinite())
+  {
+    result = WrapResult();
+    return WrapAction::NoWrap; // an end's polar plane parallel to the wrap's (degenerate)
+  }
   // The section is drawn about the plane's point on the coordinate axis most nearly normal to it.
   int normalAxis = 0;
   for (int i = 1; i < 3; ++i)

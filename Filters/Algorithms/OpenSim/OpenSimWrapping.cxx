@@ -197,12 +197,15 @@ void SpiralPath(const Vector& p1, const Vector& p2, double radius, bool longWrap
 
 Vector SurfacePointAt(const WrapResult& wrap, double t)
 {
-  const Vector turned = Eigen::AngleAxisd(t * wrap.turn, wrap.axis) * (wrap.r1 - wrap.centre);
   if (wrap.radii.isZero())
   {
-    return wrap.centre + turned + t * wrap.rise * wrap.axis;
+    return wrap.centre + Eigen::AngleAxisd(t * wrap.turn, wrap.axis) * (wrap.r1 - wrap.centre) +
+      t * wrap.rise * wrap.axis;
   }
-  // Along the turned direction from the centre to the ellipsoid: the quadratic's positive root.
+  // Along the turned direction from the centre to the ellipsoid (the quadratic's positive root);
+  // r1 - centre is normal to the axis, so the turn is cos and sin.
+  const Vector from = wrap.r1 - wrap.centre;
+  const Vector turned = std::cos(t * wrap.turn) * from + std::sin(t * wrap.turn) * wrap.axis.cross(from);
   const Vector f1 = turned.cwiseQuotient(wrap.radii), f2 = wrap.centre.cwiseQuotient(wrap.radii);
   const double a = f1.squaredNorm(), b = 2.0 * f1.dot(f2), c = f2.squaredNorm() - 1.0;
   const double along = (-b + std::sqrt(std::max(0.0, b * b - 4.0 * a * c))) / (2.0 * a);
