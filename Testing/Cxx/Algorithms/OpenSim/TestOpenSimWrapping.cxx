@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Paths over OpenSim's wrap cylinders against closed forms; the model's wrap settings read and
-// honoured; bad wrap settings named. (OpenSim's own lengths: TestOpenSimKinematics.cxx.)
+// Paths over OpenSim's wrap cylinders, spheres, ellipsoids and tori against closed forms and
+// opensim-core's golden cases; the model's wrap settings read and honoured; bad wrap settings named.
+// (OpenSim's own lengths: TestOpenSimKinematics.cxx.)
 #include "OpenSim/MomentArms.h"
 #include "OpenSim/OpenSimKinematics.h"
 #include "OpenSim/OpenSimWrapping.h"
