@@ -4,7 +4,6 @@
 #include <pugixml.hpp>
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -1138,28 +1137,18 @@ private:
       {
         // As OpenSim: the three names in lower case, capitalised or upper case; "Unassigned" is
         // the default.
+        using Method = EllipsoidWrapMethod;
+        static const std::map<std::string, Method> kMethods = { { "hybrid", Method::Hybrid },
+          { "Hybrid", Method::Hybrid }, { "HYBRID", Method::Hybrid }, { "Unassigned", Method::Hybrid },
+          { "midpoint", Method::Midpoint }, { "Midpoint", Method::Midpoint }, { "MIDPOINT", Method::Midpoint },
+          { "axial", Method::Axial }, { "Axial", Method::Axial }, { "AXIAL", Method::Axial } };
         const std::string name = FirstWord(method.text().get());
-        const auto is = [&](const std::string& lower) {
-          std::string capital = lower, upper = lower;
-          const auto toUpper = [](char c) {
-            return static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-          };
-          capital[0] = toUpper(capital[0]);
-          std::transform(upper.begin(), upper.end(), upper.begin(), toUpper);
-          return name == lower || name == capital || name == upper;
-        };
-        if (is("midpoint"))
-        {
-          w.method = EllipsoidWrapMethod::Midpoint;
-        }
-        else if (is("axial"))
-        {
-          w.method = EllipsoidWrapMethod::Axial;
-        }
-        else if (!is("hybrid") && name != "Unassigned")
+        const auto known = kMethods.find(name);
+        if (known == kMethods.end())
         {
           this->reader.Fail(wrap, "wrapping method '" + name + "' is not one of hybrid, midpoint or axial");
         }
+        w.method = known->second;
       }
       path.wraps.push_back(w);
     }

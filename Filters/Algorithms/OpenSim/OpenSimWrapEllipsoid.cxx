@@ -3,6 +3,7 @@
 // WrapEllipsoid::wrapLine, whose algorithm this follows (the wrap's plane, the sampled section),
 // with the tangent points in closed form. The code is ours.
 #include "OpenSim/OpenSimWrapping.h"
+#include "OpenSim/WrapGeometry.h"
 
 #include <algorithm>
 #include <array>
@@ -26,13 +27,6 @@ constexpr double kRoundoff = 2e-13;
 /// segments.
 constexpr double kSurfaceSegment = 0.001;
 constexpr int kMostSegments = 499;
-
-/// v / |v|, or zero where |v| is below machine epsilon.
-Vector Unit(const Vector& v)
-{
-  const double m = v.norm();
-  return m >= std::numeric_limits<double>::epsilon() ? Vector(v / m) : Vector::Zero();
-}
 
 /// The point of the ellipse (x/a)^2 + (y/b)^2 = 1 nearest (u, v): Eberly's Newton iteration on
 /// the Lagrange multiplier (Graphics Gems IV), with its special cases on the axes, as OpenSim.
@@ -140,7 +134,7 @@ Vector WrapPlanePoint(const Vector& p1, const Vector& p2, const Vector& r1, cons
   const Vector r1r2 = r2 - r1;
   // Axial: where the segment crosses the coordinate plane normal to the axis most nearly along
   // it, and the ellipse of that plane's point nearest there.
-  Vector mu = Unit(p1 - p2).cwiseAbs();
+  Vector mu = NormalizeOrZero(p1 - p2).cwiseAbs();
   int best = 0;
   for (int i = 1; i < 3; ++i)
   {
@@ -176,9 +170,9 @@ Vector WrapPlanePoint(const Vector& p1, const Vector& p2, const Vector& r1, cons
     for (int i = 1; i < kFanSamples - 1; ++i)
     {
       const Vector on = r1 + (static_cast<double>(i) / kFanSamples) * r1r2;
-      sum += Unit(NearestOnEllipsoid(a, on) - on);
+      sum += NormalizeOrZero(NearestOnEllipsoid(a, on) - on);
     }
-    const Vector fan = NearestOnEllipsoid(a, r1 + 0.5 * r1r2 + Unit(sum));
+    const Vector fan = NearestOnEllipsoid(a, r1 + 0.5 * r1r2 + NormalizeOrZero(sum));
     if (mu[best] <= kMuBlendMin)
     {
       c1 = fan;
@@ -207,10 +201,8 @@ Vector TangentPoint(const Vector& p, const Vector& q, const Vector& side, const 
   m << n.dot(n), n.dot(polar), n.dot(polar), polar.dot(polar);
   const Eigen::Vector2d ab = m.ldlt().solve(Eigen::Vector2d(-d, 1.0));
   const Vector x0 = ab[0] * n + ab[1] * polar;
-  const Vector f1 = along.cwiseQuotient(a), f2 = x0.cwiseQuotient(a);
-  const double qa = f1.squaredNorm(), qb = 2.0 * f1.dot(f2), qc = f2.squaredNorm() - 1.0;
-  const double root = std::sqrt(std::max(0.0, qb * qb - 4.0 * qa * qc));
-  const Vector t1 = x0 + (-qb + root) / (2.0 * qa) * along, t2 = x0 + (-qb - root) / (2.0 * qa) * along;
+  const EllipsoidCrossings on = CrossEllipsoid(x0, along, a);
+  const Vector t1 = x0 + on.larger * along, t2 = x0 + on.smaller * along;
   const auto sideOf = [&](const Vector& x) {
     return (x - p).cross(q - p).dot(n);
   };
@@ -259,21 +251,15 @@ WrapAction WrapEllipsoidSegment(const Vector& point1, const Vector& point2, cons
   {
     return WrapAction::InsideRadius;
   }
-  if (std::abs(Unit(p1).dot(Unit(p2)) - 1.0) < 1e-4)
+  if (std::abs(NormalizeOrZero(p1).dot(NormalizeOrZero(p2)) - 1.0) < 1e-4)
   {
     return WrapAction::NoWrap; // p1 and p2 in one direction from the centre
   }
   // Only a segment that cuts the ellipsoid wraps: where its line meets it, both within it.
   const Vector p1p2 = p1 - p2;
-  const Vector f1 = p1p2.cwiseQuotient(a), f2 = p2.cwiseQuotient(a);
-  const double qa = f1.squaredNorm(), qb = 2.0 * f1.dot(f2), qc = f2.squaredNorm() - 1.0;
-  const double disc = qb * qb - 4.0 * qa * qc;
-  if (disc < 0.0)
-  {
-    return WrapAction::NoWrap;
-  }
-  const double l1 = (-qb + std::sqrt(disc)) / (2.0 * qa), l2 = (-qb - std::sqrt(disc)) / (2.0 * qa);
-  if (!(0.0 < l1 && l1 < 1.0) || !(0.0 < l2 && l2 < 1.0))
+  const EllipsoidCrossings cut = CrossEllipsoid(p2, p1p2, a);
+  const double l1 = cut.larger, l2 = cut.smaller;
+  if (!cut.meets || !(0.0 < l1 && l1 < 1.0) || !(0.0 < l2 && l2 < 1.0))
   {
     return WrapAction::NoWrap;
   }
@@ -296,7 +282,7 @@ WrapAction WrapEllipsoidSegment(const Vector& point1, const Vector& point2, cons
     }
   }
   // The wrap's plane, through p1, p2 and c1.
-  const Vector n = Unit(p1p2.cross(p1 - c1));
+  const Vector n = NormalizeOrZero(p1p2.cross(p1 - c1));
   if (n.isZero())
   {
     return WrapAction::NoWrap;
@@ -316,9 +302,9 @@ WrapAction WrapEllipsoidSegment(const Vector& point1, const Vector& point2, cons
     normalAxis = std::abs(n[i]) > std::abs(n[normalAxis]) ? i : normalAxis;
   }
   result.centre = Vector::Unit(normalAxis) * (-d / n[normalAxis]);
-  const Vector ar1 = Unit(result.r1 - result.centre), ar2 = Unit(result.r2 - result.centre);
+  const Vector ar1 = NormalizeOrZero(result.r1 - result.centre), ar2 = NormalizeOrZero(result.r2 - result.centre);
   const double angle = std::acos(std::clamp(ar1.dot(ar2), -1.0, 1.0));
-  result.axis = Unit(ar1.cross(ar2));
+  result.axis = NormalizeOrZero(ar1.cross(ar2));
   result.radii = a;
   result.rise = 0.0;
   result.turn = angle;
@@ -328,8 +314,9 @@ WrapAction WrapEllipsoidSegment(const Vector& point1, const Vector& point2, cons
   const int segments =
     std::min(kMostSegments, static_cast<int>((result.r2 - result.r1).norm() / factor / kSurfaceSegment));
   if (quadrantSign != 0 && segments >= 2 &&
-    (Unit(p1 - result.r1).dot(Unit(SurfacePointAt(result, 1.0 / segments) - result.r1)) > 0.0 ||
-      Unit(p2 - result.r2).dot(Unit(SurfacePointAt(result, 1.0 - 1.0 / segments) - result.r2)) > 0.0))
+    (NormalizeOrZero(p1 - result.r1).dot(NormalizeOrZero(SurfacePointAt(result, 1.0 / segments) - result.r1)) > 0.0 ||
+      NormalizeOrZero(p2 - result.r2).dot(NormalizeOrZero(SurfacePointAt(result, 1.0 - 1.0 / segments) - result.r2)) >
+        0.0))
   {
     result.turn = -(2.0 * M_PI - angle);
   }

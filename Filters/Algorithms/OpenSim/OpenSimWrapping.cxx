@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "OpenSim/OpenSimWrapping.h"
+#include "OpenSim/WrapGeometry.h"
 
 #include <algorithm>
 #include <array>
@@ -30,17 +31,6 @@ constexpr int kWrapIterations = 8;
 int Sign(double a)
 {
   return a >= 0.0 ? 1 : -1;
-}
-
-/// v / |v|, or zero where |v| is below machine epsilon; `magnitude` gets |v|.
-Vector NormalizeOrZero(const Vector& v, double* magnitude = nullptr)
-{
-  const double m = v.norm();
-  if (magnitude)
-  {
-    *magnitude = m;
-  }
-  return m >= std::numeric_limits<double>::epsilon() ? Vector(v / m) : Vector::Zero();
 }
 
 /// The point of the line through `linePoint` along `line` (any length) nearest to `p`.
@@ -206,10 +196,7 @@ Vector SurfacePointAt(const WrapResult& wrap, double t)
   // r1 - centre is normal to the axis, so the turn is cos and sin.
   const Vector from = wrap.r1 - wrap.centre;
   const Vector turned = std::cos(t * wrap.turn) * from + std::sin(t * wrap.turn) * wrap.axis.cross(from);
-  const Vector f1 = turned.cwiseQuotient(wrap.radii), f2 = wrap.centre.cwiseQuotient(wrap.radii);
-  const double a = f1.squaredNorm(), b = 2.0 * f1.dot(f2), c = f2.squaredNorm() - 1.0;
-  const double along = (-b + std::sqrt(std::max(0.0, b * b - 4.0 * a * c))) / (2.0 * a);
-  return wrap.centre + along * turned;
+  return wrap.centre + CrossEllipsoid(wrap.centre, turned, wrap.radii).larger * turned;
 }
 
 Points SurfacePoints(const WrapResult& wrap, double spacing)

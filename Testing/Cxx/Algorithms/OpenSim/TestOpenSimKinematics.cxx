@@ -115,8 +115,9 @@ TEST(OpenSimOracle, Rajagopal2016WrappedLengthsEqualOpenSims)
         EXPECT_LE(std::abs(differences[k]), 1e-6) << name << " frame " << k << " noise " << noise;
         worst = std::max(worst, std::abs(differences[k]));
       }
-      auto [it, fresh] = spread.try_emplace(name, worst, worst);
-      it->second = { std::min(it->second.first, worst), std::max(it->second.second, worst) };
+      auto& [least, most] = spread.try_emplace(name, worst, worst).first->second;
+      least = std::min(least, worst);
+      most = std::max(most, worst);
     }
   }
   for (const auto& [name, range] : spread)
