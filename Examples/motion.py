@@ -29,7 +29,8 @@ the landmark's bone carries it), and the largest step of a muscle point between 
 against the median of those steps.
 With --paths-over-bones the LHDL paths are first kept out of the scanned bones (PathsOverBones,
 --path-points-per-segment points between each two of a path's own): no action line then runs
-through a bone; off by default (docs/DESIGN.md, "Paths over the bones", says what it costs).
+through a bone, and the muscles are driven by the paths over the bones; off by default, the model's
+own straight paths (docs/DESIGN.md, "Paths over the bones", compares the two).
 """
 import argparse
 import csv

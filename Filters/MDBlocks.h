@@ -127,6 +127,10 @@ constexpr const char* FrameSeconds = "FrameSeconds";
 constexpr const char* Frame = "Frame";
 constexpr const char* Time = "Time";
 constexpr const char* ActionLineName = "ActionLineName";
+/// PathsOverBones' point array: 1 at a path's own points (origin, via points, insertion), 0 at the
+/// points it puts between them. The deformation filters take a line piece by piece from one of
+/// its own points to the next (md::Knots); a line without it has only its own points.
+constexpr const char* PathOwnPoint = "PathOwnPoint";
 constexpr const char* Body = "Body"; ///< a body's name: BodyTransforms' first column, MoveWithBodies' field data
 /// BodyTransforms' field data (and MoveWithBodies' output's): the names of the rotational
 /// coordinates among the pose's coordinate values (in degrees; the others in the model's unit).

@@ -158,26 +158,64 @@ vtkSmartPointer<vtkPolyData> ToPolyLines(const std::vector<Points>& lines)
   return output;
 }
 
-std::vector<Points> ToPolylines(vtkPolyData* polyData, const Points* values)
+std::vector<std::vector<vtkIdType>> PolylineIds(vtkPolyData* polyData)
 {
-  std::vector<Points> lines;
+  std::vector<std::vector<vtkIdType>> polylines;
   vtkCellArray* cells = polyData ? polyData->GetLines() : nullptr;
-  if (!cells || cells->GetNumberOfCells() == 0)
+  if (!cells)
   {
-    return lines;
+    return polylines;
   }
-  const Points all = values ? Points() : ToPoints(polyData->GetPoints());
-  const Points& source = values ? *values : all;
   auto it = vtk::TakeSmartPointer(cells->NewIterator());
   for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
   {
     vtkIdType size;
     const vtkIdType* ids;
     it->GetCurrentCell(size, ids);
-    Points line(size, 3);
-    for (vtkIdType k = 0; k < size; ++k)
+    polylines.emplace_back(ids, ids + size);
+  }
+  return polylines;
+}
+
+std::vector<Knots> ToKnots(vtkPolyData* polyData)
+{
+  vtkDataArray* own = polyData ? polyData->GetPointData()->GetArray(array::PathOwnPoint) : nullptr;
+  std::vector<Knots> knots;
+  if (!own || own->GetNumberOfTuples() != polyData->GetNumberOfPoints())
+  {
+    return knots;
+  }
+  for (const std::vector<vtkIdType>& ids : PolylineIds(polyData))
+  {
+    Knots line;
+    for (size_t k = 0; k < ids.size(); ++k)
     {
-      line.row(k) = source.row(ids[k]);
+      if (k == 0 || k + 1 == ids.size() || own->GetComponent(ids[k], 0) != 0)
+      {
+        line.push_back(static_cast<Eigen::Index>(k));
+      }
+    }
+    knots.push_back(std::move(line));
+  }
+  return knots;
+}
+
+std::vector<Points> ToPolylines(vtkPolyData* polyData, const Points* values)
+{
+  std::vector<Points> lines;
+  const std::vector<std::vector<vtkIdType>> polylines = PolylineIds(polyData);
+  if (polylines.empty())
+  {
+    return lines;
+  }
+  const Points all = values ? Points() : ToPoints(polyData->GetPoints());
+  const Points& source = values ? *values : all;
+  for (const std::vector<vtkIdType>& ids : polylines)
+  {
+    Points line(static_cast<Eigen::Index>(ids.size()), 3);
+    for (size_t k = 0; k < ids.size(); ++k)
+    {
+      line.row(static_cast<Eigen::Index>(k)) = source.row(ids[k]);
     }
     lines.push_back(std::move(line));
   }

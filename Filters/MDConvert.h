@@ -25,6 +25,7 @@ struct BoneMotion;
 
 namespace mdvtk
 {
+using md::Knots;
 using md::Points;
 using md::TriangleMesh;
 /// How messages and tables name a leaf: its block name, else its label.
@@ -54,6 +55,11 @@ vtkIdType ReadTriangles(vtkPolyData* input, TriangleMesh& mesh);
 /// The polylines of a polydata, each as its point coordinates, or as the rows
 /// of `values` (one per point of the polydata, e.g. a point array) when given.
 std::vector<Points> ToPolylines(vtkPolyData* polyData, const Points* values = nullptr);
+/// The point ids of each polyline of a polydata, in order (none without one).
+std::vector<std::vector<vtkIdType>> PolylineIds(vtkPolyData* polyData);
+/// The own points (array::PathOwnPoint) of each polyline of a polydata, ToPolylines' order; its
+/// first and last point are always its own. None (every point its own) without the array.
+std::vector<Knots> ToKnots(vtkPolyData* polyData);
 /// A polydata with one polyline cell per entry of `lines`, their points in order.
 vtkSmartPointer<vtkPolyData> ToPolyLines(const std::vector<Points>& lines);
 /// The meshes of every block of every connection of a repeatable input port

@@ -12,6 +12,7 @@
 #include <vtkFieldData.h>
 #include <vtkInformation.h>
 #include <vtkInformationVector.h>
+#include <vtkNew.h>
 #include <vtkObjectFactory.h>
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
@@ -168,6 +169,26 @@ int vtkActionLineMatching::RequestData(
       out = std::copy(line.data(), line.data() + line.size(), out);
     }
     restOut->GetPointData()->AddArray(currentPosition);
+    // A path's own points (PathsOverBones) stay its own among the points matching inserted.
+    const std::vector<md::Knots> knots = mdvtk::ToKnots(rest.data);
+    if (!knots.empty())
+    {
+      vtkNew<vtkUnsignedCharArray> own;
+      own->SetName(mdvtk::array::PathOwnPoint);
+      own->SetNumberOfValues(restOut->GetNumberOfPoints());
+      vtkIdType next = 0;
+      for (size_t l = 0; l < restBuilder.lines.size(); ++l)
+      {
+        Eigen::Index original = 0;
+        for (const bool inserted : restBuilder.inserted[l])
+        {
+          const bool isOwn = !inserted && std::binary_search(knots[l].begin(), knots[l].end(), original);
+          original += inserted ? 0 : 1;
+          own->SetValue(next++, isOwn ? 1 : 0);
+        }
+      }
+      restOut->GetPointData()->AddArray(own);
+    }
     restResults[b] = restOut;
     currentResults[partner[b]] = currentOut;
   }

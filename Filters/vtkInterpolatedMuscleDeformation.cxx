@@ -468,7 +468,8 @@ bool vtkInterpolatedMuscleDeformation::MatchLines(const std::vector<mdvtk::Leaf>
           this, "an action line of " + restLeaf.label + " or " + currentLeaf.label + ": ",
           [&] {
             std::vector<std::string> notes;
-            motion.lines = md::MatchMuscleLines(rest, current, this->MatchingTolerance, notes);
+            motion.lines =
+              md::MatchMuscleLines(rest, current, this->MatchingTolerance, notes, mdvtk::ToKnots(restLeaf.data));
             for (const std::string& note : notes)
             {
               vtkWarningMacro(<< restLeaf.label << ": " << note);

@@ -674,6 +674,7 @@ bool vtkMotionMuscleDeformation::Start(const Leaves& leaves, vtkDataObject* land
       continue;
     }
     muscle.restLines = lines.data ? mdvtk::ToPolylines(lines.data) : std::vector<md::Points>{};
+    muscle.restKnots = mdvtk::ToKnots(lines.data);
     if (muscle.restLines.empty())
     {
       mdvtk::FailBlock(this, in.failedBlocks, b,

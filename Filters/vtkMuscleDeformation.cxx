@@ -59,9 +59,10 @@ bool ReadMatchedLines(
   const md::Points currentPositions = mdvtk::ToPoints(current);
   const std::vector<md::Points> rest = mdvtk::ToPolylines(data);
   const std::vector<md::Points> moved = mdvtk::ToPolylines(data, &currentPositions);
+  const std::vector<md::Knots> knots = mdvtk::ToKnots(data);
   for (size_t l = 0; l < rest.size(); ++l)
   {
-    lines.push_back({ rest[l], moved[l] });
+    lines.push_back({ rest[l], moved[l], l < knots.size() ? knots[l] : md::Knots() });
   }
   notes = md::LimitActionLinePoints(lines);
   return true;
@@ -174,10 +175,11 @@ bool vtkMuscleDeformation::PassOnSurface(const PassInput& in, std::vector<std::s
       continue;
     }
     const auto energyStart = Clock::now();
-    std::vector<md::Points> restLines;
-    for (const md::MatchedLine& line : in.toDeform[m].lines)
+    std::vector<md::MatchedLine> restLines; // StillLines
+    for (md::MatchedLine line : in.toDeform[m].lines)
     {
-      restLines.push_back(line.rest);
+      line.current = line.rest;
+      restLines.push_back(std::move(line));
     }
     md::KeptSurfaceEnergy& entry = this->Kept->energies[b];
     if (!entry.Holds(in.surfaces[b], restLines, parameters))

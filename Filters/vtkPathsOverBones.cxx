@@ -15,11 +15,13 @@
 #include <vtkFieldData.h>
 #include <vtkInformation.h>
 #include <vtkInformationVector.h>
+#include <vtkNew.h>
 #include <vtkObjectFactory.h>
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkStringArray.h>
+#include <vtkUnsignedCharArray.h>
 
 #include <algorithm>
 #include <map>
@@ -46,25 +48,6 @@ struct FrameAnswer
   std::vector<std::vector<md::PathOverBonesResult>> paths;
   std::map<std::string, std::vector<std::vector<md::Points>>> stepped;
 };
-
-std::vector<std::vector<vtkIdType>> PolylineIds(vtkPolyData* data)
-{
-  std::vector<std::vector<vtkIdType>> polylines;
-  vtkCellArray* cells = data ? data->GetLines() : nullptr;
-  if (!cells)
-  {
-    return polylines;
-  }
-  auto it = vtk::TakeSmartPointer(cells->NewIterator());
-  for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
-  {
-    vtkIdType size;
-    const vtkIdType* ids;
-    it->GetCurrentCell(size, ids);
-    polylines.emplace_back(ids, ids + size);
-  }
-  return polylines;
-}
 
 /// The names of the stepped poses `data` carries (point arrays PointsAt(<pose>)).
 std::vector<std::string> SteppedPoses(vtkPolyData* data)
@@ -225,7 +208,7 @@ int vtkPathsOverBones::RequestData(
   std::vector<PathLeaf> leaves(paths.size());
   for (size_t p = 0; p < paths.size(); ++p)
   {
-    leaves[p].polylines = PolylineIds(paths[p].data);
+    leaves[p].polylines = mdvtk::PolylineIds(paths[p].data);
     for (const std::vector<vtkIdType>& ids : leaves[p].polylines)
     {
       if (ids.size() < 2)
@@ -433,9 +416,9 @@ int vtkPathsOverBones::RequestData(
     {
       vtkAbstractArray* array = pd->GetAbstractArray(a);
       const std::string name = array->GetName() ? array->GetName() : "";
-      if (name.rfind("PointsAt(", 0) == 0 || name.empty())
+      if (name.rfind("PointsAt(", 0) == 0 || name.empty() || name == mdvtk::array::PathOwnPoint)
       {
-        continue; // written below from the stepped poses' answers
+        continue; // written below from the answers
       }
       if (auto* strings = vtkStringArray::SafeDownCast(array))
       {
@@ -482,6 +465,13 @@ int vtkPathsOverBones::RequestData(
       array->SetName(mdvtk::PointsAt(pose).c_str());
       out->GetPointData()->AddArray(array);
     }
+    vtkNew<vtkUnsignedCharArray> own;
+    own->SetName(mdvtk::array::PathOwnPoint);
+    for (const vtkIdType input : from)
+    {
+      own->InsertNextValue(input >= 0 ? 1 : 0);
+    }
+    out->GetPointData()->AddArray(own);
     mdvtk::AddFieldValue(out->GetFieldData(), "PathLength", length);
     mdvtk::AddFieldValue(out->GetFieldData(), "StraightPathLength", straight);
     results.push_back(out);

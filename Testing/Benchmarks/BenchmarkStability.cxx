@@ -116,10 +116,11 @@ Output RunFilterPass(const MotionCase& c, const Method& method, int hullPoints)
       std::vector<md::MuscleToSettle> toSettle;
       for (size_t m = 0; m < count; ++m)
       {
-        std::vector<md::Points> restLines;
-        for (const md::MatchedLine& line : toDeform[m].lines)
+        std::vector<md::MatchedLine> restLines; // StillLines
+        for (md::MatchedLine line : toDeform[m].lines)
         {
-          restLines.push_back(line.rest);
+          line.current = line.rest;
+          restLines.push_back(std::move(line));
         }
         energies.push_back(std::make_unique<md::SurfaceEnergy>(surfaces[m], restLines, md::SettleParameters{}));
         toSettle.push_back({ toDeform[m].name, &surfaces[m], toDeform[m].lines, energies.back().get() });

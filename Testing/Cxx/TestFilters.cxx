@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "FilterTestUtilities.h"
+#include "MDConvert.h"
 
 #include "vtkActionLineMatching.h"
 #include "vtkBoneInterpolation.h"
@@ -12,6 +13,7 @@
 #include <vtkPointData.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkTrivialProducer.h>
+#include <vtkUnsignedCharArray.h>
 
 #include <gtest/gtest.h>
 
@@ -126,6 +128,40 @@ TEST(ActionLineMatching, PlainPolyDataInputsGivePolyDataOutputs)
   EXPECT_EQ(outRest->GetNumberOfLines(), 2);
   EXPECT_EQ(outRest->GetNumberOfPoints(), outCurrent->GetNumberOfPoints());
   EXPECT_EQ(outRest->GetNumberOfPoints(), 3 + 3);
+}
+
+TEST(ActionLineMatching, APathsOwnPointsStayItsOwnAmongThePointsInserted)
+{
+  // PathOwnPoint (PathsOverBones'): the points matching inserts are not the path's own.
+  auto rest = MakePolylines({ { 0, 0, 0, 1, 0, 0, 1, 2, 0 }, { 5, 5, 5, 6, 6, 6 } });
+  vtkNew<vtkUnsignedCharArray> own;
+  own->SetName("PathOwnPoint");
+  for (const unsigned char value : { 1, 0, 1, 1, 1 })
+  {
+    own->InsertNextValue(value);
+  }
+  rest->GetPointData()->AddArray(own);
+  auto current = MakePolylines({ { 0, 0, 0, 0, 3, 0 }, { 5, 5, 5, 5, 5, 6, 6, 6, 6 } });
+  vtkNew<vtkActionLineMatching> matching;
+  matching->SetInputData(0, rest);
+  matching->SetInputData(1, current);
+  matching->Update();
+  auto* outRest = vtkPolyData::SafeDownCast(matching->GetOutputDataObject(0));
+  ASSERT_NE(outRest, nullptr);
+  vtkDataArray* matched = outRest->GetPointData()->GetArray("PathOwnPoint");
+  ASSERT_NE(matched, nullptr);
+  ASSERT_EQ(matched->GetNumberOfTuples(), 6);
+  const double expected[6] = { 1, 0, 1, 1, 0, 1 }; // the second line's middle point is inserted
+  for (vtkIdType i = 0; i < 6; ++i)
+  {
+    EXPECT_EQ(matched->GetTuple1(i), expected[i]) << i;
+  }
+  const std::vector<md::Knots> knots = mdvtk::ToKnots(outRest);
+  ASSERT_EQ(knots.size(), 2u);
+  EXPECT_EQ(knots[0], md::Knots({ 0, 2 }));
+  EXPECT_EQ(knots[1], md::Knots({ 0, 2 }));
+  // Without the array every point is its own.
+  EXPECT_TRUE(mdvtk::ToKnots(MakePolylines({ { 0, 0, 0, 1, 0, 0 } })).empty());
 }
 
 TEST(ActionLineMatching, BlocksThatShareNoNamePairByOrderWithANote)

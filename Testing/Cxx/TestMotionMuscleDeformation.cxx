@@ -9,6 +9,7 @@
 #include "vtkBoneInterpolation.h"
 #include "vtkMotionMuscleDeformation.h"
 #include "vtkMusculoskeletalPhantom.h"
+#include "vtkPathsOverBones.h"
 
 #include <vtkCallbackCommand.h>
 #include <vtkCellData.h>
@@ -18,6 +19,7 @@
 #include <vtkInformationVector.h>
 #include <vtkObjectFactory.h>
 #include <vtkPassInputTypeAlgorithm.h>
+#include <vtkPointData.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkTable.h>
 
@@ -404,4 +406,71 @@ TEST(MotionMuscleDeformation, FibresRunInsideEachMuscleAtEveryFrameWithTheirLeng
   ASSERT_EQ(p.At(4), 1);
   EXPECT_EQ(vtkMultiBlockDataSet::SafeDownCast(p.motion->GetOutputDataObject(4))->GetNumberOfBlocks(), 0u);
   EXPECT_EQ(LargestDifference(p.Muscle(0)->GetPoints(), with), 0.0);
+}
+
+TEST(MotionMuscleDeformation, PathsKeptOverTheBonesDriveTheMusclesByTheirOwnPoints)
+{
+  // PathsOverBones puts 3 points between each two of a path's own and marks its own
+  // (PathOwnPoint). With only a bone far away the paths are the straight ones subdivided, and the
+  // muscles move exactly as the plain lines move them; over the phantom's bones, every frame holds
+  // its volume and stays out of the bones.
+  PhantomMotionPipeline plain(30, 6);
+  ASSERT_EQ(plain.At(6), 1);
+  auto far = MakeBlocks({ { "Far", vtkSmartPointer<vtkPolyData>() } });
+  {
+    md::TriangleMesh box;
+    box.points.resize(8, 3);
+    for (int i = 0; i < 8; ++i)
+    {
+      box.points.row(i) << 1e5 + (i & 1), 1e5 + (i & 2 ? 1 : 0), 1e5 + (i & 4 ? 1 : 0);
+    }
+    box.triangles.resize(12, 3);
+    box.triangles << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5,
+      3, 7, 5;
+    far->SetBlock(0, mdvtk::ToPolyData(box));
+  }
+  for (const bool overBones : { false, true })
+  {
+    PhantomMotionPipeline p(30, 6);
+    vtkNew<vtkPathsOverBones> rest, moving;
+    rest->SetInputConnection(0, p.phantom->GetOutputPort(3));
+    moving->SetInputConnection(0, p.lines->GetOutputPort());
+    if (overBones)
+    {
+      rest->SetBonesConnection(p.phantom->GetOutputPort(1));
+      moving->SetBonesConnection(p.bones->GetOutputPort());
+    }
+    else
+    {
+      rest->SetInputData(1, far);
+      moving->SetInputData(1, far);
+    }
+    for (vtkPathsOverBones* paths : { rest.Get(), moving.Get() })
+    {
+      paths->SetPointsPerSegment(3);
+    }
+    p.motion->SetActionLinesRestConnection(rest->GetOutputPort());
+    p.motion->SetActionLinesMotionConnection(moving->GetOutputPort());
+    ASSERT_EQ(p.At(6), 1);
+    auto* line =
+      vtkPolyData::SafeDownCast(vtkMultiBlockDataSet::SafeDownCast(rest->GetOutputDataObject(0))->GetBlock(0));
+    vtkDataArray* own = line->GetPointData()->GetArray("PathOwnPoint");
+    ASSERT_NE(own, nullptr);
+    for (vtkIdType i = 0; i < line->GetNumberOfPoints(); ++i)
+    {
+      EXPECT_EQ(own->GetTuple1(i), i % 4 == 0 ? 1.0 : 0.0) << i;
+    }
+    const unsigned int muscles =
+      vtkMultiBlockDataSet::SafeDownCast(p.motion->GetOutputDataObject(0))->GetNumberOfBlocks();
+    for (unsigned int b = 0; b < muscles; ++b)
+    {
+      EXPECT_LT(std::abs(Field(p.Muscle(b), "VolumeChangePercent")), 1e-4) << b;
+      EXPECT_EQ(Field(p.Muscle(b), "MaxNewBonePenetrationDepth"), 0.0) << b;
+      const double apart = LargestDifference(p.Muscle(b)->GetPoints(), plain.Muscle(b)->GetPoints());
+      if (!overBones)
+      {
+        EXPECT_LT(apart, 1e-6) << "muscle " << b;
+      }
+    }
+  }
 }

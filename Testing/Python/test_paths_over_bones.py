@@ -2,7 +2,8 @@
 """PathsOverBones as a pvpython user runs it on the LHDL hip (skipped, exit 77, without the data): the
 reader's paths kept out of the scanned bones through both motions, at least as long as the
 straight paths, moving no further between frames than the bones do, with moment arms from the
-reader's stepped poses that agree with OpenSim 3.3's where the paths do not wrap."""
+reader's stepped poses that agree with OpenSim 3.3's where the paths do not wrap; and muscles driven
+by them (ActionLineGrouping, MotionMuscleDeformation) as sound as those driven by the straight paths."""
 import json
 import os
 import sys
@@ -78,6 +79,9 @@ class LhdlPathsOverBones(unittest.TestCase):
                     wrapped.add(name)
                 # Between two of the path's own points that lie outside a bone, no point is in it.
                 own = points[::PER]
+                # The path's own points are named as such (the deformation takes the path by them).
+                own_flags = mdtesting.vtk_to_numpy(path.GetPointData().GetArray("PathOwnPoint"))
+                self.assertEqual(list(own_flags), [int(i % PER == 0) for i in range(len(points))], name)
                 for bone, surface in surfaces.items():
                     own_in = inside(own, surface)
                     free = [i for i in range(len(points)) if i % PER and not own_in[i // PER] and not own_in[i // PER + 1]]
@@ -120,6 +124,78 @@ class LhdlPathsOverBones(unittest.TestCase):
 
     def test_hip_adduction(self):
         self.check_motion("hip_adduction")
+
+
+@unittest.skipIf(DATA is None or not os.path.isdir(os.path.join(DATA or "", "lhdl_hip_r")), "LHDL data not found")
+class LhdlMusclesDrivenByPathsOverBones(unittest.TestCase):
+    """The first frames of hip_flexion through MotionMuscleDeformation, its action lines from the
+    straight paths, from the paths subdivided but straight (PathsOverBones with a bone far away),
+    and from the paths over the scanned bones."""
+    FRAMES = 4
+
+    @classmethod
+    def setUpClass(cls):
+        from vtkmodules.vtkFiltersSources import vtkSphereSource
+        far = vtkSphereSource()
+        far.SetCenter(1e5, 1e5, 1e5)
+        far.Update()
+        cls.straight = cls.run_motion(None)
+        cls.subdivided = cls.run_motion("far", far.GetOutput())
+        cls.over = cls.run_motion("bones")
+
+    @classmethod
+    def run_motion(cls, paths_over, far_surface=None):
+        import lhdl
+        folder = os.path.join(DATA, "lhdl_hip_r")
+        reader = lhdl.model_reader(folder, "hip_flexion", 0, play=True)
+        reader.ConditionalPointFade = 10.0
+        bones = lhdl.producer(lhdl.named_blocks([(n, lhdl.read_surface(folder, n)) for n in BONES]), "bones")
+        muscles = lhdl.producer(lhdl.named_blocks([(n, lhdl.read_surface(folder, n)) for n in lhdl.MUSCLES]),
+                                "muscles")
+        moved = simple.MoveWithBodies(Input=bones, BodyTransforms=simple.OutputPort(reader, 4),
+                                      BodyOfSurface=lhdl.BODY_OF_SURFACE)
+        proxies = [reader, bones, muscles, moved]
+        paths_rest, paths_now = simple.OutputPort(reader, 3), simple.OutputPort(reader, 1)
+        if paths_over:
+            rest_bones, now_bones = bones, moved
+            if paths_over == "far":
+                rest_bones = now_bones = lhdl.producer(lhdl.named_blocks([("far", far_surface)]), "far")
+                proxies.append(rest_bones)
+            paths_rest = simple.PathsOverBones(Input=paths_rest, Bones=rest_bones, PointsPerSegment=3)
+            paths_now = simple.PathsOverBones(Input=paths_now, Bones=now_bones, PointsPerSegment=3)
+            proxies += [paths_rest, paths_now]
+        lines = simple.ActionLineGrouping(Input=muscles, Paths=paths_rest, PathsCurrent=paths_now)
+        motion = simple.MotionMuscleDeformation(Input=muscles, BonesRest=bones, BonesMotion=moved,
+                                                ActionLinesRest=simple.OutputPort(lines, 0),
+                                                ActionLinesMotion=simple.OutputPort(lines, 1))
+        frames = []
+        with mdtesting.CapturedMessages() as messages:
+            for t in list(reader.TimestepValues)[:cls.FRAMES]:
+                motion.UpdatePipeline(t)
+                frames.append(leaves(servermanager.Fetch(motion)))
+        for proxy in reversed(proxies + [lines, motion]):
+            simple.Delete(proxy)
+        return frames, messages.text
+
+    def test_a_path_subdivided_but_straight_drives_the_muscles_as_the_straight_path(self):
+        """The deformation takes a path piece by piece between its own points (PathOwnPoint), however
+        many points PathsOverBones puts between them."""
+        for k, (straight, subdivided) in enumerate(zip(self.straight[0], self.subdivided[0])):
+            for name, muscle in straight.items():
+                moved = numpy.linalg.norm(mdtesting.points(subdivided[name]) - mdtesting.points(muscle), axis=1)
+                self.assertLess(float(moved.max()), 1e-6, "%s at frame %d" % (name, k))
+
+    def test_paths_over_the_bones_drive_muscles_as_sound_as_the_straight_paths(self):
+        """No action line crosses a bone any more; the muscles keep their volume, turn no triangle
+        over, and lie within 3 mm of those the straight paths drive (the paths move by under 1 mm)."""
+        self.assertNotIn("crosses bone", self.over[1])
+        for k, (straight, over) in enumerate(zip(self.straight[0], self.over[0])):
+            for name, muscle in over.items():
+                where = "%s at frame %d" % (name, k)
+                self.assertEqual(field(muscle, "FlippedTriangleCount"), 0, where)
+                self.assertLess(abs(field(muscle, "VolumeChangePercent")), 1e-6, where)
+                moved = numpy.linalg.norm(mdtesting.points(muscle) - mdtesting.points(straight[name]), axis=1)
+                self.assertLess(float(moved.max()), 3.0, where)
 
 
 if __name__ == "__main__":

@@ -9,11 +9,16 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace md
 {
 /// n x 3 point coordinates, one point per row.
 using Points = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+/// The points of a polyline that are its own (a path's origin, via points and insertion), in
+/// rising order from its first point to its last, where PathsOverBones has put points between
+/// them. Empty: every point is the line's own.
+using Knots = std::vector<Eigen::Index>;
 /// m x 3 point indices, one triangle per row.
 using Triangles = Eigen::Matrix<std::int64_t, Eigen::Dynamic, 3, Eigen::RowMajor>;
 

@@ -165,21 +165,23 @@ void Validate(const MuscleToDeform& m)
     {
       throw InputError("an action line of " + name + " has non-finite coordinates");
     }
+    if (!KnotsFit(line.knots, line.rest.rows()))
+    {
+      throw InputError("an action line of " + name + " names its own points wrongly: " + kKnotsRule);
+    }
   }
 }
 
 /// Throws InputError when an action line of muscle `m` does not pass through it: none of its
-/// rest-pose samples (`restSamples`, each line's after the last's) is inside the muscle's hull.
-void CheckLinesPassThrough(const MuscleToDeform& m, const Points& restSamples, int samplesPerSegment)
+/// rest-pose samples is inside the muscle's hull.
+void CheckLinesPassThrough(const MuscleToDeform& m, int samplesPerSegment)
 {
   const TriangleTree hullTree(*m.hull);
-  Eigen::Index first = 0; // each line's samples follow the previous line's
   for (size_t l = 0; l < m.lines.size(); ++l)
   {
-    const Eigen::Index count = (m.lines[l].rest.rows() - 1) * std::max(1, samplesPerSegment) + 1;
-    const bool passes = CountInsideTree(hullTree, restSamples.middleRows(first, count)) > 0;
-    first += count;
-    if (!passes)
+    Points restSamples, unused;
+    SampleMatchedLines({ m.lines[l] }, samplesPerSegment, restSamples, unused);
+    if (CountInsideTree(hullTree, restSamples) == 0)
     {
       throw InputError("action line " + std::to_string(l + 1) + " of muscle '" + m.name +
         "' does not pass through the muscle (none of its rest-pose samples is inside the muscle's hull): "
@@ -254,7 +256,7 @@ void SetUp(MuscleState& s, const DeformationParameters& parameters)
   Points restSamples;
   Points& currentSamples = s.currentSamples;
   SampleMatchedLines(m.lines, parameters.samplesPerSegment, restSamples, currentSamples);
-  CheckLinesPassThrough(m, restSamples, parameters.samplesPerSegment);
+  CheckLinesPassThrough(m, parameters.samplesPerSegment);
   const WeightMatrix sampleWeights = coordinates.Compute(restSamples);
   const std::vector<Eigen::Index> anchored = HullPointsNoLineDrives(hull, restSamples);
   if (!anchored.empty())
@@ -839,6 +841,13 @@ double SegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const
 }
 }
 
+bool KnotsFit(const Knots& knots, Eigen::Index points)
+{
+  return knots.empty() ||
+    (knots.size() >= 2 && knots.front() == 0 && knots.back() == points - 1 &&
+      std::adjacent_find(knots.begin(), knots.end(), std::greater_equal<>()) == knots.end());
+}
+
 std::vector<std::string> LimitActionLinePoints(std::vector<MatchedLine>& lines, Eigen::Index maximumPoints)
 {
   std::vector<std::string> notes;
@@ -877,10 +886,18 @@ std::vector<std::string> LimitActionLinePoints(std::vector<MatchedLine>& lines, 
     // Deviations below rounding of the line's size: the points lie on the kept line.
     const double negligible = kDegenerateShare * BoxDiagonal(line.rest);
     std::vector<char> keep(static_cast<size_t>(n), 0);
-    keep.front() = keep.back() = 1;
-    Eigen::Index kept = 2;
     std::priority_queue<Span> queue;
-    queue.push(span(0, n - 1));
+    const Knots ends{ 0, n - 1 };
+    const Knots& own = line.knots.empty() ? ends : line.knots;
+    for (size_t j = 0; j < own.size(); ++j)
+    {
+      keep[static_cast<size_t>(own[j])] = 1;
+      if (j + 1 < own.size())
+      {
+        queue.push(span(own[j], own[j + 1]));
+      }
+    }
+    auto kept = static_cast<Eigen::Index>(own.size());
     double left = 0.0;
     while (!queue.empty())
     {
@@ -909,6 +926,10 @@ std::vector<std::string> LimitActionLinePoints(std::vector<MatchedLine>& lines, 
     {
       if (keep[static_cast<size_t>(k)])
       {
+        if (!line.knots.empty() && std::binary_search(line.knots.begin(), line.knots.end(), k))
+        {
+          reduced.knots.push_back(r);
+        }
         reduced.rest.row(r) = line.rest.row(k);
         reduced.current.row(r) = line.current.row(k);
         ++r;
@@ -930,23 +951,23 @@ void SampleMatchedLines(
   Eigen::Index count = 0;
   for (const MatchedLine& line : lines)
   {
-    count += (line.rest.rows() - 1) * samplesPerSegment + 1;
+    ForEachSpan(line, [&](const LineSpan&) { count += samplesPerSegment; });
+    ++count;
   }
   restSamples.resize(count, 3);
   currentSamples.resize(count, 3);
   Eigen::Index s = 0;
   for (const MatchedLine& line : lines)
   {
-    for (Eigen::Index k = 0; k + 1 < line.rest.rows(); ++k)
-    {
+    ForEachSpan(line, [&](const LineSpan& span) {
       for (int j = 0; j < samplesPerSegment; ++j)
       {
         const double t = static_cast<double>(j) / samplesPerSegment;
-        restSamples.row(s) = (1 - t) * line.rest.row(k) + t * line.rest.row(k + 1);
-        currentSamples.row(s) = (1 - t) * line.current.row(k) + t * line.current.row(k + 1);
+        restSamples.row(s) = span.At(line.rest, line.rest, t).transpose();
+        currentSamples.row(s) = span.At(line.rest, line.current, t).transpose();
         ++s;
       }
-    }
+    });
     restSamples.row(s) = line.rest.bottomRows(1);
     currentSamples.row(s) = line.current.bottomRows(1);
     ++s;

@@ -19,11 +19,15 @@
 namespace md
 {
 /// A matched action line (ActionLineMatching): the same number of points in
-/// both poses, point k of `rest` moving to point k of `current`.
+/// both poses, point k of `rest` moving to point k of `current`. The deformation takes the line
+/// piece by piece from one of its own points (`knots`) to the next (LineSpan), so that points put
+/// between them (a path kept over a bone) only say where the piece runs: each piece pulls and
+/// turns the muscle as one segment of the line does.
 struct MatchedLine
 {
   Points rest;
   Points current;
+  Knots knots;
 };
 
 struct DeformationParameters
@@ -171,15 +175,23 @@ std::vector<DeformationResult> DeformMusclesThatCan(const std::vector<MuscleToDe
   const std::vector<Obstacle>& bones, const DeformationParameters& parameters, std::vector<std::string>& failures,
   const std::function<void(double)>& progress = {});
 
+/// Whether `knots` name the own points of a line of `points` points: none (every point is its
+/// own), or rising from its first point to its last (kKnotsRule).
+bool KnotsFit(const Knots& knots, Eigen::Index points);
+inline constexpr const char* kKnotsRule =
+  "they must be none (every point its own) or rise from its first point to its last";
+
 /// Lines of more than `maximumPoints` points (a path sampled densely, a scanned centreline) are
 /// cut down to `maximumPoints`, keeping the points that deviate most from the kept line in either
 /// pose (greedy Douglas-Peucker on both poses at once), so that the action-line rows, which grow
-/// with the points, stay bounded. Lines within the limit are left exactly as they are. Returns
-/// one note per line cut down (its index, points before and after, largest deviation left).
+/// with the points, stay bounded. A line's own points (`knots`) are always kept. Lines within the
+/// limit are left exactly as they are. Returns one note per line cut down (its index, points
+/// before and after, largest deviation left).
 std::vector<std::string> LimitActionLinePoints(std::vector<MatchedLine>& lines, Eigen::Index maximumPoints = 256);
 
-/// Samples along matched lines: `samplesPerSegment` per segment plus the last
-/// point of each line, the same parameters on both poses.
+/// Samples along matched lines: `samplesPerSegment` per piece (LineSpan: a segment, or the
+/// points between two of the line's own points, evenly over its rest length) plus the last point
+/// of each line, at the same places on both poses.
 void SampleMatchedLines(
   const std::vector<MatchedLine>& lines, int samplesPerSegment, Points& restSamples, Points& currentSamples);
 

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The action-line segment nearest to a point, and how the segment's motion
 // carries the point: the rotations of the Laplacian coordinates and the
-// follow rows of the deformation (MuscleDeformer, SurfaceSettle).
+// follow rows of the deformation (MuscleDeformer, SurfaceSettle). A segment is
+// a piece of a line between two of its own points (LineSpan).
 #pragma once
 
 #include "Deformation/MuscleDeformer.h"
@@ -21,13 +22,101 @@ inline double SegmentFoot(const Eigen::Vector3d& p, const Eigen::Vector3d& a, co
   return length2 > 0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
 }
 
-/// The action-line segment nearest to p (over all lines), as line and index
-/// of its first point, with the parameter of p's foot on it in [0, 1].
-/// Segments of zero length in either pose carry no direction and are skipped.
+/// A piece of a matched line from one of its own points to the next (MatchedLine::knots): a
+/// segment, or the segments of a path that PathsOverBones kept over a bone.
+struct LineSpan
+{
+  Eigen::Index first = 0;
+  Eigen::Index last = 1;
+
+  /// The point of `pose` (the line's rest or current points) at parameter t in [0, 1] of the
+  /// piece: at that share of its rest length along it (on a segment, t along it).
+  Eigen::Vector3d At(const Points& rest, const Points& pose, double t) const
+  {
+    Eigen::Index j = this->first;
+    double u = t;
+    if (this->last > this->first + 1)
+    {
+      double along = t * this->RestLength(rest);
+      for (; j + 1 < this->last; ++j)
+      {
+        const double length = (rest.row(j + 1) - rest.row(j)).norm();
+        if (along <= length)
+        {
+          break;
+        }
+        along -= length;
+      }
+      const double length = (rest.row(j + 1) - rest.row(j)).norm();
+      u = length > 0 ? std::clamp(along / length, 0.0, 1.0) : 0.0;
+    }
+    return ((1 - u) * pose.row(j) + u * pose.row(j + 1)).transpose();
+  }
+
+  double RestLength(const Points& rest) const
+  {
+    double length = 0;
+    for (Eigen::Index j = this->first; j < this->last; ++j)
+    {
+      length += (rest.row(j + 1) - rest.row(j)).norm();
+    }
+    return length;
+  }
+
+  /// The parameter (share of the rest length) of the point of the piece at rest nearest to p,
+  /// and its distance from p.
+  std::pair<double, double> Foot(const Points& rest, const Eigen::Vector3d& p) const
+  {
+    if (this->last == this->first + 1)
+    {
+      const Eigen::Vector3d a = rest.row(this->first).transpose(), b = rest.row(this->last).transpose();
+      const double t = SegmentFoot(p, a, b);
+      return { t, (a + t * (b - a) - p).norm() };
+    }
+    double nearest = std::numeric_limits<double>::max(), at = 0, before = 0;
+    for (Eigen::Index j = this->first; j < this->last; ++j)
+    {
+      const Eigen::Vector3d a = rest.row(j).transpose(), b = rest.row(j + 1).transpose();
+      const double u = SegmentFoot(p, a, b), length = (b - a).norm();
+      const double d = (a + u * (b - a) - p).norm();
+      if (d < nearest)
+      {
+        nearest = d;
+        at = before + u * length;
+      }
+      before += length;
+    }
+    return { before > 0 ? at / before : 0.0, nearest };
+  }
+};
+
+/// Calls visit(span) for every piece of `line` (LineSpan), in order.
+template<typename Visit>
+void ForEachSpan(const MatchedLine& line, Visit&& visit)
+{
+  if (line.knots.empty())
+  {
+    for (Eigen::Index k = 0; k + 1 < line.rest.rows(); ++k)
+    {
+      visit(LineSpan{ k, k + 1 });
+    }
+    return;
+  }
+  for (size_t j = 0; j + 1 < line.knots.size(); ++j)
+  {
+    visit(LineSpan{ line.knots[j], line.knots[j + 1] });
+  }
+}
+
+/// The action-line piece nearest to p (over all lines; LineSpan: a segment, or a path between
+/// two of its own points), with the parameter of p's foot on it in [0, 1]. Pieces whose ends
+/// coincide in either pose carry no direction and are skipped. A piece turns the points near it
+/// as its end-to-end chord turns, as the line's own segment would; its points between say where
+/// its pull runs.
 struct NearestSegment
 {
   const MatchedLine* line = nullptr;
-  Eigen::Index k = 0;
+  LineSpan span;
   double t = 0;
 
   NearestSegment() = default;
@@ -43,54 +132,52 @@ struct NearestSegment
     });
   }
 
-  /// Calls visit(segment, distance of p from it) for every segment of `lines` that carries a
-  /// direction in both poses (segments of zero length are skipped), with p's foot on it.
+  /// Calls visit(piece, distance of p from it) for every piece of `lines` that carries a
+  /// direction in both poses, with p's foot on it.
   template<typename Visit>
   static void ForEachSegment(const Eigen::Vector3d& p, const std::vector<MatchedLine>& lines, Visit&& visit)
   {
     for (const MatchedLine& candidate : lines)
     {
-      for (Eigen::Index s = 0; s + 1 < candidate.rest.rows(); ++s)
-      {
-        const Eigen::Vector3d a = candidate.rest.row(s).transpose(), b = candidate.rest.row(s + 1).transpose();
-        if ((b - a).squaredNorm() == 0 || (candidate.current.row(s + 1) - candidate.current.row(s)).squaredNorm() == 0)
+      ForEachSpan(candidate, [&](const LineSpan& span) {
+        if ((candidate.rest.row(span.last) - candidate.rest.row(span.first)).squaredNorm() == 0 ||
+          (candidate.current.row(span.last) - candidate.current.row(span.first)).squaredNorm() == 0)
         {
-          continue;
+          return;
         }
         NearestSegment segment;
         segment.line = &candidate;
-        segment.k = s;
-        segment.t = SegmentFoot(p, a, b);
-        visit(segment, (a + segment.t * (b - a) - p).norm());
-      }
+        segment.span = span;
+        const auto [t, distance] = span.Foot(candidate.rest, p);
+        segment.t = t;
+        visit(segment, distance);
+      });
     }
   }
 
-  /// The rotation taking the segment's rest direction to its current one.
+  /// The rotation taking the piece's rest direction (end to end) to its current one.
   Eigen::Matrix3d Rotation() const
   {
     if (!this->line)
     {
       return Eigen::Matrix3d::Identity();
     }
-    return Eigen::Quaterniond::FromTwoVectors(
-      (this->line->rest.row(this->k + 1) - this->line->rest.row(this->k)).transpose(),
-      (this->line->current.row(this->k + 1) - this->line->current.row(this->k)).transpose())
+    const Points &rest = this->line->rest, &current = this->line->current;
+    return Eigen::Quaterniond::FromTwoVectors((rest.row(this->span.last) - rest.row(this->span.first)).transpose(),
+      (current.row(this->span.last) - current.row(this->span.first)).transpose())
       .toRotationMatrix();
   }
 
-  /// Where the segment's motion takes p: rotated about its foot on the
-  /// segment, which moves with the segment.
+  /// Where the piece's motion takes p: rotated about its foot on the piece, which moves with the
+  /// line's point at that place.
   Eigen::Vector3d Follow(const Eigen::Vector3d& p) const
   {
     if (!this->line)
     {
       return p;
     }
-    const auto at = [&](const Points& pose) {
-      return Eigen::Vector3d(((1 - this->t) * pose.row(this->k) + this->t * pose.row(this->k + 1)).transpose());
-    };
-    return at(this->line->current) + this->Rotation() * (p - at(this->line->rest));
+    const Points &rest = this->line->rest, &current = this->line->current;
+    return this->span.At(rest, current, this->t) + this->Rotation() * (p - this->span.At(rest, rest, this->t));
   }
 };
 

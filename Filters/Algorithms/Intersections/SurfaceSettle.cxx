@@ -99,7 +99,7 @@ RowEntries ChordRow(const TriangleTree& tree, const Eigen::Vector3d& p, double r
 }
 }
 
-SurfaceEnergy::SurfaceEnergy(const TriangleMesh& rest, const std::vector<Points>& restLines,
+SurfaceEnergy::SurfaceEnergy(const TriangleMesh& rest, const std::vector<MatchedLine>& restLines,
   const SettleParameters& parameters, const std::vector<Attachment>& attachments)
   : RestPoints(rest.points)
   , SamplesPerSegment(std::max(1, parameters.samplesPerSegment))
@@ -137,7 +137,7 @@ SurfaceEnergy::SurfaceEnergy(const TriangleMesh& rest, const std::vector<Points>
 
   // The action-line samples inside the rest muscle, as sparse rows.
   Points samples, unused;
-  SampleMatchedLines(StillLines(restLines), this->SamplesPerSegment, samples, unused);
+  SampleMatchedLines(restLines, this->SamplesPerSegment, samples, unused);
   const TriangleTree tree(welded);
   std::vector<RowEntries> sampleRows;
   for (Eigen::Index s = 0; s < samples.rows(); ++s)
@@ -587,12 +587,12 @@ std::vector<SurfaceEnergy::LetGo> SurfaceEnergy::SamplesLetGo(const std::vector<
   return letGo;
 }
 
-std::vector<MatchedLine> StillLines(const std::vector<Points>& restLines)
+std::vector<MatchedLine> StillLines(const std::vector<Points>& restLines, const std::vector<Knots>& knots)
 {
   std::vector<MatchedLine> still;
-  for (const Points& line : restLines)
+  for (size_t l = 0; l < restLines.size(); ++l)
   {
-    still.push_back({ line, line });
+    still.push_back({ restLines[l], restLines[l], l < knots.size() ? knots[l] : Knots() });
   }
   return still;
 }
@@ -1229,17 +1229,19 @@ std::vector<std::vector<double>> BoneClearancesAtEnd(const std::vector<TriangleM
 }
 }
 
-bool KeptSurfaceEnergy::Holds(const TriangleMesh& muscle, const std::vector<Points>& lines,
+bool KeptSurfaceEnergy::Holds(const TriangleMesh& muscle, const std::vector<MatchedLine>& lines,
   const SettleParameters& parameters, const std::vector<Attachment>& areas) const
 {
   return this->energy && SameMesh(this->surface, muscle) && this->settle.SameEnergyAs(parameters) &&
     this->attachments == areas &&
     std::equal(this->restLines.begin(), this->restLines.end(), lines.begin(), lines.end(),
-      [](const Points& a, const Points& b) { return a.rows() == b.rows() && a == b; });
+      [](const MatchedLine& a, const MatchedLine& b) {
+        return a.rest.rows() == b.rest.rows() && a.rest == b.rest && a.knots == b.knots;
+      });
 }
 
 void KeptSurfaceEnergy::Keep(std::shared_ptr<const SurfaceEnergy> built, const TriangleMesh& muscle,
-  const std::vector<Points>& lines, const SettleParameters& parameters, const std::vector<Attachment>& areas)
+  const std::vector<MatchedLine>& lines, const SettleParameters& parameters, const std::vector<Attachment>& areas)
 {
   this->attachments = areas;
   this->energy = std::move(built);
@@ -1273,17 +1275,6 @@ LineSamplesInside LineSamplesInBones(
     }
   }
   return inside;
-}
-
-LineSamplesInside RestLineSamplesInBones(
-  const std::vector<std::vector<Points>>& restLines, const std::vector<FixedObstacle>& bones, int samplesPerSegment)
-{
-  std::vector<std::vector<MatchedLine>> still;
-  for (const std::vector<Points>& lines : restLines)
-  {
-    still.push_back(StillLines(lines));
-  }
-  return LineSamplesInBones(still, bones, samplesPerSegment);
 }
 
 std::vector<std::string> LinesThroughBones(const std::vector<std::string>& names,
@@ -1320,17 +1311,15 @@ std::vector<std::string> LinesThroughBones(const std::vector<std::string>& names
 }
 
 SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::vector<const SurfaceEnergy*>& energies,
-  const std::vector<std::vector<Points>>& restLines, const std::vector<FixedObstacle>& restBones)
+  const std::vector<std::vector<MatchedLine>>& restLines, const std::vector<FixedObstacle>& restBones)
 {
   SettleMotion motion;
-  std::vector<std::vector<MatchedLine>> still;
   for (size_t m = 0; m < muscles.size(); ++m)
   {
-    still.push_back(StillLines(restLines[m]));
     motion.points.push_back(muscles[m].points);
-    motion.restDepths.push_back(energies[m]->SampleDepthsInBones(still.back(), restBones));
+    motion.restDepths.push_back(energies[m]->SampleDepthsInBones(restLines[m], restBones));
   }
-  motion.free = FreeMinima(energies, still, restBones);
+  motion.free = FreeMinima(energies, restLines, restBones);
   auto reference = std::make_shared<std::vector<Points>>();
   for (const FixedObstacle& bone : restBones)
   {

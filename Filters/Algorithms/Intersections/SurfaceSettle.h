@@ -131,10 +131,11 @@ struct SettleParameters
 class SurfaceEnergy
 {
 public:
-  /// `restLines`: the muscle's action lines in the rest pose (matched, the
-  /// same points as every pose's lines). Throws InputError when no sample of
-  /// the lines lies inside the muscle. `attachments`: the areas that move with their bones.
-  SurfaceEnergy(const TriangleMesh& rest, const std::vector<Points>& restLines, const SettleParameters& parameters,
+  /// `restLines`: the muscle's action lines in the rest pose as a motion that goes nowhere
+  /// (StillLines: the same points and own points as every pose's lines). Throws InputError
+  /// when no sample of the lines lies inside the muscle. `attachments`: the areas that move
+  /// with their bones.
+  SurfaceEnergy(const TriangleMesh& rest, const std::vector<MatchedLine>& restLines, const SettleParameters& parameters,
     const std::vector<Attachment>& attachments = {});
 
   /// Rows^T targets for the pose that `lines` (rest -> current) describe:
@@ -269,14 +270,15 @@ struct KeptSurfaceEnergy
 {
   std::shared_ptr<const SurfaceEnergy> energy;
   TriangleMesh surface;
-  std::vector<Points> restLines;
+  std::vector<MatchedLine> restLines;
   SettleParameters settle;
   std::vector<Attachment> attachments;
 
-  bool Holds(const TriangleMesh& muscle, const std::vector<Points>& lines, const SettleParameters& parameters,
+  bool Holds(const TriangleMesh& muscle, const std::vector<MatchedLine>& lines, const SettleParameters& parameters,
     const std::vector<Attachment>& areas = {}) const;
-  void Keep(std::shared_ptr<const SurfaceEnergy> built, const TriangleMesh& muscle, const std::vector<Points>& lines,
-    const SettleParameters& parameters, const std::vector<Attachment>& areas = {});
+  void Keep(std::shared_ptr<const SurfaceEnergy> built, const TriangleMesh& muscle,
+    const std::vector<MatchedLine>& lines, const SettleParameters& parameters,
+    const std::vector<Attachment>& areas = {});
 };
 
 /// [muscle][line][bone][sample]: whether each sample of the current pose of a muscle's matched
@@ -285,10 +287,6 @@ using LineSamplesInside = std::vector<std::vector<std::vector<std::vector<char>>
 /// LineSamplesInside of `lines[m]` (every muscle's matched lines) with `bones` in that pose.
 LineSamplesInside LineSamplesInBones(
   const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones, int samplesPerSegment);
-/// LineSamplesInBones of the rest pose: every muscle's lines `restLines[m]` (StillLines) with
-/// `bones` at rest, the scans' own overlap, which LinesThroughBones is not to warn of.
-LineSamplesInside RestLineSamplesInBones(
-  const std::vector<std::vector<Points>>& restLines, const std::vector<FixedObstacle>& bones, int samplesPerSegment);
 
 /// What to say of every muscle (`names[m]`) one of whose action lines (`lines[m]`, their current
 /// pose the bones') crosses a bone it did not cross at rest (`atRest`, LineSamplesInBones' of the
@@ -300,8 +298,9 @@ std::vector<std::string> LinesThroughBones(const std::vector<std::string>& names
   const std::vector<std::vector<MatchedLine>>& lines, const std::vector<FixedObstacle>& bones,
   const LineSamplesInside* atRest, int samplesPerSegment);
 
-/// The rest pose's lines as a motion that goes nowhere (rest -> rest).
-std::vector<MatchedLine> StillLines(const std::vector<Points>& restLines);
+/// The rest pose's lines as a motion that goes nowhere (rest -> rest), with their own points
+/// `knots[l]` (none given: every point is its own).
+std::vector<MatchedLine> StillLines(const std::vector<Points>& restLines, const std::vector<Knots>& knots = {});
 
 struct SettleReport
 {
@@ -370,10 +369,10 @@ std::vector<RigidFit> PlaceBones(
 std::vector<std::vector<double>> BoneClearancesNow(
   const SettleMotion& motion, const std::vector<TriangleMesh>& muscles, const std::vector<RigidFit>& placements);
 
-/// The start of a motion: `muscles` in the rest pose (their action lines `restLines`, the
-/// bones `restBones` in the rest pose).
+/// The start of a motion: `muscles` in the rest pose (their action lines `restLines`, StillLines,
+/// the bones `restBones` in the rest pose).
 SettleMotion StartMotion(const std::vector<TriangleMesh>& muscles, const std::vector<const SurfaceEnergy*>& energies,
-  const std::vector<std::vector<Points>>& restLines, const std::vector<FixedObstacle>& restBones);
+  const std::vector<std::vector<MatchedLine>>& restLines, const std::vector<FixedObstacle>& restBones);
 
 /// Every muscle's unconstrained minimum (no contact, no volume) of its full-mesh energy for the
 /// pose `lines[m]` describe, `bones` in that pose; in parallel.

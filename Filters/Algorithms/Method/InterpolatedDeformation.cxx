@@ -128,6 +128,10 @@ std::string ProblemOf(const MuscleMotion& m)
       return "an action line of muscle '" + m.name +
         "' is not matched: it needs at least two points, as many in the rest pose as in the current pose";
     }
+    if (!KnotsFit(line.knots, line.rest.rows()))
+    {
+      return "an action line of muscle '" + m.name + "' names its own points wrongly: " + kKnotsRule;
+    }
   }
   return {};
 }
@@ -206,7 +210,7 @@ Points HullRefitter::Fit(const Points& mesh, const Points& guess) const
 }
 
 std::vector<MatchedLine> MatchMuscleLines(const std::vector<Points>& rest, const std::vector<Points>& current,
-  double tolerance, std::vector<std::string>& notes)
+  double tolerance, std::vector<std::string>& notes, const std::vector<Knots>& knots)
 {
   if (rest.size() != current.size())
   {
@@ -217,7 +221,28 @@ std::vector<MatchedLine> MatchMuscleLines(const std::vector<Points>& rest, const
   for (size_t l = 0; l < rest.size(); ++l)
   {
     const MatchedActionLines pair = MatchActionLines(rest[l], current[l], tolerance);
-    lines.push_back({ pair.rest, pair.current });
+    // The rest line's own points keep their places among the points matching inserted.
+    Knots own;
+    if (l < knots.size() && !KnotsFit(knots[l], rest[l].rows()))
+    {
+      throw InputError("action line " + std::to_string(l + 1) + " names its own points wrongly: " + kKnotsRule);
+    }
+    if (l < knots.size() && !knots[l].empty())
+    {
+      std::vector<Eigen::Index> matchedIndex; // of each point of rest[l]
+      for (size_t k = 0; k < pair.restInserted.size(); ++k)
+      {
+        if (!pair.restInserted[k])
+        {
+          matchedIndex.push_back(static_cast<Eigen::Index>(k));
+        }
+      }
+      for (Eigen::Index k : knots[l])
+      {
+        own.push_back(matchedIndex.at(static_cast<size_t>(k)));
+      }
+    }
+    lines.push_back({ pair.rest, pair.current, std::move(own) });
   }
   notes = LimitActionLinePoints(lines);
   return lines;
@@ -397,9 +422,10 @@ std::vector<DeformationResult> DeformHullStep(HullPass& pass, int j, int steps,
     d.targetVolume = restVolumes[m];
     d.reference = &muscles[m].muscle.points; // folds an earlier step left are undone too
     d.boneOverlap = &pass.boneOverlap[m];
-    for (const PoseInterpolator& line : lineMotions[m])
+    for (size_t l = 0; l < lineMotions[m].size(); ++l)
     {
-      d.lines.push_back({ line.AtStep(j - 1, steps), line.AtStep(j, steps) });
+      const PoseInterpolator& line = lineMotions[m][l];
+      d.lines.push_back({ line.AtStep(j - 1, steps), line.AtStep(j, steps), muscles[m].lines[l].knots });
     }
   }
   return DeformMuscles(toDeform, obstacles, pass.step, progress);
@@ -478,7 +504,7 @@ struct SurfaceSteps
 {
   std::vector<std::shared_ptr<const SurfaceEnergy>> energies;
   std::vector<const SurfaceEnergy*> energyPointers;
-  std::vector<std::vector<Points>> restLines;
+  std::vector<std::vector<MatchedLine>> restLines; ///< StillLines
   SettleMotion settleMotion;
   LineSamplesInside linesInBonesAtRest;
 };
@@ -496,9 +522,10 @@ SurfaceSteps StartOnSurface(const std::vector<MuscleMotion>& muscles, const Meth
   s.restLines.resize(count);
   for (size_t m = 0; m < count; ++m)
   {
-    for (const PoseInterpolator& line : motions.lines[m])
+    for (size_t l = 0; l < motions.lines[m].size(); ++l)
     {
-      s.restLines[m].push_back(line.AtStep(0, steps));
+      const Points rest = motions.lines[m][l].AtStep(0, steps);
+      s.restLines[m].push_back({ rest, rest, muscles[m].lines[l].knots });
     }
   }
   s.energies = BuildEnergies(muscles, s.restLines, parameters.settle, kept, seconds);
@@ -511,7 +538,7 @@ SurfaceSteps StartOnSurface(const std::vector<MuscleMotion>& muscles, const Meth
     }
   }
   s.settleMotion = StartMotion(current, s.energyPointers, s.restLines, fixed);
-  s.linesInBonesAtRest = RestLineSamplesInBones(s.restLines, fixed, parameters.settle.samplesPerSegment);
+  s.linesInBonesAtRest = LineSamplesInBones(s.restLines, fixed, parameters.settle.samplesPerSegment);
   return s;
 }
 

@@ -205,10 +205,11 @@ auto WithCacheSubset(RestMappingCache& cache, const std::vector<size_t>& active,
 }
 
 /// One muscle's action lines as the method takes them: rest[l] matched with current[l]
-/// (MatchActionLines with `tolerance`), lines of too many points cut down (LimitActionLinePoints,
-/// said in `notes`). Both lists must be as long (InputError otherwise).
+/// (MatchActionLines with `tolerance`), with its own points `knots[l]` (none given: every point;
+/// they must fit rest[l], KnotsFit), lines of too many points cut down
+/// (LimitActionLinePoints, said in `notes`). Both lists must be as long (InputError otherwise).
 std::vector<MatchedLine> MatchMuscleLines(const std::vector<Points>& rest, const std::vector<Points>& current,
-  double tolerance, std::vector<std::string>& notes);
+  double tolerance, std::vector<std::string>& notes, const std::vector<Knots>& knots = {});
 
 /// Number of steps: `parameters.numberOfSteps`, or when 0 enough steps that no
 /// bone point moves more than `parameters.maximumStepDisplacement` in one.

@@ -34,11 +34,17 @@ std::string ProblemOf(const MotionDeformation::Muscle& m)
   {
     return "muscle '" + m.name + "' has no action line: nothing says where it goes";
   }
-  for (const Points& line : m.restLines)
+  for (size_t l = 0; l < m.restLines.size(); ++l)
   {
+    const Points& line = m.restLines[l];
     if (line.rows() < 2 || !AllFinite(line))
     {
       return "an action line of muscle '" + m.name + "' has fewer than two points or non-finite coordinates";
+    }
+    if (l < m.restKnots.size() && !KnotsFit(m.restKnots[l], line.rows()))
+    {
+      return "action line " + std::to_string(l + 1) + " of muscle '" + m.name +
+        "' names its own points wrongly: " + kKnotsRule;
     }
   }
   if (!AllFinite(m.rest.points))
@@ -69,7 +75,7 @@ void CheckRestBones(const std::vector<MotionDeformation::Bone>& bones)
 /// its message there and is left out. `active` gets the muscles that go, in order; `kept` (when
 /// given) keeps the energies by muscle for a later motion of the same rest pose.
 std::vector<std::shared_ptr<const SurfaceEnergy>> ActiveEnergies(const std::vector<MuscleMotion>& local,
-  const std::vector<std::vector<Points>>& localLines, const SettleParameters& parameters, RestMappingCache* kept,
+  const std::vector<std::vector<MatchedLine>>& localLines, const SettleParameters& parameters, RestMappingCache* kept,
   std::vector<std::string>& failures, std::vector<size_t>& active)
 {
   RestMappingCache scratch;
@@ -78,7 +84,7 @@ std::vector<std::shared_ptr<const SurfaceEnergy>> ActiveEnergies(const std::vect
   std::vector<double> seconds(local.size(), 0.0);
   return WithoutFailedMuscles(failures, [&](const std::vector<size_t>& going) {
     std::vector<MuscleMotion> subset;
-    std::vector<std::vector<Points>> subsetLines;
+    std::vector<std::vector<MatchedLine>> subsetLines;
     for (size_t m : going)
     {
       subset.push_back(local[m]);
@@ -152,9 +158,9 @@ struct MotionDeformation::Internals
   std::vector<size_t> active;         ///< the muscles that go, in order
   std::vector<std::string> failures;  ///< [muscle]
   std::vector<std::string> warnings;
-  std::vector<std::string> names;             ///< [active]
-  std::vector<MuscleMotion> muscles;          ///< [active], local; their lines are not used
-  std::vector<std::vector<Points>> restLines; ///< [active], local
+  std::vector<std::string> names;                  ///< [active]
+  std::vector<MuscleMotion> muscles;               ///< [active], local; their lines are not used
+  std::vector<std::vector<MatchedLine>> restLines; ///< [active], local, StillLines
   std::vector<std::shared_ptr<const SurfaceEnergy>> energies;
   std::vector<const SurfaceEnergy*> energyPointers;
   std::vector<double> restVolumes;
@@ -193,7 +199,7 @@ MotionDeformation::MotionDeformation(const std::vector<Muscle>& muscles, const s
 
   // Every muscle in the local frame; those whose energy cannot be built are left out.
   std::vector<MuscleMotion> local(muscles.size());
-  std::vector<std::vector<Points>> localLines(muscles.size());
+  std::vector<std::vector<MatchedLine>> localLines(muscles.size());
   for (size_t m = 0; m < muscles.size(); ++m)
   {
     local[m].name = muscles[m].name;
@@ -204,10 +210,11 @@ MotionDeformation::MotionDeformation(const std::vector<Muscle>& muscles, const s
     {
       in.frame.ToLocal(area.anchorsRest);
     }
-    localLines[m] = muscles[m].restLines;
-    for (Points& line : localLines[m])
+    localLines[m] = StillLines(muscles[m].restLines, muscles[m].restKnots);
+    for (MatchedLine& line : localLines[m])
     {
-      in.frame.ToLocal(line);
+      in.frame.ToLocal(line.rest);
+      line.current = line.rest;
     }
   }
   std::vector<TriangleMesh> restBones;
@@ -254,13 +261,20 @@ MotionDeformation::MotionDeformation(const std::vector<Muscle>& muscles, const s
   in.sharpEdges = MuscleSharpEdges(in.muscles);
   state->settle = StartMotion(state->current, in.energyPointers, in.restLines, in.fixed);
   state->settle.carryContacts = true; // a frame's contacts are the last frame's, moved on
-  in.linesInBonesAtRest = RestLineSamplesInBones(in.restLines, in.fixed, in.parameters.settle.samplesPerSegment);
+  in.linesInBonesAtRest = LineSamplesInBones(in.restLines, in.fixed, in.parameters.settle.samplesPerSegment);
   state->previous.resize(in.muscles.size());
   for (const TriangleMesh& b : restBones)
   {
     state->pose.bones.push_back(b.points);
   }
-  state->pose.lines = in.restLines;
+  for (const std::vector<MatchedLine>& lines : in.restLines)
+  {
+    state->pose.lines.emplace_back();
+    for (const MatchedLine& line : lines)
+    {
+      state->pose.lines.back().push_back(line.rest);
+    }
+  }
   this->Rest = std::move(state);
   this->Now = this->Rest;
   in.preparationSeconds = SecondsSince(start);
@@ -378,10 +392,11 @@ MotionPose MotionDeformation::ToLocalPose(const MotionPose& worldPose) const
     pose.lines.emplace_back();
     for (size_t l = 0; l < lines.size(); ++l)
     {
-      if (lines[l].rows() != in.restLines[k][l].rows() || !AllFinite(lines[l]))
+      if (lines[l].rows() != in.restLines[k][l].rest.rows() || !AllFinite(lines[l]))
       {
         throw InputError("action line " + std::to_string(l) + " of muscle '" + in.names[k] + "' has " +
-          std::to_string(lines[l].rows()) + " points in this pose but " + std::to_string(in.restLines[k][l].rows()) +
+          std::to_string(lines[l].rows()) + " points in this pose but " +
+          std::to_string(in.restLines[k][l].rest.rows()) +
           " in the rest pose, or non-finite coordinates: its points must be the same through the motion");
       }
       pose.lines.back().push_back(lines[l]);

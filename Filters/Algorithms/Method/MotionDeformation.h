@@ -66,6 +66,7 @@ public:
     TriangleMesh rest;                   ///< its surface in the rest pose
     std::vector<Points> restLines;       ///< its action lines in the rest pose
     std::vector<Attachment> attachments; ///< where it is attached (boneIndex: the bones' order)
+    std::vector<Knots> restKnots;        ///< [line]: its own points (MatchedLine); none given: all
   };
   struct Bone
   {

@@ -109,7 +109,9 @@ std::vector<std::vector<MatchedLine>> LinesAt(const SettleInput& in, double frac
   {
     for (size_t l = 0; l < in.lineMotions[m].size(); ++l)
     {
-      lines[m].push_back({ in.restLines[m][l], in.lineMotions[m][l].AtFraction(fraction) });
+      MatchedLine line = in.restLines[m][l];
+      line.current = in.lineMotions[m][l].AtFraction(fraction);
+      lines[m].push_back(std::move(line));
     }
   }
   return lines;
@@ -290,7 +292,7 @@ void FuseAttachments(OverlapMasks& masks, const std::vector<MuscleMotion>& muscl
 }
 
 std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vector<MuscleMotion>& muscles,
-  const std::vector<std::vector<Points>>& restLines, const SettleParameters& parameters, RestMappingCache* kept,
+  const std::vector<std::vector<MatchedLine>>& restLines, const SettleParameters& parameters, RestMappingCache* kept,
   std::vector<double>& seconds)
 {
   const size_t count = muscles.size();

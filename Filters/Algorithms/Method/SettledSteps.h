@@ -32,7 +32,7 @@ struct SettleInput
   const std::vector<Obstacle>& obstacles;
   const std::vector<PoseInterpolator>& boneMotions;
   const std::vector<std::vector<PoseInterpolator>>& lineMotions;
-  const std::vector<std::vector<Points>>& restLines;
+  const std::vector<std::vector<MatchedLine>>& restLines; ///< StillLines
   const std::vector<const SurfaceEnergy*>& energies;
   const std::vector<double>& volumes;
   const std::vector<FixedObstacle>& fixed;
@@ -97,10 +97,10 @@ std::vector<NewSharpEdges> MuscleSharpEdges(const std::vector<MuscleMotion>& mus
 void MeasuresToWorld(const LocalFrame& frame, MuscleStepMeasures& measures);
 
 /// The full-mesh energy of every muscle in the rest pose (`restLines[m]`, its matched lines
-/// there), or the one an earlier run left in `kept` where it still holds; those to build are
+/// there: StillLines), or the one an earlier run left in `kept` where it still holds; those to build are
 /// built in parallel. `seconds[m]` receives the time of each energy. A muscle whose energy cannot
 /// be built throws, marked as its own (OfMuscle).
 std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vector<MuscleMotion>& muscles,
-  const std::vector<std::vector<Points>>& restLines, const SettleParameters& parameters, RestMappingCache* kept,
+  const std::vector<std::vector<MatchedLine>>& restLines, const SettleParameters& parameters, RestMappingCache* kept,
   std::vector<double>& seconds);
 }

@@ -357,4 +357,16 @@ TEST(ActionLineLimit, DenseLinesAreCutDownKeepingTheirCornersAndShortOnesAreUnto
     EXPECT_TRUE(found) << corner.transpose();
   }
   EXPECT_LT((lines[1].current - lines[1].rest * turn.transpose()).cwiseAbs().maxCoeff(), 1e-9);
+  // A line's own points are kept whatever their deviation (here two on a straight stretch), and
+  // named again among the points kept.
+  md::MatchedLine withOwn = line;
+  withOwn.knots = { 0, 5000, 10000, 15000, 30000 };
+  std::vector<md::MatchedLine> owned{ withOwn };
+  md::LimitActionLinePoints(owned, 256);
+  ASSERT_EQ(owned[0].knots.size(), withOwn.knots.size());
+  EXPECT_TRUE(md::KnotsFit(owned[0].knots, owned[0].rest.rows()));
+  for (size_t j = 0; j < withOwn.knots.size(); ++j)
+  {
+    EXPECT_EQ(owned[0].rest.row(owned[0].knots[j]), withOwn.rest.row(withOwn.knots[j])) << j;
+  }
 }

@@ -36,10 +36,11 @@ struct OnePass
     }
     for (const md::MuscleMotion& m : c.muscles)
     {
-      std::vector<md::Points> restLines;
-      for (const md::MatchedLine& line : m.lines)
+      std::vector<md::MatchedLine> restLines; // StillLines
+      for (md::MatchedLine line : m.lines)
       {
-        restLines.push_back(line.rest);
+        line.current = line.rest;
+        restLines.push_back(std::move(line));
       }
       energies.push_back(std::make_unique<md::SurfaceEnergy>(m.muscle, restLines, md::SettleParameters()));
       muscles.push_back({ m.name, &m.muscle, m.lines, energies.back().get() });

@@ -14,6 +14,7 @@
 #include "Intersections/SurfaceSettle.h"
 #include "Method/InterpolatedDeformation.h"
 #include "Method/SettledSteps.h"
+#include "Motion/PathOverBones.h"
 #include "MotionCases.h"
 #include "RealData.h"
 #include "TestMeshes.h"
@@ -51,7 +52,7 @@ struct Spindle
 struct SpindleBesideABox
 {
   Spindle s;
-  md::SurfaceEnergy energy{ s.muscle, { s.line }, md::SettleParameters() };
+  md::SurfaceEnergy energy{ s.muscle, md::StillLines({ s.line }), md::SettleParameters() };
   md::TriangleTree bone{ Box({ 5, 14, -20 }, { 45, 40, 20 }) };
   std::vector<md::FixedObstacle> bones{ { "box", &bone } };
   SpindleBesideABox() = default;
@@ -141,10 +142,128 @@ TEST(BlendedSegments, ThePullOfTwoLinesDoesNotJumpHalfwayBetweenThem)
   EXPECT_LT((alone.follow - nearest.Follow(near)).norm(), 1e-9);
 }
 
+/// Settles the spindle from its rest pose towards `line` (rest and current poses of its action
+/// line, with its own points), with the energy built on the rest line.
+md::Points SettleAlong(const Spindle& s, const md::MatchedLine& line)
+{
+  const md::SurfaceEnergy energy(s.muscle, { { line.rest, line.rest, line.knots } }, md::SettleParameters());
+  std::vector<md::TriangleMesh> meshes{ s.muscle };
+  const double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
+  const std::vector<md::SettleReport> reports =
+    md::SettleMuscles(meshes, { &energy }, { { line } }, { volume }, {}, nullptr, md::SettleParameters());
+  EXPECT_TRUE(reports[0].converged);
+  return meshes[0].points;
+}
+
+/// The own points of SubdividedPath(line, per) for a line of `points` points.
+md::Knots OwnPointsOfSubdivided(Eigen::Index points, int per)
+{
+  md::Knots own;
+  for (Eigen::Index k = 0; k < points; ++k)
+  {
+    own.push_back(k * (per + 1));
+  }
+  return own;
+}
+
+TEST(SurfaceSettle, APathSubdividedBetweenItsOwnPointsPullsAsThePathItself)
+{
+  // PathsOverBones puts points between a path's own points and says which are its own. Where no
+  // bone is near they lie on the straight segment, and the muscle settles as along the plain
+  // line: the same samples, turns and follows. Taken segment by segment instead, three points
+  // between gave a line four times the pull (and, on the LHDL hip, 54 fibre points of the
+  // gluteus maximus outside it in flexion).
+  const Spindle s;
+  const md::Points current = Bent(s.line, 40);
+  const md::MatchedLine plain{ s.line, current };
+  const md::Knots own = OwnPointsOfSubdivided(s.line.rows(), 3);
+  const md::MatchedLine fine{ md::SubdividedPath(s.line, 3), md::SubdividedPath(current, 3), own };
+  const md::MatchedLine segmentBySegment{ fine.rest, fine.current };
+  md::Points restPlain, currentPlain, restFine, currentFine, restEach, currentEach;
+  md::SampleMatchedLines({ plain }, 10, restPlain, currentPlain);
+  md::SampleMatchedLines({ fine }, 10, restFine, currentFine);
+  md::SampleMatchedLines({ segmentBySegment }, 10, restEach, currentEach);
+  ASSERT_EQ(restFine.rows(), restPlain.rows());
+  EXPECT_EQ(restEach.rows(), 4 * (restPlain.rows() - 1) + 1);
+  EXPECT_LT((restFine - restPlain).cwiseAbs().maxCoeff(), 1e-12 * s.Size());
+  EXPECT_LT((currentFine - currentPlain).cwiseAbs().maxCoeff(), 1e-12 * s.Size());
+  for (double x = -40; x <= 40; x += 4)
+  {
+    for (double y : { -10.0, 0.5, 11.0 })
+    {
+      const Eigen::Vector3d p(x, y, 3);
+      const md::BlendedSegments a(p, { plain }, 2), b(p, { fine }, 2);
+      EXPECT_LT((a.rotation - b.rotation).norm(), 1e-12) << x << " " << y;
+      EXPECT_LT((a.follow - b.follow).norm(), 1e-12 * s.Size()) << x << " " << y;
+    }
+  }
+  const md::Points settledPlain = SettleAlong(s, plain), settledFine = SettleAlong(s, fine);
+  EXPECT_LT((settledFine - settledPlain).cwiseAbs().maxCoeff(), 1e-9 * s.Size());
+  // Segment by segment the muscle settles elsewhere: the own points are what keeps it.
+  EXPECT_GT((SettleAlong(s, segmentBySegment) - settledPlain).cwiseAbs().maxCoeff(), 1e-3 * s.Size());
+}
+
+TEST(SurfaceSettle, APathPushedOverABonePullsTheMuscleOverItAndTurnsItAsItsOwnSegment)
+{
+  // A path straight at rest and pushed over a bone in this pose: its points between its own ones
+  // leave the straight segment. The piece turns the muscle as the segment between the path's own
+  // points does (as the straight path would), and its samples, on the bent piece, pull the
+  // muscle's core over the bend, continuously with the push.
+  const Spindle s;
+  const md::Points current = Bent(s.line, 40);
+  const md::MatchedLine plain{ s.line, current };
+  const md::Points rest = md::SubdividedPath(s.line, 3);
+  const md::Points straight = md::SubdividedPath(current, 3);
+  const md::Knots own = OwnPointsOfSubdivided(s.line.rows(), 3);
+  const md::Points settledPlain = SettleAlong(s, plain);
+  const Eigen::Vector3d p(20, 5, 3);
+  const std::vector<md::MatchedLine> plainLines{ plain };
+  const md::NearestSegment nearestPlain(p, plainLines); // it points into the lines it is given
+  double lastLift = 0;
+  for (double push : { 0.5, 1.0, 1.5 })
+  {
+    md::Points bent = straight;
+    bent(6, 2) += push; // the middle point between the line's second and third, lifted in z
+    const std::vector<md::MatchedLine> over{ { rest, bent, own } };
+    const md::NearestSegment nearest(p, over);
+    EXPECT_LT((nearest.Rotation() - nearestPlain.Rotation()).norm(), 1e-12) << push;
+    const md::Points settled = SettleAlong(s, over[0]);
+    // The muscle's far half rises towards the bend, by less than the bend itself.
+    double lift = 0;
+    int count = 0;
+    for (Eigen::Index i = 0; i < settled.rows(); ++i)
+    {
+      if (s.muscle.points(i, 0) > 10)
+      {
+        lift += settled(i, 2) - settledPlain(i, 2);
+        ++count;
+      }
+    }
+    lift /= count;
+    EXPECT_GT(lift, 0.1 * push) << push;
+    EXPECT_LT(lift, push) << push;
+    EXPECT_GT(lift, lastLift) << push;
+    EXPECT_LT((settled - settledPlain).rowwise().norm().maxCoeff(), 2 * push) << push;
+    lastLift = lift;
+  }
+}
+
+TEST(SurfaceSettle, OwnPointsThatDoNotRiseAlongTheLineAreRefused)
+{
+  const Spindle s;
+  md::MuscleMotion motion{ "spindle", s.muscle, { { s.line, Bent(s.line, 40), { 0, 2, 1 } } } };
+  EXPECT_FALSE(md::KnotsFit(motion.lines[0].knots, 3));
+  EXPECT_FALSE(md::KnotsFit({ 0, 1 }, 3)); // the last point is always its own
+  EXPECT_TRUE(md::KnotsFit({ 0, 2 }, 3));
+  EXPECT_TRUE(md::KnotsFit({}, 3));
+  std::vector<std::string> notes;
+  EXPECT_THROW(md::MatchMuscleLines({ s.line }, { s.line }, 0.01, notes, { { 1, 2 } }), md::InputError);
+}
+
 TEST(SurfaceSettle, TheRestPoseIsItsOwnMinimum)
 {
   const Spindle s;
-  const md::SurfaceEnergy energy(s.muscle, { s.line }, md::SettleParameters());
+  const md::SurfaceEnergy energy(s.muscle, md::StillLines({ s.line }), md::SettleParameters());
   // Of the 21 samples (10 a segment, 3.6 apart from x = -36), the 17 within |x| < 30 are inside.
   EXPECT_EQ(energy.SampleCount(), 17);
   // From a start bulged on one side, it goes back to the rest pose.
@@ -163,7 +282,7 @@ TEST(SurfaceSettle, TheRestPoseIsItsOwnMinimum)
 TEST(SurfaceSettle, ARigidMotionOfTheLineMovesTheMuscleRigidly)
 {
   const Spindle s;
-  const md::SurfaceEnergy energy(s.muscle, { s.line }, md::SettleParameters());
+  const md::SurfaceEnergy energy(s.muscle, md::StillLines({ s.line }), md::SettleParameters());
   // A turn about an axis across the line (so the line's turn is that turn) and a shift.
   const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.6, Eigen::Vector3d(0, 1, 1).normalized()).toRotationMatrix();
   const Eigen::RowVector3d shift(5, -3, 8);
@@ -181,7 +300,7 @@ TEST(SurfaceSettle, ARigidMotionOfTheLineMovesTheMuscleRigidly)
 TEST(SurfaceSettle, TheAnswerDoesNotDependOnTheStartingGuess)
 {
   const Spindle s;
-  const md::SurfaceEnergy energy(s.muscle, { s.line }, md::SettleParameters());
+  const md::SurfaceEnergy energy(s.muscle, md::StillLines({ s.line }), md::SettleParameters());
   const md::Points current = Bent(s.line, 40);
   md::SettleReport fromRest, fromShifted;
   const md::Points a = Settle(s, energy, current, s.muscle.points, &fromRest);
@@ -279,14 +398,14 @@ TEST(SurfaceSettle, AScansDuplicatePointsChangeNothing)
   // triangles of no area would drop out exactly (cotangent 0) or weigh enormously once split.
   const Spindle s;
   const md::Points current = Bent(s.line, 40);
-  const md::SurfaceEnergy plain(s.muscle, { s.line }, md::SettleParameters());
+  const md::SurfaceEnergy plain(s.muscle, md::StillLines({ s.line }), md::SettleParameters());
   const md::Points expected = plain.Solve(plain.RightHandSide({ { s.line, current } }));
   const std::int64_t k = 40;
   for (const double split : { 0.0, 1e-7 * s.Size() })
   {
     const md::TriangleMesh seamed = WithASeamAt(s.muscle, k, Eigen::RowVector3d(split, -split, 0));
     ASSERT_EQ(md::CheckEdges(seamed.triangles).IsClosedOrientedManifold(), true);
-    const md::SurfaceEnergy energy(seamed, { s.line }, md::SettleParameters());
+    const md::SurfaceEnergy energy(seamed, md::StillLines({ s.line }), md::SettleParameters());
     EXPECT_EQ(energy.Surface().rows(), s.muscle.triangles.rows()) << "split " << split;
     const md::Points free = energy.Solve(energy.RightHandSide({ { s.line, current } }));
     EXPECT_LT((free.topRows(s.muscle.points.rows()) - expected).cwiseAbs().maxCoeff(), 1e-9 * s.Size())
@@ -326,8 +445,8 @@ TEST(SurfaceSettle, APieceNoLinePassesThroughIsSaid)
   // and the whole method, solved on the surface as on the hull, says so naming the muscle.
   const Spindle s;
   const md::TriangleMesh withPiece = WithAPieceApart(s.muscle, { 0, 40, 0 });
-  EXPECT_EQ(md::SurfaceEnergy(s.muscle, { s.line }, md::SettleParameters()).PointsNoLineDrives(), 0);
-  const md::SurfaceEnergy energy(withPiece, { s.line }, md::SettleParameters());
+  EXPECT_EQ(md::SurfaceEnergy(s.muscle, md::StillLines({ s.line }), md::SettleParameters()).PointsNoLineDrives(), 0);
+  const md::SurfaceEnergy energy(withPiece, md::StillLines({ s.line }), md::SettleParameters());
   EXPECT_EQ(energy.PointsNoLineDrives(), withPiece.points.rows() - s.muscle.points.rows());
   EXPECT_EQ(energy.PointsUsed(), withPiece.points.rows());
 
@@ -357,7 +476,7 @@ TEST(SurfaceSettle, AMuscleNoActionLinePassesThroughIsRefused)
   const Spindle s;
   md::Points away = s.line;
   away.col(1).array() += 100;
-  EXPECT_THROW(md::SurfaceEnergy(s.muscle, { away }, md::SettleParameters()), md::InputError);
+  EXPECT_THROW(md::SurfaceEnergy(s.muscle, md::StillLines({ away }), md::SettleParameters()), md::InputError);
 }
 
 TEST(SurfaceSettle, ABoneStopsTheMuscle)
@@ -401,7 +520,7 @@ TEST(SurfaceSettle, APointJustBeyondTheOffsetIsHeldAsOneJustWithin)
   // 7: 2.19 mm). Watched (SettleParameters::contactLookahead), it joins the step it would
   // break, and the two iterations' points differ by as little as the boxes.
   const Spindle s;
-  const md::SurfaceEnergy energy{ s.muscle, { s.line }, md::SettleParameters() };
+  const md::SurfaceEnergy energy{ s.muscle, md::StillLines({ s.line }), md::SettleParameters() };
   const md::Points current = Bent(s.line, 25);
   const double size = s.Size(), offset = md::SettleParameters().contactOffset * size;
   auto oneIteration = [&](double gap, double lookahead) {
@@ -454,7 +573,7 @@ TEST(SurfaceSettle, AMotionsContactsAreCarriedToItsNextStep)
       nullptr, md::SettleParameters(), &motion)[0];
     return meshes[0].points;
   };
-  md::SettleMotion carried = md::StartMotion({ s.muscle }, { &energy }, { { s.line } }, bones);
+  md::SettleMotion carried = md::StartMotion({ s.muscle }, { &energy }, { md::StillLines({ s.line }) }, bones);
   carried.carryContacts = true;
   md::SettleReport first, warm, cold;
   settle(carried, 25, first);
@@ -480,7 +599,7 @@ TEST(SurfaceSettle, AMotionsContactsAreCarriedToItsNextStep)
     EXPECT_EQ(carried.held.size(), static_cast<size_t>(warm.pointsInContact)) << degrees;
   }
   EXPECT_EQ(warm.pointsInContact, 0); // straight, the spindle is clear of the box: all let go
-  md::SettleMotion plain = md::StartMotion({ s.muscle }, { &energy }, { { s.line } }, bones);
+  md::SettleMotion plain = md::StartMotion({ s.muscle }, { &energy }, { md::StillLines({ s.line }) }, bones);
   settle(plain, 25, first);
   EXPECT_TRUE(plain.held.empty());
 }
@@ -502,7 +621,7 @@ TEST(SurfaceSettle, AMotionsStepThatJumpsIsSettledInPartsThatCarryTheirContacts)
   const std::vector<md::FixedObstacle> fixed{ { "box", obstacles[0].tree.get() } };
   const std::vector<md::PoseInterpolator> boneMotions{ md::PoseInterpolator(
     box.points, box.points, md::InterpolationMode::Rigid) };
-  const std::vector<std::vector<md::Points>> restLines{ { s.line } };
+  const std::vector<std::vector<md::MatchedLine>> restLines{ md::StillLines({ s.line }) };
   const std::vector<double> volumes{ md::EnclosedVolume(s.muscle.points, s.muscle.triangles) };
   const md::OverlapMasks noOverlap;
   const std::vector<const md::SurfaceEnergy*> energies{ &energy };
@@ -566,7 +685,7 @@ TEST(SurfaceSettle, ASettleProvesWhichPointsAreOutsideEachBoneAndTheStaticResolu
   const SpindleBesideABox setup;
   const auto& [s, energy, bone, bones] = setup;
   std::vector<md::TriangleMesh> meshes{ s.muscle };
-  md::SettleMotion motion = md::StartMotion({ s.muscle }, { &energy }, { { s.line } }, bones);
+  md::SettleMotion motion = md::StartMotion({ s.muscle }, { &energy }, { md::StillLines({ s.line }) }, bones);
   const md::SettleReport report = md::SettleMuscles(meshes, { &energy }, { { { s.line, Bent(s.line, 25) } } },
     { md::EnclosedVolume(s.muscle.points, s.muscle.triangles) }, bones, nullptr, md::SettleParameters(), &motion)[0];
   ASSERT_TRUE(report.converged);
@@ -625,7 +744,7 @@ TEST(SurfaceSettle, AMotionCarriesWhatItProvedOfTheBonesToItsNextSettle)
   SpindleBesideABox setup;
   const auto& [s, energy, bone, bones] = setup;
   const double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
-  md::SettleMotion motion = md::StartMotion({ s.muscle }, { &energy }, { { s.line } }, bones);
+  md::SettleMotion motion = md::StartMotion({ s.muscle }, { &energy }, { md::StillLines({ s.line }) }, bones);
   std::vector<md::TriangleMesh> meshes{ s.muscle };
   ASSERT_TRUE(md::SettleMuscles(meshes, { &energy }, { { { s.line, Bent(s.line, 25) } } }, { volume }, bones, nullptr,
     md::SettleParameters(), &motion)[0]
@@ -1100,8 +1219,8 @@ TEST(SurfaceSettle, AStepIsSettledInAsManyPartsAsTheMinimumMovesEighths)
   // SettleParts: one part where the lines stay, more the further the minimum moves, and about
   // twice as many with half the move allowed.
   const Spindle s;
-  const md::SurfaceEnergy energy(s.muscle, { s.line }, md::SettleParameters());
-  const md::SettleMotion motion = md::StartMotion({ s.muscle }, { &energy }, { { s.line } }, {});
+  const md::SurfaceEnergy energy(s.muscle, md::StillLines({ s.line }), md::SettleParameters());
+  const md::SettleMotion motion = md::StartMotion({ s.muscle }, { &energy }, { md::StillLines({ s.line }) }, {});
   auto parts = [&](double degrees, double largestStartMove) {
     md::SettleParameters parameters;
     parameters.largestStartMove = largestStartMove;
@@ -1133,8 +1252,8 @@ TEST(SurfaceSettle, CrossedMusclesSettleApartThoughTheirContactsOppose)
   const Eigen::RowVector3d apart(0, 20, 0);
   const md::Points otherLine = (s.line * turn.transpose()).rowwise() + apart;
   const md::TriangleMesh other{ (s.muscle.points * turn.transpose()).rowwise() + apart, s.muscle.triangles };
-  const md::SurfaceEnergy first(s.muscle, { s.line }, md::SettleParameters());
-  const md::SurfaceEnergy second(other, { otherLine }, md::SettleParameters());
+  const md::SurfaceEnergy first(s.muscle, md::StillLines({ s.line }), md::SettleParameters());
+  const md::SurfaceEnergy second(other, md::StillLines({ otherLine }), md::SettleParameters());
   const double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
   std::vector<md::TriangleMesh> meshes{ s.muscle, other };
   ASSERT_GT(CountInside(md::TriangleTree(meshes[1]), meshes[0].points), 10);
@@ -1220,8 +1339,8 @@ TEST(SurfaceSettle, DISABLED_TwoMusclesPressedTogetherBothGiveWay)
   const md::Points otherRest = s.muscle.points.rowwise() + apart;
   const md::Points otherLine = s.line.rowwise() + apart;
   const md::TriangleMesh other{ otherRest, s.muscle.triangles };
-  const md::SurfaceEnergy first(s.muscle, { s.line }, md::SettleParameters());
-  const md::SurfaceEnergy second(other, { otherLine }, md::SettleParameters());
+  const md::SurfaceEnergy first(s.muscle, md::StillLines({ s.line }), md::SettleParameters());
+  const md::SurfaceEnergy second(other, md::StillLines({ otherLine }), md::SettleParameters());
   md::Points otherBent = Bent(s.line, -40);
   otherBent.rowwise() += apart;
   const std::vector<std::vector<md::MatchedLine>> lines{ { { s.line, Bent(s.line, 40) } },
