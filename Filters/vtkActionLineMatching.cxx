@@ -176,16 +176,15 @@ int vtkActionLineMatching::RequestData(
       vtkNew<vtkUnsignedCharArray> own;
       own->SetName(mdvtk::array::PathOwnPoint);
       own->SetNumberOfValues(restOut->GetNumberOfPoints());
-      vtkIdType next = 0;
+      own->Fill(0);
+      vtkIdType first = 0; // of line l among the output's points
       for (size_t l = 0; l < restBuilder.lines.size(); ++l)
       {
-        Eigen::Index original = 0;
-        for (const bool inserted : restBuilder.inserted[l])
+        for (const Eigen::Index k : md::MatchedKnots(knots[l], restBuilder.inserted[l]))
         {
-          const bool isOwn = !inserted && std::binary_search(knots[l].begin(), knots[l].end(), original);
-          original += inserted ? 0 : 1;
-          own->SetValue(next++, isOwn ? 1 : 0);
+          own->SetValue(first + static_cast<vtkIdType>(k), 1);
         }
+        first += static_cast<vtkIdType>(restBuilder.lines[l].rows());
       }
       restOut->GetPointData()->AddArray(own);
     }

@@ -175,12 +175,7 @@ bool vtkMuscleDeformation::PassOnSurface(const PassInput& in, std::vector<std::s
       continue;
     }
     const auto energyStart = Clock::now();
-    std::vector<md::MatchedLine> restLines; // StillLines
-    for (md::MatchedLine line : in.toDeform[m].lines)
-    {
-      line.current = line.rest;
-      restLines.push_back(std::move(line));
-    }
+    const std::vector<md::MatchedLine> restLines = md::StillLines(in.toDeform[m].lines);
     md::KeptSurfaceEnergy& entry = this->Kept->energies[b];
     if (!entry.Holds(in.surfaces[b], restLines, parameters))
     {

@@ -116,12 +116,7 @@ Output RunFilterPass(const MotionCase& c, const Method& method, int hullPoints)
       std::vector<md::MuscleToSettle> toSettle;
       for (size_t m = 0; m < count; ++m)
       {
-        std::vector<md::MatchedLine> restLines; // StillLines
-        for (md::MatchedLine line : toDeform[m].lines)
-        {
-          line.current = line.rest;
-          restLines.push_back(std::move(line));
-        }
+        const std::vector<md::MatchedLine> restLines = md::StillLines(toDeform[m].lines);
         energies.push_back(std::make_unique<md::SurfaceEnergy>(surfaces[m], restLines, md::SettleParameters{}));
         toSettle.push_back({ toDeform[m].name, &surfaces[m], toDeform[m].lines, energies.back().get() });
       }

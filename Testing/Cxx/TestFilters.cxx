@@ -46,6 +46,25 @@ int Update(vtkAlgorithm* algorithm)
 {
   return algorithm->GetExecutive()->Update();
 }
+
+/// Two plain polylines in each pose: the first of 3 rest points against 2 current ones, the
+/// second of 2 against 3 (a point is inserted on each pose's line).
+vtkSmartPointer<vtkPolyData> TwoLinesRest()
+{
+  return MakePolylines({ { 0, 0, 0, 1, 0, 0, 1, 2, 0 }, { 5, 5, 5, 6, 6, 6 } });
+}
+vtkSmartPointer<vtkPolyData> TwoLinesCurrent()
+{
+  return MakePolylines({ { 0, 0, 0, 0, 3, 0 }, { 5, 5, 5, 5, 5, 6, 6, 6, 6 } });
+}
+
+/// `matching` run on `rest` and `current`.
+void Match(vtkActionLineMatching* matching, vtkDataObject* rest, vtkDataObject* current)
+{
+  matching->SetInputData(0, rest);
+  matching->SetInputData(1, current);
+  matching->Update();
+}
 }
 
 TEST(MusculoskeletalPhantom, OutputsNamedBlocksOnFivePorts)
@@ -115,12 +134,8 @@ TEST(ActionLineMatching, PairsBlocksByNameAndCarriesTheCurrentPosition)
 
 TEST(ActionLineMatching, PlainPolyDataInputsGivePolyDataOutputs)
 {
-  auto rest = MakePolylines({ { 0, 0, 0, 1, 0, 0, 1, 2, 0 }, { 5, 5, 5, 6, 6, 6 } });
-  auto current = MakePolylines({ { 0, 0, 0, 0, 3, 0 }, { 5, 5, 5, 5, 5, 6, 6, 6, 6 } });
   vtkNew<vtkActionLineMatching> matching;
-  matching->SetInputData(0, rest);
-  matching->SetInputData(1, current);
-  matching->Update();
+  Match(matching, TwoLinesRest(), TwoLinesCurrent());
   auto* outRest = vtkPolyData::SafeDownCast(matching->GetOutputDataObject(0));
   auto* outCurrent = vtkPolyData::SafeDownCast(matching->GetOutputDataObject(1));
   ASSERT_NE(outRest, nullptr);
@@ -133,7 +148,7 @@ TEST(ActionLineMatching, PlainPolyDataInputsGivePolyDataOutputs)
 TEST(ActionLineMatching, APathsOwnPointsStayItsOwnAmongThePointsInserted)
 {
   // PathOwnPoint (PathsOverBones'): the points matching inserts are not the path's own.
-  auto rest = MakePolylines({ { 0, 0, 0, 1, 0, 0, 1, 2, 0 }, { 5, 5, 5, 6, 6, 6 } });
+  auto rest = TwoLinesRest();
   vtkNew<vtkUnsignedCharArray> own;
   own->SetName("PathOwnPoint");
   for (const unsigned char value : { 1, 0, 1, 1, 1 })
@@ -141,11 +156,8 @@ TEST(ActionLineMatching, APathsOwnPointsStayItsOwnAmongThePointsInserted)
     own->InsertNextValue(value);
   }
   rest->GetPointData()->AddArray(own);
-  auto current = MakePolylines({ { 0, 0, 0, 0, 3, 0 }, { 5, 5, 5, 5, 5, 6, 6, 6, 6 } });
   vtkNew<vtkActionLineMatching> matching;
-  matching->SetInputData(0, rest);
-  matching->SetInputData(1, current);
-  matching->Update();
+  Match(matching, rest, TwoLinesCurrent());
   auto* outRest = vtkPolyData::SafeDownCast(matching->GetOutputDataObject(0));
   ASSERT_NE(outRest, nullptr);
   vtkDataArray* matched = outRest->GetPointData()->GetArray("PathOwnPoint");

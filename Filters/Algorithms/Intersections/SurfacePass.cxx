@@ -11,7 +11,7 @@ std::vector<SurfacePassResult> SettleInOnePass(const std::vector<MuscleToSettle>
   std::vector<TriangleMesh> rest(count), settled(count);
   std::vector<const SurfaceEnergy*> energies(count);
   std::vector<std::vector<MatchedLine>> lines(count);
-  std::vector<std::vector<MatchedLine>> restLines(count); // StillLines
+  std::vector<std::vector<MatchedLine>> restLines(count);
   std::vector<std::string> names(count);
   std::vector<double> volumes(count);
   for (size_t m = 0; m < count; ++m)
@@ -20,11 +20,7 @@ std::vector<SurfacePassResult> SettleInOnePass(const std::vector<MuscleToSettle>
     settled[m] = rest[m];
     energies[m] = muscles[m].energy;
     lines[m] = muscles[m].lines;
-    for (MatchedLine line : lines[m])
-    {
-      line.current = line.rest;
-      restLines[m].push_back(std::move(line));
-    }
+    restLines[m] = StillLines(lines[m]);
     names[m] = muscles[m].name;
     volumes[m] = EnclosedVolume(rest[m].points, rest[m].triangles);
   }

@@ -597,6 +597,16 @@ std::vector<MatchedLine> StillLines(const std::vector<Points>& restLines, const 
   return still;
 }
 
+std::vector<MatchedLine> StillLines(const std::vector<MatchedLine>& lines)
+{
+  std::vector<MatchedLine> still;
+  for (const MatchedLine& line : lines)
+  {
+    still.push_back({ line.rest, line.rest, line.knots });
+  }
+  return still;
+}
+
 std::vector<double> SurfaceEnergy::FollowWeights() const
 {
   std::vector<double> weights(this->PointUsed.size());

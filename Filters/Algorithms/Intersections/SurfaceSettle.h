@@ -301,6 +301,8 @@ std::vector<std::string> LinesThroughBones(const std::vector<std::string>& names
 /// The rest pose's lines as a motion that goes nowhere (rest -> rest), with their own points
 /// `knots[l]` (none given: every point is its own).
 std::vector<MatchedLine> StillLines(const std::vector<Points>& restLines, const std::vector<Knots>& knots = {});
+/// The rest poses of matched lines, with their own points, as a motion that goes nowhere.
+std::vector<MatchedLine> StillLines(const std::vector<MatchedLine>& lines);
 
 struct SettleReport
 {

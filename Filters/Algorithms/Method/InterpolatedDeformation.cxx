@@ -221,28 +221,12 @@ std::vector<MatchedLine> MatchMuscleLines(const std::vector<Points>& rest, const
   for (size_t l = 0; l < rest.size(); ++l)
   {
     const MatchedActionLines pair = MatchActionLines(rest[l], current[l], tolerance);
-    // The rest line's own points keep their places among the points matching inserted.
-    Knots own;
     if (l < knots.size() && !KnotsFit(knots[l], rest[l].rows()))
     {
       throw InputError("action line " + std::to_string(l + 1) + " names its own points wrongly: " + kKnotsRule);
     }
-    if (l < knots.size() && !knots[l].empty())
-    {
-      std::vector<Eigen::Index> matchedIndex; // of each point of rest[l]
-      for (size_t k = 0; k < pair.restInserted.size(); ++k)
-      {
-        if (!pair.restInserted[k])
-        {
-          matchedIndex.push_back(static_cast<Eigen::Index>(k));
-        }
-      }
-      for (Eigen::Index k : knots[l])
-      {
-        own.push_back(matchedIndex.at(static_cast<size_t>(k)));
-      }
-    }
-    lines.push_back({ pair.rest, pair.current, std::move(own) });
+    const Knots own = l < knots.size() ? MatchedKnots(knots[l], pair.restInserted) : Knots();
+    lines.push_back({ pair.rest, pair.current, own });
   }
   notes = LimitActionLinePoints(lines);
   return lines;

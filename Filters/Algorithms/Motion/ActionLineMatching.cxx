@@ -152,4 +152,25 @@ MatchedActionLines MatchActionLines(const Points& rest, const Points& current, d
   }
   return result;
 }
+
+Knots MatchedKnots(const Knots& own, const std::vector<bool>& restInserted)
+{
+  Knots matched;
+  Eigen::Index original = 0; // points of the rest line before matched point k
+  auto next = own.begin();
+  for (size_t k = 0; k < restInserted.size() && next != own.end(); ++k)
+  {
+    if (restInserted[k])
+    {
+      continue;
+    }
+    if (*next == original)
+    {
+      matched.push_back(static_cast<Eigen::Index>(k));
+      ++next;
+    }
+    ++original;
+  }
+  return matched;
+}
 }

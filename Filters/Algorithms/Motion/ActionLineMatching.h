@@ -42,4 +42,8 @@ struct MatchedActionLines
 /// at t' = t_i; CP points left unmatched get a new RP point at t = t'_j. Both
 /// results list the matched pairs in order along the lines.
 MatchedActionLines MatchActionLines(const Points& rest, const Points& current, double tolerance);
+
+/// The own points `own` of a rest line (rising indices of its points) as indices of its matched
+/// line, whose points are the line's own and those matching inserted (`restInserted`).
+Knots MatchedKnots(const Knots& own, const std::vector<bool>& restInserted);
 }

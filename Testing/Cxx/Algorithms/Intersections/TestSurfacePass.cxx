@@ -36,12 +36,7 @@ struct OnePass
     }
     for (const md::MuscleMotion& m : c.muscles)
     {
-      std::vector<md::MatchedLine> restLines; // StillLines
-      for (md::MatchedLine line : m.lines)
-      {
-        line.current = line.rest;
-        restLines.push_back(std::move(line));
-      }
+      const std::vector<md::MatchedLine> restLines = md::StillLines(m.lines);
       energies.push_back(std::make_unique<md::SurfaceEnergy>(m.muscle, restLines, md::SettleParameters()));
       muscles.push_back({ m.name, &m.muscle, m.lines, energies.back().get() });
     }

@@ -258,6 +258,11 @@ TEST(SurfaceSettle, OwnPointsThatDoNotRiseAlongTheLineAreRefused)
   EXPECT_TRUE(md::KnotsFit({}, 3));
   std::vector<std::string> notes;
   EXPECT_THROW(md::MatchMuscleLines({ s.line }, { s.line }, 0.01, notes, { { 1, 2 } }), md::InputError);
+  // Matching inserts a rest point where the current line has one more: not the line's own.
+  const md::Points ends = s.line({ 0, 2 }, Eigen::placeholders::all);
+  const std::vector<md::MatchedLine> matched = md::MatchMuscleLines({ ends }, { s.line }, 0.01, notes, { { 0, 1 } });
+  ASSERT_EQ(matched[0].rest.rows(), 3);
+  EXPECT_EQ(matched[0].knots, md::Knots({ 0, 2 }));
 }
 
 TEST(SurfaceSettle, TheRestPoseIsItsOwnMinimum)
