@@ -683,7 +683,30 @@ void vtkOpenSimModelReader::WritePaths(const std::vector<double>& coordinates,
     block->GetPointData()->AddArray(onBody);
     block->GetCellData()->AddArray(lineName);
     mdvtk::AddFieldValue(block->GetFieldData(), "PathLength", this->Scale * g.length);
+    this->WriteMuscleProperties(path, block->GetFieldData());
     mdvtk::AddBlock(tree, path.name, block);
+  }
+}
+
+void vtkOpenSimModelReader::WriteMuscleProperties(const md::osim::Path& path, vtkFieldData* fieldData) const
+{
+  auto type = vtkSmartPointer<vtkStringArray>::New();
+  type->SetName("MuscleType");
+  type->InsertNextValue(path.type);
+  fieldData->AddArray(type);
+  mdvtk::AddFieldValue(fieldData, "MetresPerLengthUnit", 1.0 / this->Scale);
+  // As OpenSim names them; the lengths in the output's unit, as every other length here.
+  const md::MuscleProperties& muscle = path.muscle;
+  const std::pair<const char*, double> values[] = { { "max_isometric_force", muscle.maxIsometricForce },
+    { "optimal_fiber_length", this->Scale * muscle.optimalFiberLength },
+    { "tendon_slack_length", this->Scale * muscle.tendonSlackLength },
+    { "pennation_angle_at_optimal", muscle.pennationAngle } };
+  for (const auto& [name, value] : values)
+  {
+    if (std::isfinite(value))
+    {
+      mdvtk::AddFieldValue(fieldData, name, value);
+    }
   }
 }
 

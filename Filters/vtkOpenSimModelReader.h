@@ -11,11 +11,12 @@
  * Output ports (each but 4 a vtkMultiBlockDataSet of named vtkPolyData blocks):
  * 0 Bodies at the current time (one block per body, its mesh files; field data
  *   RestToCurrentTransform), 1 MusclePaths at the current time (one polyline per muscle; point
- *   data PathPointName, PathPointBody), 2 BodiesRest, 3 MusclePathsRest, 4 BodyTransforms (a
- *   vtkTable: each body's rigid transform from the rest pose to the current time, x_CP = R x_RP +
- *   t), 5 WrapObjects at the current time, 6 MomentArms (a vtkTable, a row per frame of the
- *   motion, or one at the rest pose: the time, the coordinates that move, each path's length and
- *   its moment arm about each of them, r = -dL/dq, OpenSim's sign).
+ *   data PathPointName, PathPointBody; field data PathLength, MuscleType, MetresPerLengthUnit and,
+ *   for a muscle, OpenSim's max_isometric_force (N), optimal_fiber_length, tendon_slack_length
+ *   (in the output's unit) and pennation_angle_at_optimal (radians)), 2 BodiesRest, 3 MusclePathsRest, 4 BodyTransforms
+ * (a vtkTable: each body's rigid transform from the rest pose to the current time, x_CP = R x_RP + t), 5 WrapObjects at
+ * the current time, 6 MomentArms (a vtkTable, a row per frame of the motion, or one at the rest pose: the time, the
+ * coordinates that move, each path's length and its moment arm about each of them, r = -dL/dq, OpenSim's sign).
  *
  * Every output is in the frame that ReferenceBody has at the rest pose (ground when empty), in
  * the model's units times Scale (1000: millimetres for a model in metres), so that surfaces
@@ -31,10 +32,15 @@
 #include <string>
 #include <vector>
 
+class vtkFieldData;
 class vtkTable;
 namespace md
 {
 struct RigidTransform;
+namespace osim
+{
+struct Path;
+}
 }
 
 class MUSCLEDEFORMATIONFILTERS_EXPORT vtkOpenSimModelReader : public vtkMultiBlockDataSetAlgorithm
@@ -199,6 +205,9 @@ private:
   /// Outputs WRAP_OBJECTS and BODY_TRANSFORMS at `poses` (and `stepped`).
   void WriteWrapsAndTransforms(const std::vector<md::RigidTransform>& poses, const std::vector<double>& q, double time,
     const std::vector<SteppedPose>& stepped, vtkInformationVector* outputVector) const;
+  /// The path's MuscleType, MetresPerLengthUnit and, where the model gives them, its muscle's
+  /// properties under OpenSim's names (lengths in the output's unit).
+  void WriteMuscleProperties(const md::osim::Path& path, vtkFieldData* fieldData) const;
   /// Output MOMENT_ARMS, computed once per model, motion and Scale.
   void WriteMomentArms(vtkTable* table);
   /// Output BODY_TRANSFORMS: each body's rest-to-current motion; the time and coordinates as field data.

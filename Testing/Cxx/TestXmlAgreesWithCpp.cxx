@@ -13,6 +13,7 @@
 #include "vtkMotionMuscleDeformation.h"
 #include "vtkMoveWithBodies.h"
 #include "vtkMuscleDeformation.h"
+#include "vtkMuscleFromPath.h"
 #include "vtkMusculoskeletalPhantom.h"
 #include "vtkOpenSimModelReader.h"
 #include "vtkPathsOverBones.h"
@@ -47,6 +48,7 @@ const std::map<std::string, std::function<vtkSmartPointer<vtkObject>()>> Classes
   { "vtkActionLineMatching", Make<vtkActionLineMatching> },
   { "vtkBoneInterpolation", Make<vtkBoneInterpolation> },
   { "vtkHullDecimation", Make<vtkHullDecimation> },
+  { "vtkMuscleFromPath", Make<vtkMuscleFromPath> },
   { "vtkInterpolatedMuscleDeformation", Make<vtkInterpolatedMuscleDeformation> },
   { "vtkIntersectionResolve", Make<vtkIntersectionResolve> },
   { "vtkMotionMuscleDeformation", Make<vtkMotionMuscleDeformation> },
@@ -175,8 +177,8 @@ TEST(ServerManagerXml, EveryNumericDefaultIsTheConstructorsDefault)
       << className << "." << a["name"] << ": XML default " << a["default_values"] << ", C++ " << printed;
     ++compared;
   }
-  EXPECT_EQ(files, 11u) << "one file per proxy";
-  EXPECT_GE(compared, 39); // every numeric property the XML had when this was written: the parsing works
+  EXPECT_EQ(files, 12u) << "one file per proxy";
+  EXPECT_GE(compared, 42); // every numeric property the XML had when this was written: the parsing works
 }
 
 namespace

@@ -178,6 +178,38 @@ class Inputs:
         self.data["matched"] = vtkMultiBlockDataSet()
         self.data["matched"].DeepCopy(matching.GetClientSideObject().GetOutputDataObject(0))
         self.data["transforms"] = body_transforms(self.data["bones_rest"])
+        self.data["paths"] = muscle_paths(self.data["lines_rest"])
+
+
+def muscle_paths(lines):
+    """A block per polyline of `lines`, with a muscle's properties as the OpenSim reader writes
+    them (lengths in mm), as MuscleFromPath takes them."""
+    from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkPoints
+    from vtkmodules.vtkCommonDataModel import vtkCellArray
+    tree = vtkMultiBlockDataSet()
+    for b in range(lines.GetNumberOfBlocks()):
+        leaf = lines.GetBlock(b)
+        ids = leaf.GetLines()
+        ids.InitTraversal()
+        for cell in range(leaf.GetNumberOfLines()):
+            path = vtkPolyData()
+            points, line = vtkPoints(), vtkCellArray()
+            cell_ids = leaf.GetCell(leaf.GetNumberOfVerts() + cell).GetPointIds()
+            line.InsertNextCell(cell_ids.GetNumberOfIds())
+            for k in range(cell_ids.GetNumberOfIds()):
+                line.InsertCellPoint(points.InsertNextPoint(leaf.GetPoint(cell_ids.GetId(k))))
+            path.SetPoints(points)
+            path.SetLines(line)
+            for name, value in (("max_isometric_force", 500.0), ("optimal_fiber_length", 40.0),
+                                ("tendon_slack_length", 20.0), ("MetresPerLengthUnit", 0.001)):
+                array = vtkDoubleArray()
+                array.SetName(name)
+                array.InsertNextValue(value)
+                path.GetFieldData().AddArray(array)
+            index = tree.GetNumberOfBlocks()
+            tree.SetBlock(index, path)
+            tree.GetMetaData(index).Set(vtkMultiBlockDataSet.NAME(), "path%d" % index)
+    return tree
 
 
 def body_transforms(bones):
@@ -252,6 +284,7 @@ FILTERS = [
     ("ActionLineGrouping", [("Input", "muscles", False), ("Paths", "lines_rest", False)], {}),
     ("MoveWithBodies", [("Input", "bones_rest", False), ("BodyTransforms", "transforms", False)], {}),
     ("PathsOverBones", [("Input", "lines_current", False), ("Bones", "bones_current", False)], {}),
+    ("MuscleFromPath", [("Input", "paths", False), ("Bones", "bones_rest", False)], {"NumberOfPoints": 100}),
     # The bones and the lines of the motion: BoneInterpolation from the rest to the current pose.
     ("MotionMuscleDeformation", [("Input", "muscles", False), ("BonesRest", "bones_rest", False),
                                  ("BonesMotion", ("bones_rest", "bones_current"), False),

@@ -23,7 +23,7 @@ class ServerManagerXML(unittest.TestCase):
         proxies = []
         for file_name in sorted(os.listdir(folder)):
             proxies += ElementTree.parse(os.path.join(folder, file_name)).getroot().findall("./ProxyGroup/SourceProxy")
-        self.assertEqual(len(proxies), 12)
+        self.assertEqual(len(proxies), 13)
         for proxy in proxies:
             name = proxy.get("name")
             self.assertTrue((proxy.findtext("Documentation") or "").strip(), name)
@@ -54,7 +54,7 @@ class ServerManagerXML(unittest.TestCase):
                                     "MuscleDeformation.Obstacles", "MuscleDeformation.Hull",
                                     "IntersectionResolve.InputRest", "IntersectionResolve.ObstaclesRest",
                                     "InterpolatedMuscleDeformation.Attachments",
-                                    "MotionMuscleDeformation.Attachments"})
+                                    "MotionMuscleDeformation.Attachments", "MuscleFromPath.Bones"})
 
     def test_the_plugin_folder_offers_the_plugin_alone(self):
         # Tools > Manage Plugins > Load New... lists the shared libraries of the folder: a second

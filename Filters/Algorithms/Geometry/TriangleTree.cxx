@@ -275,22 +275,34 @@ void TriangleTree::ForTrianglesNearSegment(
   }
 }
 
-std::optional<TriangleTree::Hit> TriangleTree::FirstHit(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const
+template<typename Accept>
+std::optional<TriangleTree::Hit> TriangleTree::FirstHitWhere(
+  const Eigen::Vector3d& from, const Eigen::Vector3d& direction, Accept&& accepted) const
 {
-  const Eigen::Vector3d direction = to - from;
   std::optional<Hit> best;
   double limit = 1.0;
   this->ForTrianglesNearSegment(from, direction, limit, [&](Eigen::Index t) {
     double t01, u, v;
     if (IntersectLineTriangle(
           from, direction, this->Corner(t, 0), this->Corner(t, 1), this->Corner(t, 2), 0.0, t01, u, v) &&
-      t01 >= 0 && t01 <= limit)
+      t01 >= 0 && t01 <= limit && accepted(t))
     {
       limit = t01;
       best = Hit{ t01, t, from + t01 * direction };
     }
   });
   return best;
+}
+
+std::optional<TriangleTree::Hit> TriangleTree::FirstHit(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const
+{
+  return this->FirstHitWhere(from, to - from, [](Eigen::Index) { return true; });
+}
+
+std::optional<TriangleTree::Hit> TriangleTree::FirstEntry(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const
+{
+  const Eigen::Vector3d direction = to - from;
+  return this->FirstHitWhere(from, direction, [&](Eigen::Index t) { return direction.dot(this->Normal(t)) < 0; });
 }
 
 int TriangleTree::Crossings(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const

@@ -30,6 +30,12 @@ public:
   /// The first triangle the segment from `from` to `to` meets, if any.
   std::optional<Hit> FirstHit(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
 
+  /// The first triangle the segment from `from` to `to` enters through (against the triangle's
+  /// normal: from outside an outward surface to its inside), if any. Triangles it leaves through
+  /// are passed, so a segment that starts inside an outward surface, or behind a one-sided
+  /// open sheet, meets only what it enters.
+  std::optional<Hit> FirstEntry(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
+
   /// How many triangles the segment from `from` to `to` crosses: odd when
   /// the segment leaves or enters the closed surface, even when both ends are
   /// on the same side.
@@ -130,6 +136,11 @@ private:
   /// Six ray directions from p: towards the faces of the surface's box, nearest first, each
   /// tilted off its axis.
   std::array<Eigen::Vector3d, 6> RayDirections(const Eigen::Vector3d& p) const;
+  /// The first triangle the segment from + t direction, t in [0, 1], meets among those
+  /// `accepted(triangle)` is true of.
+  template<typename Accept>
+  std::optional<Hit> FirstHitWhere(
+    const Eigen::Vector3d& from, const Eigen::Vector3d& direction, Accept&& accepted) const;
   /// Calls visit(triangle) for every triangle whose leaf box the segment
   /// from + t direction, t in [0, limit], meets.
   template<typename Visit>

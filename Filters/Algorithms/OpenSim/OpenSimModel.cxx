@@ -1058,6 +1058,12 @@ private:
     Path path;
     path.name = force.attribute("name").value();
     path.type = force.name();
+    const double unknown = MuscleProperties::kUnknown;
+    path.muscle.maxIsometricForce = this->reader.Number(force, "max_isometric_force", unknown);
+    path.muscle.optimalFiberLength = this->reader.Number(force, "optimal_fiber_length", unknown);
+    path.muscle.tendonSlackLength = this->reader.Number(force, "tendon_slack_length", unknown);
+    path.muscle.pennationAngle =
+      this->reader.Number(force, "pennation_angle_at_optimal", this->reader.Number(force, "pennation_angle", unknown));
     for (Node pointNode : geometryPath.child("PathPointSet").child("objects").children())
     {
       if (pointNode.type() != pugi::node_element)

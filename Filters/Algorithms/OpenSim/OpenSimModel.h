@@ -5,6 +5,7 @@
 #pragma once
 
 #include "Common/MeshTypes.h"
+#include "Common/MuscleProperties.h"
 #include "Geometry/RigidMotion.h"
 #include "OpenSim/OpenSimFunction.h"
 
@@ -150,6 +151,10 @@ struct Path
 {
   std::string name;
   std::string type; ///< e.g. Thelen2003Muscle
+  /// The muscle's max_isometric_force, optimal_fiber_length, tendon_slack_length (metres, as the
+  /// file) and pennation_angle_at_optimal (pennation_angle in older files); unknown for a path
+  /// actuator that is not a muscle.
+  MuscleProperties muscle;
   std::vector<PathPoint> points;
   std::vector<PathWrap> wraps; ///< in the order OpenSim applies them
 };

@@ -256,3 +256,28 @@ TEST(TriangleTree, ASurfaceOfOnePointGetsNoDistanceGrid)
   tree.BuildDistanceGrid();
   EXPECT_FALSE(tree.SignedDistanceBounds(Eigen::Vector3d(1, 2, 3)).has_value());
 }
+
+TEST(TriangleTree, FirstEntryMeetsOnlyTrianglesEnteredFromOutside)
+{
+  // A unit cube (outward): from outside, the segment enters at x = 0; from inside, it passes the
+  // face it leaves through and meets nothing; through the cube, the entry again.
+  md::TriangleMesh cube;
+  cube.points.resize(8, 3);
+  for (int i = 0; i < 8; ++i)
+  {
+    cube.points.row(i) << (i & 1 ? 1.0 : 0.0), (i & 2 ? 1.0 : 0.0), (i & 4 ? 1.0 : 0.0);
+  }
+  cube.triangles.resize(12, 3);
+  cube.triangles << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5,
+    3, 7, 5;
+  ASSERT_GT(md::SignedVolume(cube.points, cube.triangles), 0);
+  const md::TriangleTree tree(cube);
+  const auto entry = tree.FirstEntry({ -1, 0.3, 0.4 }, { 3, 0.3, 0.4 });
+  ASSERT_TRUE(entry);
+  EXPECT_NEAR(entry->point.x(), 0.0, 1e-12);
+  EXPECT_FALSE(tree.FirstEntry({ 0.5, 0.3, 0.4 }, { 3, 0.3, 0.4 }));
+  ASSERT_TRUE(tree.FirstHit({ 0.5, 0.3, 0.4 }, { 3, 0.3, 0.4 }));
+  const auto back = tree.FirstEntry({ 3, 0.3, 0.4 }, { -1, 0.3, 0.4 });
+  ASSERT_TRUE(back);
+  EXPECT_NEAR(back->point.x(), 1.0, 1e-12);
+}

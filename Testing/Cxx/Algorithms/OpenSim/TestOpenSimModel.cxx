@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Reading a model: joints composed as Simbody composes them, wrap surfaces, bad input named.
+// Reading a model: joints composed as Simbody composes them, wrap surfaces, muscle properties, bad
+// input named.
 #include "OpenSim/OpenSimKinematics.h"
 #include "OpenSimTestModels.h"
 
@@ -123,6 +124,46 @@ TEST(OpenSimModel, JointsComposeAsSimbody)
   EXPECT_LT(
     (g.points.row(kept[1]).transpose() - poses2[model.FindBody("tibia")].Apply(Eigen::Vector3d(-0.1, -0.2, 0))).norm(),
     1e-14);
+}
+
+TEST(OpenSimModel, AMusclesPropertiesAreReadAndAnActuatorHasNone)
+{
+  // The small model's muscle gives none; one that does, the older pennation_angle, and a path
+  // actuator.
+  std::string text = kSmallModel;
+  const std::string end = "</GeometryPath></Thelen2003Muscle>";
+  const size_t at = text.find(end);
+  ASSERT_NE(at, std::string::npos);
+  const std::string path =
+    text.substr(text.rfind("<GeometryPath", at), at - text.rfind("<GeometryPath", at)) + "</GeometryPath>";
+  text.replace(at, end.size(),
+    "</GeometryPath><max_isometric_force>900</max_isometric_force><optimal_fiber_length>0.12</optimal_fiber_length>"
+    "<tendon_slack_length>0.3</tendon_slack_length><pennation_angle_at_optimal>0.2</pennation_angle_at_optimal>"
+    "</Thelen2003Muscle><Schutte1993Muscle_Deprecated name=\"old\">" +
+      path +
+      "<max_isometric_force>100</max_isometric_force><optimal_fiber_length>0.1</optimal_fiber_length>"
+      "<tendon_slack_length>0.2</tendon_slack_length><pennation_angle>0.05</pennation_angle>"
+      "</Schutte1993Muscle_Deprecated><PathActuator name=\"motor\">" +
+      path + "<optimal_force>10</optimal_force></PathActuator>");
+  const Model model = ParseModel(text, "small.osim");
+  ASSERT_EQ(model.paths.size(), 3u);
+  const md::MuscleProperties& m1 = model.paths[0].muscle;
+  EXPECT_TRUE(m1.Known());
+  EXPECT_EQ(m1.maxIsometricForce, 900);
+  EXPECT_EQ(m1.optimalFiberLength, 0.12);
+  EXPECT_EQ(m1.tendonSlackLength, 0.3);
+  EXPECT_EQ(m1.pennationAngle, 0.2);
+  EXPECT_EQ(model.paths[1].type, "Schutte1993Muscle_Deprecated");
+  EXPECT_EQ(model.paths[1].muscle.pennationAngle, 0.05);
+  EXPECT_TRUE(model.paths[1].muscle.Known());
+  EXPECT_EQ(model.paths[2].type, "PathActuator");
+  EXPECT_FALSE(model.paths[2].muscle.Known());
+  EXPECT_TRUE(std::isnan(model.paths[2].muscle.maxIsometricForce));
+  // A property that is not a number is refused, named.
+  std::string bad = text;
+  bad.replace(bad.find("<max_isometric_force>900"), 24, "<max_isometric_force>x");
+  EXPECT_NE(
+    ExpectInputError([&] { ParseModel(bad, "small.osim"); }).find("'x' is not a finite number"), std::string::npos);
 }
 
 TEST(OpenSimModel, WrapSurfacesAreClosedAndOutward)
