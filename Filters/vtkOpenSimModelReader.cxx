@@ -257,6 +257,7 @@ struct vtkOpenSimModelReader::Internals
   std::vector<double> rest;
   std::vector<RigidTransform> restPoses;
   RigidTransform toOutput;     ///< ground -> the reference body's rest frame, lengths not yet scaled
+  int referenceBody = -1;      ///< the reference body's index; -1: ground
   vtkNew<vtkTable> momentArms; ///< output MOMENT_ARMS as last computed
   std::string momentArmsKey;   ///< what it was computed from
 };
@@ -457,6 +458,7 @@ void vtkOpenSimModelReader::LoadRestPose()
   osim::SetCoordinates(in.model, Text(this->RestPoseCoordinates), true, in.rest);
   in.restPoses = osim::BodyPoses(in.model, in.rest);
   in.toOutput = RigidTransform();
+  in.referenceBody = -1;
   const std::string reference = Text(this->ReferenceBody);
   if (!reference.empty())
   {
@@ -466,6 +468,7 @@ void vtkOpenSimModelReader::LoadRestPose()
       throw md::InputError("ReferenceBody '" + reference + "' is not a body of the model");
     }
     in.toOutput = Inverse(in.restPoses[body]);
+    in.referenceBody = body;
   }
   in.poseKey = poseKey;
 }
@@ -578,9 +581,16 @@ void vtkOpenSimModelReader::WriteWrapsAndTransforms(const std::vector<md::RigidT
   this->WriteTransforms(poses, q, time, stepped, vtkTable::GetData(outputVector, BODY_TRANSFORMS));
 }
 
+md::RigidTransform vtkOpenSimModelReader::OutputFrame(const std::vector<md::RigidTransform>& poses) const
+{
+  const Internals& in = *this->Internal;
+  return this->FollowReferenceBody && in.referenceBody >= 0 ? Inverse(poses[static_cast<size_t>(in.referenceBody)])
+                                                            : in.toOutput;
+}
+
 md::RigidTransform vtkOpenSimModelReader::Placed(const std::vector<md::RigidTransform>& poses, size_t body) const
 {
-  return Compose(this->Internal->toOutput, poses[body]); // body frame -> output frame (scaled apart)
+  return Compose(this->OutputFrame(poses), poses[body]); // body frame -> output frame (scaled apart)
 }
 
 void vtkOpenSimModelReader::WriteBodies(
@@ -630,11 +640,12 @@ void vtkOpenSimModelReader::WritePaths(const std::vector<double>& coordinates,
   const Internals& in = *this->Internal;
   const osim::Model& model = in.model;
   const double fade = this->ConditionalPointFade * M_PI / 180.0;
-  // A path's points in the output frame and units.
-  const auto placed = [&](md::Points points, const std::string& label) {
+  // A path's points at `at` in the output frame and units.
+  const auto placed = [&](md::Points points, const std::vector<RigidTransform>& at, const std::string& label) {
+    const RigidTransform frame = this->OutputFrame(at);
     for (Eigen::Index i = 0; i < points.rows(); ++i)
     {
-      points.row(i) = this->Scale * in.toOutput.Apply(Eigen::Vector3d(points.row(i).transpose())).transpose();
+      points.row(i) = this->Scale * frame.Apply(Eigen::Vector3d(points.row(i).transpose())).transpose();
     }
     CheckPlaced(points, RigidTransform(), label);
     return points;
@@ -642,7 +653,7 @@ void vtkOpenSimModelReader::WritePaths(const std::vector<double>& coordinates,
   for (const osim::Path& path : model.paths)
   {
     const osim::PathGeometry g = osim::PathAt(model, path, coordinates, poses, fade);
-    const md::Points points = placed(g.points, "path '" + path.name + "' " + when);
+    const md::Points points = placed(g.points, poses, "path '" + path.name + "' " + when);
     auto block = vtkSmartPointer<vtkPolyData>::New();
     block->SetPoints(mdvtk::ToVtkPoints(points));
     for (const SteppedPose& pose : stepped)
@@ -650,7 +661,7 @@ void vtkOpenSimModelReader::WritePaths(const std::vector<double>& coordinates,
       // The frame's conditional points and fades (conditionsAt): as many points as at the frame.
       const osim::PathGeometry at = osim::PathAt(model, path, pose.coordinates, pose.bodyPoses, fade, &coordinates);
       vtkSmartPointer<vtkDataArray> array = mdvtk::ToVtkPoints(
-        placed(osim::PointsLike(at, g), "path '" + path.name + "' at pose " + pose.name + " " + when))
+        placed(osim::PointsLike(at, g), pose.bodyPoses, "path '" + path.name + "' at pose " + pose.name + " " + when))
                                               ->GetData();
       array->SetName(mdvtk::PointsAt(pose.name).c_str());
       block->GetPointData()->AddArray(array);
@@ -840,6 +851,7 @@ void vtkOpenSimModelReader::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "RestPoseCoordinates: " << Text(this->RestPoseCoordinates) << "\n";
   os << indent << "RestPoseFileName: " << Text(this->RestPoseFileName) << "\n";
   os << indent << "ReferenceBody: " << Text(this->ReferenceBody) << "\n";
+  os << indent << "FollowReferenceBody: " << this->FollowReferenceBody << "\n";
   os << indent << "Scale: " << this->Scale << "\n";
   os << indent << "CurrentPoseTime: " << this->CurrentPoseTime << "\n";
   os << indent << "PlayMotion: " << this->PlayMotion << "\n";

@@ -18,7 +18,8 @@
  * the current time, 6 MomentArms (a vtkTable, a row per frame of the motion, or one at the rest pose: the time, the
  * coordinates that move, each path's length and its moment arm about each of them, r = -dL/dq, OpenSim's sign).
  *
- * Every output is in the frame that ReferenceBody has at the rest pose (ground when empty), in
+ * Every output is in the frame that ReferenceBody has at the rest pose (ground when empty; with
+ * FollowReferenceBody, in its frame at each time, so that it stays still), in
  * the model's units times Scale (1000: millimetres for a model in metres), so that surfaces
  * scanned in that body's frame, in the rest pose, lie where the model's bodies do.
  */
@@ -95,6 +96,13 @@ public:
   vtkGetStringMacro(ReferenceBody);
   vtkSetStringMacro(ReferenceBody);
 
+  /// Keep ReferenceBody where it is in the rest pose at every time: the outputs are in that
+  /// body's frame at each time, and the model moves about it (a walk in place, the pelvis still).
+  /// Default off (the outputs in its rest-pose frame, the body moving as the motion moves it).
+  vtkSetMacro(FollowReferenceBody, bool);
+  vtkGetMacro(FollowReferenceBody, bool);
+  vtkBooleanMacro(FollowReferenceBody, bool);
+
   /// Multiplies every length (1000: millimetres for a model in metres). Default 1.
   vtkSetClampMacro(Scale, double, 1e-9, 1e9);
   vtkGetMacro(Scale, double);
@@ -166,6 +174,7 @@ protected:
   char* RestPoseCoordinates = nullptr;
   char* RestPoseFileName = nullptr;
   char* ReferenceBody = nullptr;
+  bool FollowReferenceBody = false;
   double Scale = 1.0;
   static constexpr double kDefaultCurrentPoseTime = 0.0;
   double CurrentPoseTime = kDefaultCurrentPoseTime;
@@ -192,6 +201,9 @@ private:
   void LoadModel(const std::string& fileName, std::vector<std::string>& warnings);
   void LoadMotion(std::vector<std::string>& warnings);
   void LoadRestPose();
+  /// Ground in pose `poses` -> the output frame (lengths not yet scaled): the reference body's
+  /// rest frame, or with FollowReferenceBody its frame in `poses`.
+  md::RigidTransform OutputFrame(const std::vector<md::RigidTransform>& poses) const;
   /// Body `body` in pose `poses` -> the output frame (lengths not yet scaled).
   md::RigidTransform Placed(const std::vector<md::RigidTransform>& poses, size_t body) const;
   /// The bodies' meshes as blocks of `tree`, each with RestToCurrentTransform; throws

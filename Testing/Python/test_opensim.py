@@ -424,6 +424,35 @@ class OpenSimData(unittest.TestCase):
         paths = servermanager.Fetch(reader, idx=1)
         self.assertEqual(paths.GetNumberOfBlocks(), 92)
 
+    def test_gait2392_walks_in_place_about_its_pelvis(self):
+        # FollowReferenceBody: the pelvis stays where it is at rest at every time, every other body
+        # and path moves about it as in the ground frame, the lengths as they are.
+        folder = os.path.join(DATA, "opensim", "gait2392_walk_forward")
+        model, motion = (os.path.join(folder, "subject01_simbody_adjusted.osim"),
+                         os.path.join(folder, "subject01_walk1_Kinematics_q.mot"))
+        ground = simple.OpenSimModelReader(FileName=model, MotionFileName=motion, Scale=1000.0, ReferenceBody="pelvis")
+        still = simple.OpenSimModelReader(FileName=model, MotionFileName=motion, Scale=1000.0, ReferenceBody="pelvis",
+                                          FollowReferenceBody=1)
+        rest = block(servermanager.Fetch(still, idx=2), "pelvis")
+        travelled = 0.0
+        for time in list(ground.TimestepValues)[::40]:
+            ground.UpdatePipeline(time)
+            still.UpdatePipeline(time)
+            moving, kept = servermanager.Fetch(ground, idx=0), servermanager.Fetch(still, idx=0)
+            self.assertLess(abs(points(block(kept, "pelvis")) - points(rest)).max(), 1e-9)
+            travelled = max(travelled, abs(points(block(moving, "pelvis")) - points(rest)).max())
+            # The same relative placement: distances from the pelvis to the other bodies' points.
+            anchor_moving, anchor_kept = points(block(moving, "pelvis"))[0], points(block(kept, "pelvis"))[0]
+            for name in ("femur_r", "tibia_l", "calcn_r", "torso"):
+                numpy.testing.assert_allclose(numpy.linalg.norm(points(block(moving, name)) - anchor_moving, axis=1),
+                                              numpy.linalg.norm(points(block(kept, name)) - anchor_kept, axis=1),
+                                              atol=1e-6)
+            for name in ("glut_max1_r", "soleus_l"):
+                self.assertAlmostEqual(mdtesting.field(block(servermanager.Fetch(ground, idx=1), name), "PathLength"),
+                                       mdtesting.field(block(servermanager.Fetch(still, idx=1), name), "PathLength"),
+                                       places=9)
+        self.assertGreater(travelled, 500.0)  # the walk carries the pelvis half a metre and more
+
 
 @unittest.skipIf(DATA is None or not os.path.isdir(os.path.join(DATA or "", "lhdl_hip_r")), "LHDL data not found")
 class LhdlFromItsOpenSimFiles(unittest.TestCase):
