@@ -72,6 +72,7 @@ vtkMuscleFromPath::vtkMuscleFromPath()
   this->SpecificTension = defaults.specificTension * 100; // N/mm^2 -> N/cm^2
   this->NumberOfPoints = defaults.numberOfPoints;
   this->TendonRadiusRatio = defaults.tendonRadiusRatio;
+  this->KeepMusclesApart = true;
 }
 
 int vtkMuscleFromPath::FillInputPortInformation(int port, vtkInformation* info)
@@ -148,104 +149,139 @@ int vtkMuscleFromPath::RequestData(
   size_t muscleCount = 0, failedCount = 0;
   std::string noted;      // the muscles whose belly a limit set
   std::string notMuscles; // the model's paths that are not muscles
-  std::string cramped;    // the muscles the bones left too little room
+  std::string cramped;    // the muscles the bones and the others left too little room
   const auto fail = [&](size_t b, const std::string& message) {
     vtkErrorMacro(<< message);
     results[b] = mdvtk::FailedMuscle(leaves[b].data, message); // the other muscles go on
     ++failedCount;
   };
+  // The muscles to make: their blocks, paths and properties, in one length unit.
+  std::vector<size_t> blocks;
+  std::vector<md::Points> paths;
+  std::vector<md::MuscleProperties> muscles;
+  double unit = 0; // metres per length unit, the first muscle's
   for (size_t b = 0; b < leaves.size(); ++b)
   {
-    if (mdvtk::ProgressOrStop(this, static_cast<double>(b) / leaves.size()))
-    {
-      return 1;
-    }
     const mdvtk::Leaf& leaf = leaves[b];
     if (!leaf.data)
     {
       continue;
     }
-    ++muscleCount;
-    const auto start = std::chrono::steady_clock::now();
     const std::vector<md::Points> lines = mdvtk::ToPolylines(leaf.data);
-    if (lines.size() != 1)
-    {
-      fail(b,
-        leaf.label + " has " + std::to_string(lines.size()) + " polylines: a muscle's path is one" +
-          mdvtk::UpstreamFailure(leaf.data));
-      continue;
-    }
     auto* type = vtkStringArray::SafeDownCast(leaf.data->GetFieldData()->GetAbstractArray("MuscleType"));
     if (type && type->GetNumberOfValues() > 0 && !leaf.data->GetFieldData()->GetArray("max_isometric_force"))
     {
       // A model's path actuator that is not a muscle (OpenSim's PathActuator): nothing to make.
       results[b] = mdvtk::FailedMuscle(leaf.data, "a " + type->GetValue(0) + ", not a muscle: no surface is made");
       notMuscles += (notMuscles.empty() ? "" : ", ") + mdvtk::NameOf(leaf) + " (" + type->GetValue(0) + ")";
-      --muscleCount;
       continue;
     }
+    ++muscleCount;
     md::MuscleProperties muscle;
     double metresPerUnit = 0;
-    if (!ReadMuscle(leaf.data, muscle, metresPerUnit, error))
+    if (lines.size() != 1)
+    {
+      fail(b,
+        leaf.label + " has " + std::to_string(lines.size()) + " polylines: a muscle's path is one" +
+          mdvtk::UpstreamFailure(leaf.data));
+    }
+    else if (!ReadMuscle(leaf.data, muscle, metresPerUnit, error))
     {
       fail(b, leaf.label + " " + error);
-      continue;
     }
-    md::MuscleFromPathParameters parameters;
-    const double centimetresPerUnit = 100 * metresPerUnit;
-    parameters.specificTension = this->SpecificTension * centimetresPerUnit * centimetresPerUnit;
-    parameters.numberOfPoints = this->NumberOfPoints;
-    parameters.tendonRadiusRatio = this->TendonRadiusRatio;
-    md::MuscleFromPathResult made;
-    int result = 1;
-    std::string failure;
-    if (!mdvtk::CallCore(
-          this, leaf.label + ": ", [&] { made = md::MuscleFromPath(lines[0], muscle, parameters, bones); }, result,
-          &failure))
+    else if (unit > 0 && metresPerUnit != unit)
     {
-      if (failure.empty())
+      fail(b,
+        leaf.label + " is in a length unit of " + std::to_string(metresPerUnit) + " m, the muscles before it in " +
+          std::to_string(unit) + " m: one unit for all");
+    }
+    else
+    {
+      unit = metresPerUnit;
+      blocks.push_back(b);
+      paths.push_back(lines[0]);
+      muscles.push_back(muscle);
+    }
+  }
+  md::MuscleFromPathParameters parameters;
+  const double centimetresPerUnit = 100 * unit;
+  parameters.specificTension = this->SpecificTension * centimetresPerUnit * centimetresPerUnit;
+  parameters.numberOfPoints = this->NumberOfPoints;
+  parameters.tendonRadiusRatio = this->TendonRadiusRatio;
+  std::vector<md::MuscleFromPathResult> made(paths.size());
+  std::vector<std::string> failures(paths.size());
+  int result = 1;
+  std::string failure;
+  const auto start = std::chrono::steady_clock::now();
+  const auto make = [&] {
+    if (this->KeepMusclesApart)
+    {
+      made = md::MusclesFromPaths(paths, muscles, parameters, bones, failures);
+      return;
+    }
+    for (size_t m = 0; m < paths.size(); ++m)
+    {
+      try
       {
-        return result; // stopped by the user
+        made[m] = md::MuscleFromPath(paths[m], muscles[m], parameters, bones);
       }
-      results[b] = mdvtk::FailedMuscle(leaf.data, failure);
-      ++failedCount;
+      catch (const md::InputError& e)
+      {
+        failures[m] = e.what(); // the others go on
+      }
+    }
+  };
+  if (!paths.empty() && !mdvtk::CallCore(this, "", make, result, &failure))
+  {
+    return result; // stopped by the user, or reported
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (size_t m = 0; m < paths.size(); ++m)
+  {
+    const size_t b = blocks[m];
+    const mdvtk::Leaf& leaf = leaves[b];
+    if (!failures[m].empty())
+    {
+      fail(b, leaf.label + ": " + failures[m]);
       continue;
     }
-    auto surface = mdvtk::ToPolyData(made.surface);
+    const md::MuscleFromPathResult& muscle = made[m];
+    auto surface = mdvtk::ToPolyData(muscle.surface);
     vtkFieldData* fieldData = surface->GetFieldData();
     fieldData->PassData(leaf.data->GetFieldData());
-    mdvtk::AddFieldValue(fieldData, "EstimatedVolume", made.estimatedVolume);
-    mdvtk::AddFieldValue(fieldData, "MuscleVolume", made.volume);
+    mdvtk::AddFieldValue(fieldData, "EstimatedVolume", muscle.estimatedVolume);
+    mdvtk::AddFieldValue(fieldData, "MuscleVolume", muscle.volume);
     mdvtk::AddFieldValue(
-      fieldData, "PhysiologicalCrossSectionalArea", muscle.maxIsometricForce / parameters.specificTension);
-    mdvtk::AddFieldValue(fieldData, "BellyStart", made.bellyStart);
-    mdvtk::AddFieldValue(fieldData, "BellyEnd", made.bellyEnd);
-    mdvtk::AddFieldValue(fieldData, "BellyRadius", made.bellyRadius);
-    mdvtk::AddFieldValue(fieldData, "TendonRadius", made.tendonRadius);
+      fieldData, "PhysiologicalCrossSectionalArea", muscles[m].maxIsometricForce / parameters.specificTension);
+    mdvtk::AddFieldValue(fieldData, "BellyStart", muscle.bellyStart);
+    mdvtk::AddFieldValue(fieldData, "BellyEnd", muscle.bellyEnd);
+    mdvtk::AddFieldValue(fieldData, "BellyRadius", muscle.bellyRadius);
+    mdvtk::AddFieldValue(fieldData, "TendonRadius", muscle.tendonRadius);
     mdvtk::AddFieldValue(fieldData, "SpecificTension", this->SpecificTension);
-    mdvtk::AddFieldValue(fieldData, "PointsHeldByBones", made.pointsHeldByBones);
-    mdvtk::AddFieldValue(fieldData, "VolumeKept", made.volumeKept);
-    if (!made.notes.empty())
+    mdvtk::AddFieldValue(fieldData, "PointsHeldByBones", muscle.pointsHeldByBones);
+    mdvtk::AddFieldValue(fieldData, "PointsHeldByMuscles", muscle.pointsHeldByMuscles);
+    mdvtk::AddFieldValue(fieldData, "VolumeKept", muscle.volumeKept);
+    if (!muscle.notes.empty())
     {
       vtkNew<vtkStringArray> notes;
       notes->SetName("Notes");
-      for (const std::string& note : made.notes)
+      for (const std::string& note : muscle.notes)
       {
         notes->InsertNextValue(note);
       }
       fieldData->AddArray(notes);
-      if (made.volumeKept < 1 - 1e-6)
-      {
-        cramped += (cramped.empty() ? "" : ", ") + mdvtk::NameOf(leaf) + " " +
-          std::to_string(static_cast<int>(std::floor(100 * made.volumeKept))) + " %";
-      }
-      if (made.bellyLimited)
-      {
-        noted += (noted.empty() ? "" : ", ") + mdvtk::NameOf(leaf);
-      }
     }
-    mdvtk::AddFieldValue(fieldData, mdvtk::array::ElapsedSeconds,
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    if (muscle.volumeKept < 1 - 1e-6)
+    {
+      cramped += (cramped.empty() ? "" : ", ") + mdvtk::NameOf(leaf) + " " +
+        std::to_string(static_cast<int>(std::floor(100 * muscle.volumeKept))) + " %";
+    }
+    if (muscle.bellyLimited)
+    {
+      noted += (noted.empty() ? "" : ", ") + mdvtk::NameOf(leaf);
+    }
+    // The time of the whole model's making, shared out.
+    mdvtk::AddFieldValue(fieldData, mdvtk::array::ElapsedSeconds, seconds / static_cast<double>(paths.size()));
     results[b] = surface;
   }
   if (!notMuscles.empty())
@@ -254,7 +290,8 @@ int vtkMuscleFromPath::RequestData(
   }
   if (!cramped.empty())
   {
-    vtkWarningMacro(<< "the bones leave too little room for the volume of these muscles (field data VolumeKept): "
+    vtkWarningMacro(<< "the bones and the other muscles leave too little room for the volume of these muscles "
+                       "(field data VolumeKept): "
                     << cramped);
   }
   if (!noted.empty())
@@ -275,4 +312,5 @@ void vtkMuscleFromPath::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SpecificTension: " << this->SpecificTension << "\n";
   os << indent << "NumberOfPoints: " << this->NumberOfPoints << "\n";
   os << indent << "TendonRadiusRatio: " << this->TendonRadiusRatio << "\n";
+  os << indent << "KeepMusclesApart: " << this->KeepMusclesApart << "\n";
 }

@@ -30,7 +30,11 @@
  * obstacle, met from its outer side; a path that runs in a bone keeps its tube there. Field data
  * PointsHeldByBones and VolumeKept (1 unless the bones left too little room, said in a warning).
  *
- * Not yet: the surfaces are not kept out of each other.
+ * With KeepMusclesApart (the default), the muscles share the space between them
+ * (md::MusclesFromPaths): a point belongs to the muscle whose smoothed path is nearest, each
+ * surface point stops short of its muscle's share, and the rest widens to keep the volume; only
+ * where paths cross or meet (a shared insertion) do muscles still overlap. Field data
+ * PointsHeldByMuscles.
  */
 #pragma once
 
@@ -68,6 +72,11 @@ public:
   vtkSetClampMacro(TendonRadiusRatio, double, 0.01, 1.0);
   vtkGetMacro(TendonRadiusRatio, double);
 
+  /// Share the space between the muscles so that they do not overlap. Default on.
+  vtkSetMacro(KeepMusclesApart, bool);
+  vtkGetMacro(KeepMusclesApart, bool);
+  vtkBooleanMacro(KeepMusclesApart, bool);
+
 protected:
   vtkMuscleFromPath();
   ~vtkMuscleFromPath() override = default;
@@ -83,6 +92,7 @@ protected:
   double SpecificTension;
   int NumberOfPoints;
   double TendonRadiusRatio;
+  bool KeepMusclesApart;
 
 private:
   vtkMuscleFromPath(const vtkMuscleFromPath&) = delete;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 namespace md
@@ -30,11 +31,18 @@ constexpr double kSmoothingRadii = 2.0;
 /// The surface's volume is scaled to the estimate within this share.
 constexpr double kVolumeTolerance = 1e-9;
 constexpr int kVolumeRounds = 50;
-/// Against the bones: how far a point stops short of a bone and how near the centre it may be
-/// drawn, as shares of the local radius, and how far the other points may widen to keep the volume.
-constexpr double kBoneClearanceShare = 0.02;
+/// Against the bones and the other muscles: how far a point stops short of one and how near the
+/// centre it may be drawn, as shares of the local radius, and how far the other points may widen
+/// to keep the volume.
+constexpr double kClearanceShare = 0.02;
 constexpr double kLeastRadiusShare = 0.1;
+/// A held point stays this many times as far from its ring's centre as the path near the ring.
+constexpr double kPathMargin = 1.5;
 constexpr double kMostRadiusScale = 3.0;
+/// A ray is followed out of its tube's cell in steps of the local radius over this, then the step
+/// halved this many times (to a 1/2048 of the radius).
+constexpr double kCellSteps = 8;
+constexpr int kCellHalvings = 8;
 
 /// A polyline parametrised by arc length.
 class ArcPolyline
@@ -156,11 +164,41 @@ double EstimatedMuscleVolume(const MuscleProperties& muscle, double specificTens
   return muscle.maxIsometricForce / specificTension * muscle.optimalFiberLength;
 }
 
-MuscleFromPathResult MuscleFromPath(const Points& path, const MuscleProperties& muscle,
-  const MuscleFromPathParameters& parameters, const std::vector<const TriangleTree*>& bones)
+namespace
+{
+/// A muscle's tube before its radii are scaled to its volume: rings round the smoothed path,
+/// each point's direction from its ring's centre and how far it may go (its reach).
+struct Tube
+{
+  MuscleFromPathResult result; ///< the estimate, the belly, the notes so far
+  double radius = 0;           ///< the belly's radius before scaling
+  int rings = 0, ringPoints = 0;
+  std::vector<Eigen::Vector3d> centres, normals, binormals;
+  std::vector<double> shares; ///< each ring's radius as a share of `radius`
+  /// How near its ring's centre a point may be drawn: a tenth of the local radius, and far enough
+  /// that the ring's chords pass outside the path near the ring (which the smoothing moved off the
+  /// centre), so that the path stays in.
+  std::vector<double> floors;
+  std::vector<Eigen::Vector3d> directions;
+  std::vector<double> reach; ///< per point; infinity where nothing is in the way
+  std::vector<char> heldByBone, heldByMuscle;
+  Triangles triangles;
+  Eigen::Vector3d start, end; ///< the path's first and last points: the caps' centres
+  Eigen::Vector3d low, high;  ///< a box round every point the tube can reach
+
+  Eigen::Index Id(int ring, int j) const
+  {
+    return static_cast<Eigen::Index>(ring) * this->ringPoints + (j % this->ringPoints);
+  }
+  /// The local radius (before scaling) of ring k.
+  double Local(size_t k) const { return this->radius * this->shares[k]; }
+};
+
+Tube MakeTube(const Points& path, const MuscleProperties& muscle, const MuscleFromPathParameters& parameters)
 {
   CheckInput(path, muscle, parameters);
-  MuscleFromPathResult result;
+  Tube tube;
+  MuscleFromPathResult& result = tube.result;
   result.estimatedVolume = EstimatedMuscleVolume(muscle, parameters.specificTension);
   const ArcPolyline line(path);
   const double length = line.Length();
@@ -192,108 +230,266 @@ MuscleFromPathResult MuscleFromPath(const Points& path, const MuscleProperties& 
   double integral = 0;
   for (int k = 0; k < kIntegrationSteps; ++k)
   {
-    const double share = shareAt(length * (k + 0.5) / kIntegrationSteps);
-    integral += share * share * length / kIntegrationSteps;
+    const double at = shareAt(length * (k + 0.5) / kIntegrationSteps);
+    integral += at * at * length / kIntegrationSteps;
   }
-  const double radius = std::sqrt(result.estimatedVolume / (M_PI * integral));
+  tube.radius = std::sqrt(result.estimatedVolume / (M_PI * integral));
+  const double radius = tube.radius;
 
   // Rings of equal spacing, their points about as far apart round the belly as along the path.
   const int inner = parameters.numberOfPoints - 2;
-  const int ringPoints = std::clamp(static_cast<int>(std::lround(std::sqrt(inner * 2 * M_PI * radius / length))),
+  tube.ringPoints = std::clamp(static_cast<int>(std::lround(std::sqrt(inner * 2 * M_PI * radius / length))),
     kLeastRingPoints, inner / kLeastRings);
-  const int rings = inner / ringPoints;
+  tube.rings = inner / tube.ringPoints;
+  const int rings = tube.rings, ringPoints = tube.ringPoints;
 
   // Each ring's centre on the path smoothed over the local radius, and a frame carried along it.
-  std::vector<Eigen::Vector3d> centres(static_cast<size_t>(rings)), normals(centres.size()), binormals(centres.size());
-  std::vector<double> shares(centres.size());
+  const auto count = static_cast<size_t>(rings);
+  tube.centres.resize(count);
+  tube.normals.resize(count);
+  tube.binormals.resize(count);
+  tube.shares.resize(count);
   const double spacing = length / (rings - 1);
-  for (int k = 0; k < rings; ++k)
+  for (size_t k = 0; k < count; ++k)
   {
-    const double s = spacing * k;
-    shares[k] = shareAt(s);
-    centres[k] = line.SmoothedAt(s, kSmoothingRadii * radius * shares[k]);
+    const double s = spacing * static_cast<double>(k);
+    tube.shares[k] = shareAt(s);
+    tube.centres[k] = line.SmoothedAt(s, kSmoothingRadii * radius * tube.shares[k]);
   }
   Eigen::Vector3d previousTangent = (line.At(spacing) - line.At(0)).normalized(), normal;
-  for (int k = 0; k < rings; ++k)
+  for (size_t k = 0; k < count; ++k)
   {
-    const double s = spacing * k, h = 0.5 * spacing;
-    const Eigen::Vector3d ahead =
-      line.SmoothedAt(std::min(length, s + h), kSmoothingRadii * radius * shareAt(std::min(length, s + h)));
-    const Eigen::Vector3d behind =
-      line.SmoothedAt(std::max(0.0, s - h), kSmoothingRadii * radius * shareAt(std::max(0.0, s - h)));
-    Eigen::Vector3d tangent = ahead - behind;
+    const double s = spacing * static_cast<double>(k), h = 0.5 * spacing;
+    const double ahead = std::min(length, s + h), behind = std::max(0.0, s - h);
+    Eigen::Vector3d tangent = line.SmoothedAt(ahead, kSmoothingRadii * radius * shareAt(ahead)) -
+      line.SmoothedAt(behind, kSmoothingRadii * radius * shareAt(behind));
     tangent = tangent.norm() > kDegenerateShare * length ? tangent.normalized() : previousTangent;
     normal = k == 0 ? AnyPerpendicular(tangent) : Eigen::Vector3d(normal - normal.dot(tangent) * tangent);
     normal = normal.norm() > 1e-6 ? normal.normalized() : AnyPerpendicular(tangent);
-    normals[k] = normal;
-    binormals[k] = tangent.cross(normal);
+    tube.normals[k] = normal;
+    tube.binormals[k] = tangent.cross(normal);
     previousTangent = tangent;
   }
 
   // The triangles: quads between neighbouring rings, a fan at each end.
   const Eigen::Index first = static_cast<Eigen::Index>(rings) * ringPoints, last = first + 1;
-  const auto id = [&](int ring, int j) {
-    return static_cast<std::int64_t>(ring) * ringPoints + (j % ringPoints);
-  };
-  Triangles triangles(2 * (rings - 1) * ringPoints + 2 * ringPoints, 3);
+  tube.triangles.resize(2 * (rings - 1) * ringPoints + 2 * ringPoints, 3);
   Eigen::Index t = 0;
   for (int k = 0; k + 1 < rings; ++k)
   {
     for (int j = 0; j < ringPoints; ++j)
     {
-      triangles.row(t++) << id(k, j), id(k, j + 1), id(k + 1, j + 1);
-      triangles.row(t++) << id(k, j), id(k + 1, j + 1), id(k + 1, j);
+      tube.triangles.row(t++) << tube.Id(k, j), tube.Id(k, j + 1), tube.Id(k + 1, j + 1);
+      tube.triangles.row(t++) << tube.Id(k, j), tube.Id(k + 1, j + 1), tube.Id(k + 1, j);
     }
   }
   for (int j = 0; j < ringPoints; ++j)
   {
-    triangles.row(t++) << first, id(0, j + 1), id(0, j);
-    triangles.row(t++) << last, id(rings - 1, j), id(rings - 1, j + 1);
+    tube.triangles.row(t++) << first, tube.Id(0, j + 1), tube.Id(0, j);
+    tube.triangles.row(t++) << last, tube.Id(rings - 1, j), tube.Id(rings - 1, j + 1);
+  }
+  tube.start = line.At(0);
+  tube.end = line.At(length);
+  tube.floors.resize(count);
+  for (size_t k = 0; k < count; ++k)
+  {
+    const Eigen::Vector3d tangent = tube.normals[k].cross(tube.binormals[k]);
+    double offset = 0;
+    for (int sample = -kSmoothingSamples / 2; sample <= kSmoothingSamples / 2; ++sample)
+    {
+      const Eigen::Vector3d v =
+        line.At(spacing * (static_cast<double>(k) + 2.0 * static_cast<double>(sample) / kSmoothingSamples)) -
+        tube.centres[k];
+      offset = std::max(offset, (v - v.dot(tangent) * tangent).norm());
+    }
+    // A chord between two of the ring's points lies cos(pi / ringPoints) as far out as they do,
+    // and between two rings that turn at a corner the surface passes inside both: half as much
+    // again.
+    tube.floors[k] = std::max(kLeastRadiusShare * tube.Local(k),
+      (kPathMargin * offset + kClearanceShare * tube.Local(k)) / std::cos(M_PI / ringPoints));
   }
 
-  // Each point's direction from its ring's centre, and how far it may go before a bone.
-  std::vector<Eigen::Vector3d> directions(static_cast<size_t>(first));
-  std::vector<double> reach(directions.size(), std::numeric_limits<double>::infinity());
+  // Each point's direction; nothing in its way yet.
+  tube.directions.resize(static_cast<size_t>(first));
   for (int k = 0; k < rings; ++k)
   {
-    const double local = radius * shares[k];
     for (int j = 0; j < ringPoints; ++j)
     {
       const double angle = 2 * M_PI * j / ringPoints;
-      const auto i = static_cast<size_t>(id(k, j));
-      directions[i] = std::cos(angle) * normals[k] + std::sin(angle) * binormals[k];
+      tube.directions[static_cast<size_t>(tube.Id(k, j))] = std::cos(angle) * tube.normals[static_cast<size_t>(k)] +
+        std::sin(angle) * tube.binormals[static_cast<size_t>(k)];
+    }
+  }
+  tube.reach.assign(tube.directions.size(), std::numeric_limits<double>::infinity());
+  tube.heldByBone.assign(tube.directions.size(), 0);
+  tube.heldByMuscle.assign(tube.directions.size(), 0);
+  tube.low = tube.high = tube.centres[0];
+  for (size_t k = 0; k < count; ++k)
+  {
+    const Eigen::Vector3d grow = Eigen::Vector3d::Constant(kMostRadiusScale * tube.Local(k));
+    tube.low = tube.low.cwiseMin(tube.centres[k] - grow);
+    tube.high = tube.high.cwiseMax(tube.centres[k] + grow);
+  }
+  return tube;
+}
+
+/// Each point of `tube` stops short of the first bone its ray enters.
+void HoldOffBones(Tube& tube, const std::vector<const TriangleTree*>& bones)
+{
+  for (int k = 0; k < tube.rings; ++k)
+  {
+    const double local = tube.Local(static_cast<size_t>(k));
+    const Eigen::Vector3d& centre = tube.centres[static_cast<size_t>(k)];
+    for (int j = 0; j < tube.ringPoints; ++j)
+    {
+      const auto i = static_cast<size_t>(tube.Id(k, j));
       const double farthest = kMostRadiusScale * local;
       for (const TriangleTree* bone : bones)
       {
-        if (const auto hit = bone->FirstEntry(centres[k], centres[k] + farthest * directions[i]))
+        if (const auto hit = bone->FirstEntry(centre, centre + farthest * tube.directions[i]))
         {
-          reach[i] =
-            std::min(reach[i], std::max(hit->t * farthest - kBoneClearanceShare * local, kLeastRadiusShare * local));
+          const double limit =
+            std::max(hit->t * farthest - kClearanceShare * local, tube.floors[static_cast<size_t>(k)]);
+          if (limit < tube.reach[i])
+          {
+            tube.reach[i] = limit;
+            tube.heldByBone[i] = 1;
+          }
         }
       }
     }
   }
+}
 
-  // The points at a scale of the radii (each within its reach); the scale that gives the volume.
-  Points points(last + 1, 3);
-  points.row(first) = line.At(0).transpose();
-  points.row(last) = line.At(length).transpose();
-  const auto place = [&](double scale) {
-    for (int k = 0; k < rings; ++k)
+/// The distance from x to a neighbour's centre line, over its segments `near` (k: ring k to k+1).
+double DistanceToCentreLine(const Tube& other, const std::vector<int>& near, const Eigen::Vector3d& x)
+{
+  double least = std::numeric_limits<double>::infinity();
+  for (const int k : near)
+  {
+    const auto a = static_cast<size_t>(k);
+    const Eigen::Vector3d& p = other.centres[a];
+    const Eigen::Vector3d d = other.centres[a + 1] - p;
+    const double f = std::clamp(d.squaredNorm() > 0 ? (x - p).dot(d) / d.squaredNorm() : 0.0, 0.0, 1.0);
+    least = std::min(least, (x - (p + f * d)).norm());
+  }
+  return least;
+}
+
+/// Each point of `tube` stops where its ray leaves the tube's share of the space it shares with
+/// `others`: the points nearer its own centre line than any other's (a Voronoi diagram of the
+/// centre lines; a point's distance to its own taken as its distance from its ring's centre,
+/// which is never less, so that the cell is if anything smaller). The cells of two tubes do not
+/// overlap, so their points stay apart whatever each widens to, and each centre line, hence each
+/// path, keeps its own cell: only where paths cross do they meet.
+void HoldOffNeighbours(Tube& tube, const std::vector<const Tube*>& others)
+{
+  for (int k = 0; k < tube.rings; ++k)
+  {
+    const auto ring = static_cast<size_t>(k);
+    const double local = tube.Local(ring), farthest = kMostRadiusScale * local;
+    const Eigen::Vector3d& centre = tube.centres[ring];
+    // The neighbours' segments that can come within this ring's reach.
+    std::vector<std::pair<const Tube*, std::vector<int>>> near;
+    for (const Tube* other : others)
     {
-      for (int j = 0; j < ringPoints; ++j)
+      if (((centre.array() + farthest) < other->low.array()).any() ||
+        ((centre.array() - farthest) > other->high.array()).any())
       {
-        const auto i = static_cast<size_t>(id(k, j));
-        points.row(id(k, j)) =
-          (centres[k] + std::min(scale * radius * shares[k], reach[i]) * directions[i]).transpose();
+        continue;
+      }
+      std::vector<int> segments;
+      for (int s = 0; s + 1 < other->rings; ++s)
+      {
+        const auto a = static_cast<size_t>(s);
+        const Eigen::Vector3d& p = other->centres[a];
+        const Eigen::Vector3d d = other->centres[a + 1] - p;
+        const double f = std::clamp(d.squaredNorm() > 0 ? (centre - p).dot(d) / d.squaredNorm() : 0.0, 0.0, 1.0);
+        if ((centre - (p + f * d)).norm() < 2 * farthest)
+        {
+          segments.push_back(s);
+        }
+      }
+      if (!segments.empty())
+      {
+        near.emplace_back(other, std::move(segments));
       }
     }
-    return SignedVolume(points, triangles);
+    // At t along the ray, the cell's edge where a neighbour's centre line is nearer than t.
+    const auto margin = [&](const Eigen::Vector3d& x, double t) {
+      double least = std::numeric_limits<double>::infinity();
+      for (const auto& [other, segments] : near)
+      {
+        least = std::min(least, DistanceToCentreLine(*other, segments, x));
+      }
+      return least - t; // > 0: x is in this tube's cell
+    };
+    if (near.empty() || margin(centre, 0) <= 0)
+    {
+      continue;
+    }
+    for (int j = 0; j < tube.ringPoints; ++j)
+    {
+      const auto i = static_cast<size_t>(tube.Id(k, j));
+      const Eigen::Vector3d& direction = tube.directions[i];
+      const double reach = std::min(tube.reach[i], farthest);
+      // March out to the first step outside the cell, then halve the step.
+      const double step = local / kCellSteps;
+      double inner = 0, outer = -1;
+      for (double t = step; t <= reach + 0.5 * step; t += step)
+      {
+        if (margin(centre + std::min(t, reach) * direction, std::min(t, reach)) <= 0)
+        {
+          outer = std::min(t, reach);
+          break;
+        }
+        inner = std::min(t, reach);
+      }
+      if (outer < 0)
+      {
+        continue; // the cell reaches as far as the point may go
+      }
+      for (int halving = 0; halving < kCellHalvings; ++halving)
+      {
+        const double mid = 0.5 * (inner + outer);
+        (margin(centre + mid * direction, mid) > 0 ? inner : outer) = mid;
+      }
+      const double limit = std::max(inner - kClearanceShare * local, tube.floors[ring]);
+      if (limit < tube.reach[i])
+      {
+        tube.reach[i] = limit;
+        tube.heldByMuscle[i] = 1;
+      }
+    }
+  }
+}
+
+/// The surface of `tube` with its radii scaled (each within its reach) to the estimated volume.
+MuscleFromPathResult Finish(Tube& tube)
+{
+  MuscleFromPathResult result = tube.result;
+  const Eigen::Index first = static_cast<Eigen::Index>(tube.rings) * tube.ringPoints, last = first + 1;
+  Points points(last + 1, 3);
+  points.row(first) = tube.start.transpose();
+  points.row(last) = tube.end.transpose();
+  const auto place = [&](double scale) {
+    for (int k = 0; k < tube.rings; ++k)
+    {
+      const double local = tube.Local(static_cast<size_t>(k));
+      for (int j = 0; j < tube.ringPoints; ++j)
+      {
+        const auto i = static_cast<size_t>(tube.Id(k, j));
+        points.row(tube.Id(k, j)) =
+          (tube.centres[static_cast<size_t>(k)] + std::min(scale * local, tube.reach[i]) * tube.directions[i])
+            .transpose();
+      }
+    }
+    return SignedVolume(points, tube.triangles);
   };
   double scale = 1, volume = place(scale);
   if (volume < 0)
   {
-    triangles.col(1).swap(triangles.col(2));
+    tube.triangles.col(1).swap(tube.triangles.col(2));
     volume = -volume;
   }
   const auto off = [&] {
@@ -304,7 +500,7 @@ MuscleFromPathResult MuscleFromPath(const Points& path, const MuscleProperties& 
     scale = std::min(kMostRadiusScale, scale * std::sqrt(result.estimatedVolume / volume));
     volume = place(scale);
   }
-  // Where bones hold points, the volume grows slower than the scale squared: halve the bracket
+  // Where points are held, the volume grows slower than the scale squared: halve the bracket
   // (the volume rises with the scale), unless even the largest scale falls short.
   double low = 0, high = kMostRadiusScale;
   for (int round = 0; round < kVolumeRounds && off() && !(scale == kMostRadiusScale && volume < result.estimatedVolume);
@@ -317,20 +513,82 @@ MuscleFromPathResult MuscleFromPath(const Points& path, const MuscleProperties& 
   if (volume < result.estimatedVolume * (1 - 1e-6))
   {
     std::ostringstream note;
-    note << "the bones leave room for " << 100 * volume / result.estimatedVolume
+    note << "the bones and the other muscles leave room for " << 100 * volume / result.estimatedVolume
          << " % of the estimated volume at three times the radii";
     result.notes.push_back(note.str());
   }
-  for (size_t i = 0; i < reach.size(); ++i)
+  for (size_t i = 0; i < tube.reach.size(); ++i)
   {
-    const int ring = static_cast<int>(i) / ringPoints;
-    result.pointsHeldByBones += reach[i] < scale * radius * shares[static_cast<size_t>(ring)];
+    const bool held = tube.reach[i] < scale * tube.Local(i / static_cast<size_t>(tube.ringPoints));
+    result.pointsHeldByBones += held && tube.heldByBone[i] && !tube.heldByMuscle[i];
+    result.pointsHeldByMuscles += held && tube.heldByMuscle[i];
   }
-  result.surface = { points, triangles };
+  result.surface = { points, tube.triangles };
   result.volume = volume;
   result.volumeKept = volume / result.estimatedVolume;
-  result.bellyRadius = scale * radius;
-  result.tendonRadius = scale * radius * ratio;
+  result.bellyRadius = scale * tube.radius;
+  result.tendonRadius = scale * tube.radius * tube.shares.front();
   return result;
+}
+}
+
+MuscleFromPathResult MuscleFromPath(const Points& path, const MuscleProperties& muscle,
+  const MuscleFromPathParameters& parameters, const std::vector<const TriangleTree*>& bones)
+{
+  Tube tube = MakeTube(path, muscle, parameters);
+  HoldOffBones(tube, bones);
+  return Finish(tube);
+}
+
+std::vector<MuscleFromPathResult> MusclesFromPaths(const std::vector<Points>& paths,
+  const std::vector<MuscleProperties>& muscles, const MuscleFromPathParameters& parameters,
+  const std::vector<const TriangleTree*>& bones, std::vector<std::string>& failures)
+{
+  if (muscles.size() != paths.size())
+  {
+    throw InputError("there are " + std::to_string(paths.size()) + " paths and " + std::to_string(muscles.size()) +
+      " muscles' properties: one each");
+  }
+  failures.assign(paths.size(), std::string());
+  std::vector<std::optional<Tube>> tubes(paths.size());
+  for (size_t m = 0; m < paths.size(); ++m)
+  {
+    try
+    {
+      tubes[m] = MakeTube(paths[m], muscles[m], parameters);
+    }
+    catch (const InputError& e)
+    {
+      failures[m] = e.what(); // the others go on
+    }
+  }
+  std::vector<MuscleFromPathResult> results(paths.size());
+#pragma omp parallel for schedule(dynamic)
+  for (std::ptrdiff_t m = 0; m < static_cast<std::ptrdiff_t>(paths.size()); ++m)
+  {
+    auto& tube = tubes[static_cast<size_t>(m)];
+    if (!tube)
+    {
+      continue;
+    }
+    HoldOffBones(*tube, bones);
+    std::vector<const Tube*> others;
+    for (size_t o = 0; o < tubes.size(); ++o)
+    {
+      if (o != static_cast<size_t>(m) && tubes[o])
+      {
+        others.push_back(&*tubes[o]);
+      }
+    }
+    HoldOffNeighbours(*tube, others);
+  }
+  for (size_t m = 0; m < paths.size(); ++m)
+  {
+    if (tubes[m])
+    {
+      results[m] = Finish(*tubes[m]);
+    }
+  }
+  return results;
 }
 }

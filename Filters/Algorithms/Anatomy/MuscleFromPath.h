@@ -36,9 +36,10 @@ struct MuscleFromPathResult
   bool bellyLimited = false;  ///< the belly's share of the path set by a limit, not the tendon
   double bellyRadius = 0;     ///< the belly's largest radius
   double tendonRadius = 0;    ///< the radius along the tendons
-  /// Surface points whose radius a bone held short, and the volume the surface holds as a share
-  /// of the estimate (1 unless the bones left no room for it).
+  /// Surface points whose radius a bone, or another muscle, held short, and the volume the
+  /// surface holds as a share of the estimate (1 unless they left no room for it).
   int pointsHeldByBones = 0;
+  int pointsHeldByMuscles = 0;
   double volumeKept = 1;
   std::vector<std::string> notes; ///< assumptions the input forced (a belly share clamped)
 };
@@ -68,4 +69,15 @@ double EstimatedMuscleVolume(const MuscleProperties& muscle, double specificTens
 /// length, a muscle property missing or out of range, parameters out of range.
 MuscleFromPathResult MuscleFromPath(const Points& path, const MuscleProperties& muscle,
   const MuscleFromPathParameters& parameters, const std::vector<const TriangleTree*>& bones = {});
+
+/// Every muscle of a model at once, as MuscleFromPath, each also kept out of the others: the
+/// space is shared as a Voronoi diagram of the tubes' centre lines (a point belongs to the muscle
+/// whose smoothed path is nearest), each point stops 2 % of its local radius short of its tube's
+/// cell, and the rest widens to keep the volume. The cells do not overlap, so neither do the
+/// surfaces' points, however each widens; each path keeps its own cell, so only paths that cross
+/// make their muscles meet. `failures[m]` gets muscle m's InputError (its result left empty); the
+/// others go on.
+std::vector<MuscleFromPathResult> MusclesFromPaths(const std::vector<Points>& paths,
+  const std::vector<MuscleProperties>& muscles, const MuscleFromPathParameters& parameters,
+  const std::vector<const TriangleTree*>& bones, std::vector<std::string>& failures);
 }
