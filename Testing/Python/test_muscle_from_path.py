@@ -87,13 +87,7 @@ def path_points_outside(path, surface, count=40):
                            for s in numpy.linspace(0, at[-1], count + 1)[1:-1]])
     queries = vtkPolyData()
     queries.SetPoints(vtk_points(samples))
-    enclosed = vtkSelectEnclosedPoints()
-    enclosed.SetInputData(queries)
-    enclosed.SetSurfaceData(surface)
-    enclosed.SetTolerance(1e-9)
-    enclosed.Update()
-    inside = enclosed.GetOutput().GetPointData().GetArray("SelectedPoints")
-    return sum(1 for i in range(inside.GetNumberOfTuples()) if inside.GetValue(i) == 0)
+    return len(samples) - count_inside(queries, surface)
 
 
 def vtk_points(array):
@@ -104,37 +98,28 @@ def vtk_points(array):
     return points
 
 
+def count_inside(points, surface):
+    """How many of the points of the dataset `points` lie inside the closed `surface`."""
+    enclosed = vtkSelectEnclosedPoints()
+    enclosed.SetInputData(points)
+    enclosed.SetSurfaceData(surface)
+    enclosed.SetTolerance(1e-9)
+    enclosed.Update()
+    selected = enclosed.GetOutput().GetPointData().GetArray("SelectedPoints")
+    return sum(selected.GetValue(i) for i in range(selected.GetNumberOfTuples()))
+
+
 def points_in_closed_bones(muscles, bones):
     """How many of the muscles' surface points lie inside any of `bones` (closed surfaces)."""
-    count = 0
-    for _, surface in muscles:
-        for bone in bones:
-            enclosed = vtkSelectEnclosedPoints()
-            enclosed.SetInputData(surface)
-            enclosed.SetSurfaceData(bone)
-            enclosed.SetTolerance(1e-9)
-            enclosed.Update()
-            selected = enclosed.GetOutput().GetPointData().GetArray("SelectedPoints")
-            count += sum(selected.GetValue(i) for i in range(selected.GetNumberOfTuples()))
-    return count
+    return sum(count_inside(surface, bone) for _, surface in muscles for bone in bones)
 
 
 def points_in_other_muscles(muscles):
     """How many of the muscles' surface points lie inside another of them (pairs whose boxes meet)."""
-    count = 0
-    for a, (_, first) in enumerate(muscles):
-        for b, (_, second) in enumerate(muscles):
-            low_a, low_b = first.GetBounds(), second.GetBounds()
-            if a == b or any(low_a[2 * k + 1] < low_b[2 * k] or low_b[2 * k + 1] < low_a[2 * k] for k in range(3)):
-                continue
-            enclosed = vtkSelectEnclosedPoints()
-            enclosed.SetInputData(first)
-            enclosed.SetSurfaceData(second)
-            enclosed.SetTolerance(1e-9)
-            enclosed.Update()
-            selected = enclosed.GetOutput().GetPointData().GetArray("SelectedPoints")
-            count += sum(selected.GetValue(i) for i in range(selected.GetNumberOfTuples()))
-    return count
+    def meet(a, b):
+        return all(a[2 * k] <= b[2 * k + 1] and b[2 * k] <= a[2 * k + 1] for k in range(3))
+    return sum(count_inside(first, second) for a, (_, first) in enumerate(muscles)
+               for b, (_, second) in enumerate(muscles) if a != b and meet(first.GetBounds(), second.GetBounds()))
 
 
 def leaves(data):

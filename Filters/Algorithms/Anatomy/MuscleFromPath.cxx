@@ -36,9 +36,9 @@ constexpr int kVolumeRounds = 50;
 /// to keep the volume.
 constexpr double kClearanceShare = 0.02;
 constexpr double kLeastRadiusShare = 0.1;
+constexpr double kMostRadiusScale = 3.0;
 /// A held point stays this many times as far from its ring's centre as the path near the ring.
 constexpr double kPathMargin = 1.5;
-constexpr double kMostRadiusScale = 3.0;
 /// A ray is followed out of its tube's cell in steps of the local radius over this, then the step
 /// halved this many times (to a 1/2048 of the radius).
 constexpr double kCellSteps = 8;

@@ -60,7 +60,8 @@ double EstimatedMuscleVolume(const MuscleProperties& muscle, double specificTens
 ///
 /// `bones` (outward surfaces, closed or not): each surface point stops short of the first bone
 /// its ray from the tube's centre enters (by 2 % of the local radius, and never nearer the centre
-/// than a tenth of it), and the others widen, to three times their radius at most, to keep the
+/// than a tenth of it, nor so near that the path near it would leave the surface), and the others
+/// widen, to three times their radius at most, to keep the
 /// volume. A ray that starts inside a bone passes the triangles it leaves through, so a path
 /// that runs in a bone (an attachment) keeps its tube there, and an open mesh is a one-sided
 /// obstacle, met from its outer side only. Where the bones leave too little room, the volume
