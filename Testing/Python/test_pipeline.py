@@ -54,7 +54,7 @@ class ServerManagerXML(unittest.TestCase):
                                     "MuscleDeformation.Obstacles", "MuscleDeformation.Hull",
                                     "IntersectionResolve.InputRest", "IntersectionResolve.ObstaclesRest",
                                     "InterpolatedMuscleDeformation.Attachments",
-                                    "MotionMuscleDeformation.Attachments", "MuscleFromPath.Bones"})
+                                    "MotionMuscleDeformation.Attachments"})
 
     def test_the_plugin_folder_offers_the_plugin_alone(self):
         # Tools > Manage Plugins > Load New... lists the shared libraries of the folder: a second
