@@ -141,6 +141,15 @@ constexpr const char* FibreLength = "FibreLength";
 /// adds rows: empty for the frame's own pose, "<coordinate>+" or "<coordinate>-" for the frame's
 /// pose stepped by +-MomentArmStep in that coordinate. Absent: every row is the frame's.
 constexpr const char* Pose = "Pose";
+/// OpenSimModelReader's field data of each muscle path, which MuscleFromPath reads: OpenSim's
+/// class of the path's actuator, metres per length unit of the output, and the muscle's
+/// properties under OpenSim's names (lengths in the output's unit; absent for a path actuator).
+constexpr const char* MuscleType = "MuscleType";
+constexpr const char* MetresPerLengthUnit = "MetresPerLengthUnit";
+constexpr const char* MaxIsometricForce = "max_isometric_force";
+constexpr const char* OptimalFiberLength = "optimal_fiber_length";
+constexpr const char* TendonSlackLength = "tendon_slack_length";
+constexpr const char* PennationAngleAtOptimal = "pennation_angle_at_optimal";
 /// BodyTransforms' field data (and MoveWithBodies' output's): the step of the stepped poses, degrees.
 constexpr const char* MomentArmStep = "MomentArmStep";
 /// BodyTransforms' other columns (OpenSimModelReader writes them, MoveWithBodies reads them): each

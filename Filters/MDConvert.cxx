@@ -275,7 +275,7 @@ vtkIdType ReadTriangles(vtkPolyData* input, TriangleMesh& mesh)
 }
 
 bool ReadMeshes(vtkInformationVector* port, const std::string& portName, std::vector<std::string>& names,
-  std::vector<TriangleMesh>& meshes, std::string& error)
+  std::vector<TriangleMesh>& meshes, std::string& error, bool skipEmpty)
 {
   for (int c = 0; c < port->GetNumberOfInformationObjects(); ++c)
   {
@@ -287,7 +287,7 @@ bool ReadMeshes(vtkInformationVector* port, const std::string& portName, std::ve
     }
     for (const Leaf& leaf : leaves)
     {
-      if (!leaf.data)
+      if (!leaf.data || (skipEmpty && leaf.data->GetNumberOfPoints() == 0))
       {
         continue;
       }

@@ -64,9 +64,10 @@ std::vector<Knots> ToKnots(vtkPolyData* polyData);
 vtkSmartPointer<vtkPolyData> ToPolyLines(const std::vector<Points>& lines);
 /// The meshes of every block of every connection of a repeatable input port
 /// (such as Obstacles), named by block name or label. Fails, with a message,
-/// on a block without triangles or with non-finite coordinates.
+/// on a block without triangles or with non-finite coordinates; with `skipEmpty`, a block with no
+/// points (a model's body without a mesh) is passed over instead.
 bool ReadMeshes(vtkInformationVector* port, const std::string& portName, std::vector<std::string>& names,
-  std::vector<TriangleMesh>& meshes, std::string& error);
+  std::vector<TriangleMesh>& meshes, std::string& error, bool skipEmpty = false);
 
 /// The bones of `rest` (input `restName`) and `current` (input `currentName`) paired as PairLeaves
 /// pairs them, each with the same points in both; an empty block in both is skipped. Fails, naming

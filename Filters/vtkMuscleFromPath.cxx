@@ -34,15 +34,17 @@ double FieldNumber(vtkFieldData* fieldData, const char* name)
 bool ReadMuscle(vtkPolyData* path, md::MuscleProperties& muscle, double& metresPerUnit, std::string& error)
 {
   vtkFieldData* fieldData = path->GetFieldData();
-  muscle.maxIsometricForce = FieldNumber(fieldData, "max_isometric_force");
-  muscle.optimalFiberLength = FieldNumber(fieldData, "optimal_fiber_length");
-  muscle.tendonSlackLength = FieldNumber(fieldData, "tendon_slack_length");
-  muscle.pennationAngle = FieldNumber(fieldData, "pennation_angle_at_optimal");
-  metresPerUnit = FieldNumber(fieldData, "MetresPerLengthUnit");
+  namespace array = mdvtk::array;
+  muscle.maxIsometricForce = FieldNumber(fieldData, array::MaxIsometricForce);
+  muscle.optimalFiberLength = FieldNumber(fieldData, array::OptimalFiberLength);
+  muscle.tendonSlackLength = FieldNumber(fieldData, array::TendonSlackLength);
+  muscle.pennationAngle = FieldNumber(fieldData, array::PennationAngleAtOptimal);
+  metresPerUnit = FieldNumber(fieldData, array::MetresPerLengthUnit);
   std::string missing;
-  for (const auto& [name, value] : { std::pair<const char*, double>{ "max_isometric_force", muscle.maxIsometricForce },
-         { "optimal_fiber_length", muscle.optimalFiberLength }, { "tendon_slack_length", muscle.tendonSlackLength },
-         { "MetresPerLengthUnit", metresPerUnit } })
+  for (const auto& [name, value] :
+    { std::pair<const char*, double>{ array::MaxIsometricForce, muscle.maxIsometricForce },
+      { array::OptimalFiberLength, muscle.optimalFiberLength }, { array::TendonSlackLength, muscle.tendonSlackLength },
+      { array::MetresPerLengthUnit, metresPerUnit } })
   {
     if (!std::isfinite(value))
     {
@@ -72,7 +74,7 @@ vtkMuscleFromPath::vtkMuscleFromPath()
   this->SpecificTension = defaults.specificTension * 100; // N/mm^2 -> N/cm^2
   this->NumberOfPoints = defaults.numberOfPoints;
   this->TendonRadiusRatio = defaults.tendonRadiusRatio;
-  this->KeepMusclesApart = true;
+  this->KeepMusclesApart = defaults.keepMusclesApart;
 }
 
 int vtkMuscleFromPath::FillInputPortInformation(int port, vtkInformation* info)
@@ -88,30 +90,20 @@ int vtkMuscleFromPath::FillInputPortInformation(int port, vtkInformation* info)
 bool vtkMuscleFromPath::ReadBones(
   vtkInformationVector* port, std::vector<std::unique_ptr<md::TriangleTree>>& trees, std::string& error)
 {
-  vtkDataObject* bones = port->GetNumberOfInformationObjects() > 0 ? vtkDataObject::GetData(port, 0) : nullptr;
-  std::vector<mdvtk::Leaf> leaves;
-  if (bones && !mdvtk::CollectLeaves(bones, "Bones", leaves, error))
+  std::vector<std::string> names;
+  std::vector<md::TriangleMesh> meshes;
+  if (!mdvtk::ReadMeshes(port, "Bones", names, meshes, error, /*skipEmpty=*/true)) // a body without a mesh
   {
     return false;
   }
-  for (const mdvtk::Leaf& leaf : leaves)
+  for (size_t b = 0; b < meshes.size(); ++b)
   {
-    md::TriangleMesh mesh;
-    if (!leaf.data || leaf.data->GetNumberOfPoints() == 0)
+    if (!md::AllFinite(meshes[b].points))
     {
-      continue; // a body without a mesh (the ground)
-    }
-    if (mdvtk::ReadTriangles(leaf.data, mesh) < 0 || mesh.triangles.rows() == 0)
-    {
-      error = leaf.label + " has no triangles: a bone is a surface";
+      error = "Bones block '" + names[b] + "' has a coordinate that is not a finite number";
       return false;
     }
-    if (!md::AllFinite(mesh.points))
-    {
-      error = leaf.label + " has a coordinate that is not a finite number";
-      return false;
-    }
-    trees.push_back(std::make_unique<md::TriangleTree>(mesh));
+    trees.push_back(std::make_unique<md::TriangleTree>(meshes[b]));
   }
   return true;
 }
@@ -168,8 +160,8 @@ int vtkMuscleFromPath::RequestData(
       continue;
     }
     const std::vector<md::Points> lines = mdvtk::ToPolylines(leaf.data);
-    auto* type = vtkStringArray::SafeDownCast(leaf.data->GetFieldData()->GetAbstractArray("MuscleType"));
-    if (type && type->GetNumberOfValues() > 0 && !leaf.data->GetFieldData()->GetArray("max_isometric_force"))
+    auto* type = vtkStringArray::SafeDownCast(leaf.data->GetFieldData()->GetAbstractArray(mdvtk::array::MuscleType));
+    if (type && type->GetNumberOfValues() > 0 && !leaf.data->GetFieldData()->GetArray(mdvtk::array::MaxIsometricForce))
     {
       // A model's path actuator that is not a muscle (OpenSim's PathActuator): nothing to make.
       results[b] = mdvtk::FailedMuscle(leaf.data, "a " + type->GetValue(0) + ", not a muscle: no surface is made");
@@ -213,23 +205,9 @@ int vtkMuscleFromPath::RequestData(
   int result = 1;
   std::string failure;
   const auto start = std::chrono::steady_clock::now();
+  parameters.keepMusclesApart = this->KeepMusclesApart;
   const auto make = [&] {
-    if (this->KeepMusclesApart)
-    {
-      made = md::MusclesFromPaths(paths, muscles, parameters, bones, failures);
-      return;
-    }
-    for (size_t m = 0; m < paths.size(); ++m)
-    {
-      try
-      {
-        made[m] = md::MuscleFromPath(paths[m], muscles[m], parameters, bones);
-      }
-      catch (const md::InputError& e)
-      {
-        failures[m] = e.what(); // the others go on
-      }
-    }
+    made = md::MusclesFromPaths(paths, muscles, parameters, bones, failures);
   };
   if (!paths.empty() && !mdvtk::CallCore(this, "", make, result, &failure))
   {

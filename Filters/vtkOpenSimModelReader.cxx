@@ -701,17 +701,17 @@ void vtkOpenSimModelReader::WritePaths(const std::vector<double>& coordinates,
 
 void vtkOpenSimModelReader::WriteMuscleProperties(const md::osim::Path& path, vtkFieldData* fieldData) const
 {
-  auto type = vtkSmartPointer<vtkStringArray>::New();
-  type->SetName("MuscleType");
+  namespace array = mdvtk::array;
+  auto type = Strings(array::MuscleType);
   type->InsertNextValue(path.type);
   fieldData->AddArray(type);
-  mdvtk::AddFieldValue(fieldData, "MetresPerLengthUnit", 1.0 / this->Scale);
+  mdvtk::AddFieldValue(fieldData, array::MetresPerLengthUnit, 1.0 / this->Scale);
   // As OpenSim names them; the lengths in the output's unit, as every other length here.
   const md::MuscleProperties& muscle = path.muscle;
-  const std::pair<const char*, double> values[] = { { "max_isometric_force", muscle.maxIsometricForce },
-    { "optimal_fiber_length", this->Scale * muscle.optimalFiberLength },
-    { "tendon_slack_length", this->Scale * muscle.tendonSlackLength },
-    { "pennation_angle_at_optimal", muscle.pennationAngle } };
+  const std::pair<const char*, double> values[] = { { array::MaxIsometricForce, muscle.maxIsometricForce },
+    { array::OptimalFiberLength, this->Scale * muscle.optimalFiberLength },
+    { array::TendonSlackLength, this->Scale * muscle.tendonSlackLength },
+    { array::PennationAngleAtOptimal, muscle.pennationAngle } };
   for (const auto& [name, value] : values)
   {
     if (std::isfinite(value))

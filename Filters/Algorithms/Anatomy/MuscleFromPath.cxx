@@ -2,6 +2,7 @@
 #include "Anatomy/MuscleFromPath.h"
 
 #include "Geometry/MeshChecks.h"
+#include "Geometry/Polyline.h"
 
 #include <algorithm>
 #include <cmath>
@@ -361,17 +362,20 @@ void HoldOffBones(Tube& tube, const std::vector<const TriangleTree*>& bones)
   }
 }
 
+/// The distance from x to the segment of `other`'s centre line from ring k to ring k + 1.
+double DistanceToSegment(const Eigen::Vector3d& x, const Tube& other, size_t k)
+{
+  const Eigen::Vector3d &a = other.centres[k], &b = other.centres[k + 1];
+  return (a + SegmentFoot(x, a, b) * (b - a) - x).norm();
+}
+
 /// The distance from x to a neighbour's centre line, over its segments `near` (k: ring k to k+1).
 double DistanceToCentreLine(const Tube& other, const std::vector<int>& near, const Eigen::Vector3d& x)
 {
   double least = std::numeric_limits<double>::infinity();
   for (const int k : near)
   {
-    const auto a = static_cast<size_t>(k);
-    const Eigen::Vector3d& p = other.centres[a];
-    const Eigen::Vector3d d = other.centres[a + 1] - p;
-    const double f = std::clamp(d.squaredNorm() > 0 ? (x - p).dot(d) / d.squaredNorm() : 0.0, 0.0, 1.0);
-    least = std::min(least, (x - (p + f * d)).norm());
+    least = std::min(least, DistanceToSegment(x, other, static_cast<size_t>(k)));
   }
   return least;
 }
@@ -401,11 +405,7 @@ void HoldOffNeighbours(Tube& tube, const std::vector<const Tube*>& others)
       std::vector<int> segments;
       for (int s = 0; s + 1 < other->rings; ++s)
       {
-        const auto a = static_cast<size_t>(s);
-        const Eigen::Vector3d& p = other->centres[a];
-        const Eigen::Vector3d d = other->centres[a + 1] - p;
-        const double f = std::clamp(d.squaredNorm() > 0 ? (centre - p).dot(d) / d.squaredNorm() : 0.0, 0.0, 1.0);
-        if ((centre - (p + f * d)).norm() < 2 * farthest)
+        if (DistanceToSegment(centre, *other, static_cast<size_t>(s)) < 2 * farthest)
         {
           segments.push_back(s);
         }
@@ -572,6 +572,10 @@ std::vector<MuscleFromPathResult> MusclesFromPaths(const std::vector<Points>& pa
       continue;
     }
     HoldOffBones(*tube, bones);
+    if (!parameters.keepMusclesApart)
+    {
+      continue;
+    }
     std::vector<const Tube*> others;
     for (size_t o = 0; o < tubes.size(); ++o)
     {

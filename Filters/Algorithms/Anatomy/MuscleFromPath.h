@@ -24,6 +24,9 @@ struct MuscleFromPathParameters
   /// A tendon's radius as a share of the belly's: the surface keeps this radius along the
   /// tendons and at its ends, which are the muscle's attachments.
   double tendonRadiusRatio = 0.25;
+  /// MusclesFromPaths: share the space between the muscles, so that they do not overlap; off,
+  /// each is made as MuscleFromPath makes it alone.
+  bool keepMusclesApart = true;
 };
 
 struct MuscleFromPathResult
@@ -76,8 +79,8 @@ MuscleFromPathResult MuscleFromPath(const Points& path, const MuscleProperties& 
 /// whose smoothed path is nearest), each point stops 2 % of its local radius short of its tube's
 /// cell, and the rest widens to keep the volume. The cells do not overlap, so neither do the
 /// surfaces' points, however each widens; each path keeps its own cell, so only paths that cross
-/// make their muscles meet. `failures[m]` gets muscle m's InputError (its result left empty); the
-/// others go on.
+/// make their muscles meet (unless `parameters.keepMusclesApart` is off). `failures[m]` gets
+/// muscle m's InputError (its result left empty); the others go on.
 std::vector<MuscleFromPathResult> MusclesFromPaths(const std::vector<Points>& paths,
   const std::vector<MuscleProperties>& muscles, const MuscleFromPathParameters& parameters,
   const std::vector<const TriangleTree*>& bones, std::vector<std::string>& failures);

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "Deformation/MuscleDeformer.h"
+#include "Geometry/Polyline.h"
 
 #include <algorithm>
 #include <limits>
@@ -14,14 +15,6 @@
 
 namespace md
 {
-/// The parameter in [0, 1] of the foot of p on the segment from a to b (0 on a segment of no length).
-inline double SegmentFoot(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b)
-{
-  const Eigen::Vector3d ab = b - a;
-  const double length2 = ab.squaredNorm();
-  return length2 > 0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
-}
-
 /// A piece of a matched line from one of its own points to the next (MatchedLine::knots): a
 /// segment, or the segments of a path that PathsOverBones kept over a bone.
 struct LineSpan

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Polylines: their length, and points at equal arc lengths along them.
+// Polylines: their length, the foot of a point on a segment, and points at equal arc lengths
+// along them.
 #pragma once
 
 #include "Common/MeshTypes.h"
@@ -19,6 +20,14 @@ double PolylineLength(const Eigen::MatrixBase<Derived>& points)
     length += (points.row(i) - points.row(i - 1)).norm();
   }
   return length;
+}
+
+/// The parameter in [0, 1] of the foot of p on the segment from a to b (0 on a segment of no length).
+inline double SegmentFoot(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+{
+  const Eigen::Vector3d ab = b - a;
+  const double length2 = ab.squaredNorm();
+  return length2 > 0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
 }
 
 /// `count` (>= 2) points at equal arc lengths along `curve`, its ends included.

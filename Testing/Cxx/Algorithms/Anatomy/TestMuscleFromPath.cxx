@@ -4,6 +4,7 @@
 #include "Anatomy/MuscleFromPath.h"
 
 #include "Geometry/MeshChecks.h"
+#include "Geometry/Polyline.h"
 #include "OpenSim/OpenSimKinematics.h"
 #include "OpenSim/OpenSimModel.h"
 #include "RealData.h"
@@ -42,23 +43,16 @@ md::Points Path(std::initializer_list<Eigen::Vector3d> points)
 /// caps) are not inside `surface`.
 int PathPointsOutside(const md::Points& path, const md::TriangleMesh& surface, int count = 50)
 {
-  double length = 0;
-  std::vector<double> at{ 0.0 };
-  for (Eigen::Index i = 1; i < path.rows(); ++i)
+  std::vector<Eigen::Vector3d> curve;
+  for (Eigen::Index i = 0; i < path.rows(); ++i)
   {
-    at.push_back(length += (path.row(i) - path.row(i - 1)).norm());
+    curve.emplace_back(path.row(i).transpose());
   }
+  const md::Points samples = md::ResampleByArcLength(curve, count + 1);
   int outside = 0;
-  for (int k = 1; k < count; ++k)
+  for (Eigen::Index k = 1; k < count; ++k)
   {
-    const double s = length * k / count;
-    size_t i = 1;
-    while (i + 1 < at.size() && at[i] < s)
-    {
-      ++i;
-    }
-    const double f = (s - at[i - 1]) / std::max(at[i] - at[i - 1], 1e-300);
-    const Eigen::Vector3d p = ((1 - f) * path.row(i - 1) + f * path.row(i)).transpose();
+    const Eigen::Vector3d p = samples.row(k).transpose();
     outside += std::abs(md::WindingNumber(surface.points, surface.triangles, p) - 1.0) > 1e-6;
   }
   return outside;
