@@ -114,29 +114,45 @@ std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, 
   }
   md::FibreParameters parameters;
   parameters.count = count;
-  std::string report = filterName + ", fibres:";
-  for (size_t m = 0; m < muscles.size(); ++m)
+  // Each muscle's fibres on their own (a core each), reported in the muscles' order.
+  std::vector<md::FibreEnds> ends(muscles.size());
+  std::vector<std::string> errors(muscles.size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int m = 0; m < static_cast<int>(muscles.size()); ++m)
   {
-    if (failed[m])
+    if (failed[size_t(m)])
     {
       continue;
     }
     try
     {
-      const md::FibreEnds ends = md::FindFibreEnds(muscles[m].rest, muscles[m].attachments, muscles[m].restLines);
-      fibres[m] = std::make_unique<md::MuscleFibres>(muscles[m].rest, ends, parameters, obstacles);
-      report += "\n  muscle '" + muscles[m].name + "': " + std::to_string(fibres[m]->Count()) + " fibres from " +
-        ends.originSource + " to " + ends.insertionSource;
-      for (const std::string& warning : fibres[m]->Warnings())
-      {
-        report += " (" + warning + ")";
-      }
+      const md::MotionDeformation::Muscle& muscle = muscles[size_t(m)];
+      ends[size_t(m)] = md::FindFibreEnds(muscle.rest, muscle.attachments, muscle.restLines);
+      fibres[size_t(m)] = std::make_unique<md::MuscleFibres>(muscle.rest, ends[size_t(m)], parameters, obstacles);
     }
     catch (const md::Error& e)
     {
+      errors[size_t(m)] = e.what();
+    }
+  }
+  std::string report = filterName + ", fibres:";
+  for (size_t m = 0; m < muscles.size(); ++m)
+  {
+    if (!errors[m].empty())
+    {
       vtkOutputWindow::GetInstance()->DisplayWarningText((filterName + " (" + filter->GetClassName() + "): muscle '" +
-        muscles[m].name + "' has no fibres: " + e.what() + "\n")
+        muscles[m].name + "' has no fibres: " + errors[m] + "\n")
                                                            .c_str());
+    }
+    if (!fibres[m])
+    {
+      continue;
+    }
+    report += "\n  muscle '" + muscles[m].name + "': " + std::to_string(fibres[m]->Count()) + " fibres from " +
+      ends[m].originSource + " to " + ends[m].insertionSource;
+    for (const std::string& warning : fibres[m]->Warnings())
+    {
+      report += " (" + warning + ")";
     }
   }
   vtkOutputWindow::GetInstance()->DisplayText((report + "\n").c_str());
