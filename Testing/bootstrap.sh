@@ -12,6 +12,7 @@ MD_DATA_DIR=${MUSCLEDEFORMATION_DATA_DIR:-$MD_SOURCE_DIR/../shared/data}
 # conflicts with python3-paraview). The -dev packages after qtxmlpatterns5-dev-tools are ones
 # ParaView's CMake package looks for when a plugin asks for ParaView::RemotingCore.
 # libqt5svg5: the GUI's toolbar icons are SVG; without it they show blank.
+# openmpi-bin: mpiexec, to run Examples/batch.py's trials over ranks (pvbatch --mpi).
 MD_PACKAGES=(
   cmake g++ make
   paraview paraview-dev python3-paraview
@@ -20,7 +21,7 @@ MD_PACKAGES=(
   qtbase5-dev qttools5-dev qtxmlpatterns5-dev-tools
   libopenmpi-dev libdouble-conversion-dev liblz4-dev libutfcpp-dev
   libpugixml-dev
-  libqt5svg5
+  libqt5svg5 openmpi-bin
 )
 
 # What the test suite needs besides: its hygiene checks (Testing/lint.sh).

@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""The example scripts run as a user runs them, and write what they promise."""
+"""The example scripts run as a user runs them (the batch script also under pvbatch --mpi on two
+ranks), and write what they promise."""
 import glob
 import json
 import os
@@ -8,6 +9,7 @@ import subprocess
 import unittest
 
 import mdtesting
+import numpy
 from vtkmodules.vtkIOImage import vtkPNGReader
 from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
 
@@ -95,6 +97,82 @@ class MotionExample(unittest.TestCase):
         self.assertEqual(sum(figures["fibre_points_outside_muscle"].values()), 0)
         self.assertEqual(sum(figures["fibre_points_inside_bone"].values()), 0)
         self.assertEqual(len(figures["measures"]["Time"]), 16)
+
+
+def leaves_of(path):
+    """Every polydata file under `path`, relative to it."""
+    return sorted(os.path.relpath(f, path) for f in glob.glob(os.path.join(path, "**", "*.vtp"), recursive=True))
+
+
+def same_surfaces(a, b):
+    """Whether two written surfaces hold the same points, cells and arrays, bit for bit (the arrays
+    of seconds apart: times differ from run to run)."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    data = []
+    for path in (a, b):
+        reader = vtkXMLPolyDataReader()
+        reader.SetFileName(path)
+        reader.Update()
+        data.append(reader.GetOutput())
+    if not numpy.array_equal(vtk_to_numpy(data[0].GetPoints().GetData()), vtk_to_numpy(data[1].GetPoints().GetData())):
+        return False
+    if not numpy.array_equal(vtk_to_numpy(data[0].GetPolys().GetData()), vtk_to_numpy(data[1].GetPolys().GetData())):
+        return False
+    for attributes in ("GetPointData", "GetFieldData"):
+        first, second = getattr(data[0], attributes)(), getattr(data[1], attributes)()
+        for i in range(first.GetNumberOfArrays()):
+            name = first.GetArrayName(i)
+            if "Seconds" in name or first.GetArray(i) is None:
+                continue
+            if second.GetArray(name) is None or not numpy.array_equal(
+                    vtk_to_numpy(first.GetArray(i)), vtk_to_numpy(second.GetArray(name)), equal_nan=True):
+                return False
+    return True
+
+
+class BatchExample(unittest.TestCase):
+    def test_trials_spread_over_two_ranks_give_what_one_process_gives(self):
+        mpiexec, pvbatch = shutil.which("mpiexec"), shutil.which("pvbatch")
+        if not mpiexec or not pvbatch:
+            self.skipTest("mpiexec or pvbatch not found")
+        output = mdtesting.output_dir("example-batch")
+        trials = os.path.join(output, "trials.json")
+        with open(trials, "w") as f:
+            json.dump([{"name": "sweep_20", "kind": "phantom", "frames": 4, "flexion": 20.0},
+                       {"name": "sweep_30", "kind": "phantom", "frames": 4, "flexion": 30.0},
+                       {"name": "broken", "kind": "opensim", "model": "missing.osim", "motion": "missing.mot"}], f)
+        # pvpython (built with MPI) started MPI alone: its Open MPI variables would make mpiexec
+        # take itself for a child of this process.
+        environment = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_", "OPAL_"))}
+        environment.update(OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+                           OMPI_MCA_rmaps_base_oversubscribe="1")
+        script = [os.path.join(EXAMPLES, "batch.py"), "--trials", trials]
+        plugin = os.environ.get("MUSCLEDEFORMATION_PLUGIN")
+        script += ["--plugin", plugin] if plugin else []
+        summaries = {}
+        for ranks in (1, 2):
+            folder = os.path.join(output, "ranks_%d" % ranks)
+            launch = [pvbatch] if ranks == 1 else [mpiexec, "-n", "2", pvbatch, "--mpi", "--symmetric"]
+            result = subprocess.run(launch + script + ["--output", folder], capture_output=True, text=True,
+                                    env=environment, timeout=500)
+            self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+            with open(os.path.join(folder, "summary.json")) as f:
+                summaries[ranks] = json.load(f)
+        self.assertEqual(summaries[2]["ranks"], 2)
+        trials = summaries[2]["trials"]
+        self.assertEqual([trials[name]["rank"] for name in ("sweep_20", "sweep_30", "broken")], [0, 1, 0])
+        self.assertIn("missing.osim", trials["broken"]["error"])  # one bad trial does not stop the others
+        for name in ("sweep_20", "sweep_30"):
+            self.assertEqual(trials[name]["frames"], 5)
+            self.assertTrue(trials[name]["every_frame_settled"], name)
+            self.assertLess(trials[name]["max_abs_volume_change_percent"], 1e-4)
+            self.assertEqual(trials[name]["max_new_bone_penetration_depth"], 0.0)
+        one, two = (os.path.join(output, "ranks_%d" % ranks) for ranks in (1, 2))
+        written = leaves_of(one)
+        self.assertEqual(len(written), 2 * 5 * 3)  # two trials, five frames, three muscles
+        self.assertEqual(written, leaves_of(two))
+        for path in written:
+            self.assertTrue(same_surfaces(os.path.join(one, path), os.path.join(two, path)), path)
 
 
 if __name__ == "__main__":
