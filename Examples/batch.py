@@ -17,7 +17,8 @@ has a "name" (its output folder) and a "kind":
   muscles made from the model's paths (MuscleFromPath, "points" a muscle, 600), the model kept
   still about "reference_body" if given.
 
-"frames" (any kind) computes only the first that many frames. Each rank writes, per trial, into
+"frames" computes only the first that many frames of a motion (the phantom's: its sweep's steps,
+computed with its rest pose as frame 0). Each rank writes, per trial, into
 <output>/<name>/: the muscles at every frame (<name>_muscles_<k>.vtm) with <name>.pvd, and
 figures.json (per frame: the seconds through the filter, and every measure of MeasuresOverTime).
 When every rank is done, rank 0 writes <output>/summary.json: per trial its rank, frames,
@@ -116,32 +117,23 @@ def run_trial(trial, folder, output):
     converged = [v for name, c in columns.items() if name.startswith("Converged (") for v in c]
     if not converged:
         raise RuntimeError("no muscle was deformed (the filters' messages say why)")
-    release_pipelines()
     return {"rank": RANK, "frames": len(times), "seconds": time.time() - start,
             "mean_frame_seconds": sum(seconds) / len(seconds),
             "max_abs_volume_change_percent": worst(columns, "VolumeChangePercent", True),
             "max_new_penetration_count": worst(columns, "NewPenetrationCount"),
             "max_new_bone_penetration_depth": worst(columns, "MaxNewBonePenetrationDepth"),
-            "every_frame_settled": bool(converged) and min(converged) == 1}
+            "every_frame_settled": min(converged) == 1}
 
 
 def release_pipelines():
     """Deletes every source, consumers first, so that a rank's memory does not grow trial by trial."""
     sources = list(simple.GetSources().values())
     while sources:
-        free = [p for p in sources if not any(p.GetNumberOfConsumers() and
-                                              c in sources for c in consumers(p))]
-        for proxy in free or sources:
+        consumed = {proxy.GetConsumerProxy(i) for proxy in sources for i in range(proxy.GetNumberOfConsumers())}
+        free = [proxy for proxy in sources if proxy.SMProxy not in consumed] or sources
+        for proxy in free:
             simple.Delete(proxy)
-        sources = [p for p in sources if p not in (free or sources)]
-
-
-def consumers(proxy):
-    found = []
-    for i in range(proxy.GetNumberOfConsumers()):
-        consumer = servermanager._getPyProxy(proxy.GetConsumerProxy(i))
-        found.append(consumer)
-    return found
+        sources = [proxy for proxy in sources if proxy not in free]
 
 
 def main(argv=None):
@@ -162,6 +154,8 @@ def main(argv=None):
         except Exception as error:  # one trial's failure is reported, the others go on
             traceback.print_exc()
             report = {"rank": RANK, "error": str(error)}
+        finally:
+            release_pipelines()
         with open(os.path.join(args.output, "trial_%d.json" % index), "w") as f:
             json.dump(report, f, indent=1, sort_keys=True)
         print("rank %d: trial %r: %s" % (RANK, trial.get("name"), report), flush=True)

@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <numeric>
 
@@ -117,6 +118,7 @@ std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, 
   // Each muscle's fibres on their own (a core each), reported in the muscles' order.
   std::vector<md::FibreEnds> ends(muscles.size());
   std::vector<std::string> errors(muscles.size());
+  std::vector<std::exception_ptr> unexpected(muscles.size()); // raised again after the loop, as before
 #pragma omp parallel for schedule(dynamic, 1)
   for (int m = 0; m < static_cast<int>(muscles.size()); ++m)
   {
@@ -133,6 +135,17 @@ std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, 
     catch (const md::Error& e)
     {
       errors[size_t(m)] = e.what();
+    }
+    catch (...)
+    {
+      unexpected[size_t(m)] = std::current_exception();
+    }
+  }
+  for (const std::exception_ptr& raised : unexpected)
+  {
+    if (raised)
+    {
+      std::rethrow_exception(raised);
     }
   }
   std::string report = filterName + ", fibres:";

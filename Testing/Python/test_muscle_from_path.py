@@ -11,6 +11,7 @@ import unittest
 import numpy
 import mdtesting
 import mdexamples
+import motion as job  # Examples/motion.py: the main job's pipeline and its helpers
 from paraview import servermanager, simple
 from vtkmodules.vtkCommonDataModel import vtkPolyData
 from vtkmodules.vtkFiltersCore import vtkFeatureEdges, vtkMassProperties, vtkTriangleFilter
@@ -278,10 +279,8 @@ class MuscleFromPathTest(unittest.TestCase):
                 motion.UpdatePipeline(t)
         self.assertNotIn("ERR", messages.text)
         self.assertNotIn("has no fibres", messages.text)
-        table = servermanager.Fetch(motion, idx=3)
-        columns = {table.GetColumnName(c): [table.GetColumn(c).GetValue(r) for r in range(table.GetNumberOfRows())]
-                   for c in range(table.GetNumberOfColumns())}
-        self.assertEqual(table.GetNumberOfRows(), len(frames))
+        columns = job.table_columns(servermanager.Fetch(motion, idx=3))
+        self.assertEqual(len(columns["Time"]), len(frames))
 
         def measure(name):
             found = {column.split(" (")[1][:-1]: values for column, values in columns.items()
