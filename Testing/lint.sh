@@ -9,9 +9,25 @@ set -euo pipefail
 check=$1
 source_dir=$2
 cd "$source_dir"
-# The project's files: tracked or new (not ignored), that exist (a deletion may not be staged yet).
+# The project's files: in a git checkout those tracked or new (not ignored) that exist (a deletion
+# may not be staged yet); in a source archive every file but what .gitignore leaves out (build
+# folders, results, Python caches). Each pattern is a path glob: '*.h', 'Filters/Algorithms/*/*.cxx'.
 project_files() {
-  git ls-files --cached --others --exclude-standard "$@" | sort -u | while read -r f; do [ -f "$f" ] && echo "$f"; done
+  if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
+    git ls-files --cached --others --exclude-standard "$@" | sort -u | while read -r f; do [ -f "$f" ] && echo "$f"; done
+    return
+  fi
+  local pattern
+  for pattern in "$@"; do
+    find . -type f -not -path './build*' -not -path './results/*' -not -path '*/__pycache__/*' \
+      -not -path './.git/*' | sed 's|^\./||' | while read -r f; do
+      # A pattern without a slash matches the file's name in any folder, as git's does.
+      case "$pattern" in
+        */*) if [[ "$f" == $pattern ]]; then echo "$f"; fi ;;
+        *) if [[ "$(basename "$f")" == $pattern ]]; then echo "$f"; fi ;;
+      esac
+    done
+  done | sort -u
 }
 cxx_files() { project_files '*.h' '*.cxx'; }
 

@@ -258,8 +258,9 @@ class MuscleFromPathTest(unittest.TestCase):
     def test_gait10dof18musc_walks_with_every_generated_muscle(self):
         """The whole model's muscles made from its paths go through the first frames of its walk
         together (MotionMuscleDeformation, fibres too), each keeping its volume, none going
-        into another or deeper into a bone. Whether every frame settles is not asserted: the
-        joint settle of many muscles does not always converge yet (docs/DESIGN.md section 12)."""
+        into another or deeper into a bone, every frame settled: at 150 points the contact set of
+        these crowded muscles cycles, and before a long settle damped its cycles (SettleMuscles)
+        frame 4 did not settle."""
         folder = "opensim/gait10dof18musc_walk/"
         if DATA is None or not os.path.isdir(os.path.join(DATA, folder)):
             self.skipTest("OpenSim data not found: set MUSCLEDEFORMATION_DATA_DIR to the folder holding opensim/")
@@ -291,7 +292,7 @@ class MuscleFromPathTest(unittest.TestCase):
         self.assertLess(max(abs(v) for v in measure("VolumeChangePercent")), 1e-4)
         self.assertEqual(max(measure("NewPenetrationCount")), 0)
         self.assertLessEqual(max(measure("MaxNewBonePenetrationDepth")), 0.5)
-        self.assertEqual(set(measure("Converged")) - {0, 1}, set())
+        self.assertEqual(set(measure("Converged")), {1})
         fibres = leaves(servermanager.Fetch(motion, idx=4))
         self.assertEqual(len(fibres), 18)
         self.assertTrue(all(block is not None and block.GetNumberOfCells() == 20 for _, block in fibres))

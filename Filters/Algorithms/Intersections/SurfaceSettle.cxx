@@ -711,6 +711,17 @@ constexpr double kSlowestCreep = 0.999;
 constexpr double kFastestCreep = 0.5;
 constexpr double kCreepAlignment = 0.99;
 
+/// A settle longer than this many iterations is no ordinary one: ShapeStep damps its cycles
+/// from here on. The LHDL hip's motions settle every step in 5 to 24 iterations, and are settled
+/// as they were before. From 30 on, the phantom at 50 degrees in 16 steps had a step that swung
+/// without end settled by the damping, with 2 triangles of the gluteus maximus turned over, where
+/// the step halved (SettleToPose) turns none over; from 40 to 80 that step is halved as before.
+constexpr int kOrdinaryIterations = 50;
+/// How many iterations back a repeated contact set is looked for, and the share of its step a
+/// repeating iteration takes (ShapeStep).
+constexpr size_t kRecentContactSets = 4;
+constexpr double kCycleStep = 0.5;
+
 /// Changes the step from `meshes`' points to `next` (all muscles together) where the plain
 /// iteration converges slowly, so that where the settle stops does not depend on how long it
 /// took to get there. The linearised contacts leave their surfaces' curvature out, so the
@@ -734,9 +745,10 @@ constexpr double kCreepAlignment = 0.99;
 /// the extended step moved them by 0.9 mm, and 1e-7 of input noise moved their answer by
 /// 0.12 mm; taken as they are, by 0.0006 mm).
 /// `lastSteps` is read and replaced by the step taken, and emptied after an extension (whose
-/// next step is the correction, no measure of the factor).
+/// next step is the correction, no measure of the factor). Without `extendCreeps` only swings
+/// are shortened.
 void SteadyStep(const std::vector<TriangleMesh>& meshes, std::vector<Points>& next, std::vector<Points>& lastSteps,
-  const std::vector<double>& sizes)
+  const std::vector<double>& sizes, bool extendCreeps = true)
 {
   const size_t count = meshes.size();
   std::vector<Points> steps(count);
@@ -754,8 +766,8 @@ void SteadyStep(const std::vector<TriangleMesh>& meshes, std::vector<Points>& ne
     }
   }
   const double lambda = last > 0 ? along / last : 0.0;
-  const bool creeps =
-    small && lambda >= kFastestCreep && lambda < 1 && along * along >= kCreepAlignment * kCreepAlignment * last * now;
+  const bool creeps = extendCreeps && small && lambda >= kFastestCreep && lambda < 1 &&
+    along * along >= kCreepAlignment * kCreepAlignment * last * now;
   if (lambda < 0 || creeps)
   {
     const double factor = 1 / (1 - std::min(lambda, kSlowestCreep));
@@ -1792,6 +1804,45 @@ void RecordInMotion(SettleMotion& motion, const std::vector<TriangleMesh>& muscl
   }
 }
 
+/// The step an iteration takes, from `meshes`' points to `next`, given its contacts `held` and
+/// whether they are the last iteration's (`sameContacts`). With the same contacts, SteadyStep.
+/// While they change, the plain step for kOrdinaryIterations; past those the contacts of crowded
+/// muscles (generated ones, Rajagopal 2016's soleus and medial gastrocnemius) can cycle, a point
+/// moving back and forth by millimetres, so the settle's swings are shortened as SteadyStep
+/// shortens them (creeps are not extended: the contacts are still changing), and a step whose
+/// contacts are a set held at one of the last kRecentContactSets iterations takes kCycleStep of
+/// itself, so that the cycle's linearisations meet between its sets. `lastSteps` as SteadyStep's;
+/// `recentHeld` the last sets, `held` added.
+void ShapeStep(const std::vector<TriangleMesh>& meshes, std::vector<Points>& next, const HeldContacts& held,
+  bool sameContacts, int iteration, const std::vector<double>& sizes, std::vector<Points>& lastSteps,
+  std::vector<HeldContacts>& recentHeld)
+{
+  if (sameContacts || iteration >= kOrdinaryIterations)
+  {
+    SteadyStep(meshes, next, lastSteps, sizes, sameContacts);
+    if (!sameContacts && std::find(recentHeld.begin(), recentHeld.end(), held) != recentHeld.end())
+    {
+      for (size_t m = 0; m < meshes.size(); ++m)
+      {
+        next[m] = meshes[m].points + kCycleStep * (next[m] - meshes[m].points);
+        if (lastSteps.size() == meshes.size())
+        {
+          lastSteps[m] = next[m] - meshes[m].points;
+        }
+      }
+    }
+  }
+  else
+  {
+    lastSteps.clear();
+  }
+  recentHeld.push_back(held);
+  if (recentHeld.size() > kRecentContactSets)
+  {
+    recentHeld.erase(recentHeld.begin());
+  }
+}
+
 /// Where a settle is between iterations, on the muscles' welded surfaces.
 struct SettleState
 {
@@ -1942,7 +1993,8 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   const std::vector<RigidFit> placements = motion ? PlaceBones(motion->boneReference, bones) : std::vector<RigidFit>();
   SettleState s = StartSettle(muscles, energies, volumes, bones.size(), free, motion, placements);
   std::vector<SettleReport> reports(count);
-  std::vector<Points> lastSteps; // each muscle's last move, for SteadyStep
+  std::vector<Points> lastSteps;        // each muscle's last move, for SteadyStep
+  std::vector<HeldContacts> recentHeld; // the last kRecentContactSets iterations' contacts
   std::vector<double> sizes(count);
   for (size_t m = 0; m < count; ++m)
   {
@@ -1973,14 +2025,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     // tolerance and every volume is within 1e-9 of its target; diverging after kFarMovesToStop
     // far moves.
     settled = step.held == s.held;
-    if (settled)
-    {
-      SteadyStep(s.meshes, next, lastSteps, sizes);
-    }
-    else
-    {
-      lastSteps.clear();
-    }
+    ShapeStep(s.meshes, next, step.held, settled, iteration, sizes, lastSteps, recentHeld);
     for (size_t m = 0; m < count; ++m)
     {
       const double change = (next[m] - s.meshes[m].points).cwiseAbs().maxCoeff();
