@@ -17,14 +17,14 @@ project_files() {
     git ls-files --cached --others --exclude-standard "$@" | sort -u | while read -r f; do [ -f "$f" ] && echo "$f"; done
     return
   fi
-  local pattern
-  for pattern in "$@"; do
-    find . -type f -not -path './build*' -not -path './results/*' -not -path '*/__pycache__/*' \
-      -not -path './.git/*' | sed 's|^\./||' | while read -r f; do
+  local f pattern
+  find . -type f -not -path './build*' -not -path './results/*' -not -path '*/__pycache__/*' \
+    -not -path './.git/*' | sed 's|^\./||' | while read -r f; do
+    for pattern in "$@"; do
       # A pattern without a slash matches the file's name in any folder, as git's does.
       case "$pattern" in
-        */*) if [[ "$f" == $pattern ]]; then echo "$f"; fi ;;
-        *) if [[ "$(basename "$f")" == $pattern ]]; then echo "$f"; fi ;;
+        */*) if [[ "$f" == $pattern ]]; then echo "$f"; break; fi ;;
+        *) if [[ "${f##*/}" == $pattern ]]; then echo "$f"; break; fi ;;
       esac
     done
   done | sort -u

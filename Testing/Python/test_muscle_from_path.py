@@ -259,8 +259,8 @@ class MuscleFromPathTest(unittest.TestCase):
         """The whole model's muscles made from its paths go through the first frames of its walk
         together (MotionMuscleDeformation, fibres too), each keeping its volume, none going
         into another or deeper into a bone, every frame settled: at 150 points the contact set of
-        these crowded muscles cycles, and before a long settle damped its cycles (SettleMuscles)
-        frame 4 did not settle."""
+        these crowded muscles cycles, and without the damping of a long settle's cycles (ShapeStep)
+        frame 4 does not settle."""
         folder = "opensim/gait10dof18musc_walk/"
         if DATA is None or not os.path.isdir(os.path.join(DATA, folder)):
             self.skipTest("OpenSim data not found: set MUSCLEDEFORMATION_DATA_DIR to the folder holding opensim/")

@@ -712,10 +712,11 @@ constexpr double kFastestCreep = 0.5;
 constexpr double kCreepAlignment = 0.99;
 
 /// A settle longer than this many iterations is no ordinary one: ShapeStep damps its cycles
-/// from here on. The LHDL hip's motions settle every step in 5 to 24 iterations, and are settled
-/// as they were before. From 30 on, the phantom at 50 degrees in 16 steps had a step that swung
-/// without end settled by the damping, with 2 triangles of the gluteus maximus turned over, where
-/// the step halved (SettleToPose) turns none over; from 40 to 80 that step is halved as before.
+/// from here on. The LHDL hip's motions settle every step in 5 to 24 iterations, so none of
+/// their steps is damped. The phantom at 50 degrees in 16 steps has a step that swings without
+/// end: damped from the 30th iteration it settles with 2 triangles of the gluteus maximus turned
+/// over, where halved (SettleToPose), as it is with damping from the 40th to the 80th, it turns
+/// none over.
 constexpr int kOrdinaryIterations = 50;
 /// How many iterations back a repeated contact set is looked for, and the share of its step a
 /// repeating iteration takes (ShapeStep).
@@ -748,7 +749,7 @@ constexpr double kCycleStep = 0.5;
 /// next step is the correction, no measure of the factor). Without `extendCreeps` only swings
 /// are shortened.
 void SteadyStep(const std::vector<TriangleMesh>& meshes, std::vector<Points>& next, std::vector<Points>& lastSteps,
-  const std::vector<double>& sizes, bool extendCreeps = true)
+  const std::vector<double>& sizes, bool extendCreeps)
 {
   const size_t count = meshes.size();
   std::vector<Points> steps(count);
@@ -1812,7 +1813,8 @@ void RecordInMotion(SettleMotion& motion, const std::vector<TriangleMesh>& muscl
 /// shortens them (creeps are not extended: the contacts are still changing), and a step whose
 /// contacts are a set held at one of the last kRecentContactSets iterations takes kCycleStep of
 /// itself, so that the cycle's linearisations meet between its sets. `lastSteps` as SteadyStep's;
-/// `recentHeld` the last sets, `held` added.
+/// `recentHeld` the last sets, `held` added from kRecentContactSets iterations before
+/// kOrdinaryIterations on.
 void ShapeStep(const std::vector<TriangleMesh>& meshes, std::vector<Points>& next, const HeldContacts& held,
   bool sameContacts, int iteration, const std::vector<double>& sizes, std::vector<Points>& lastSteps,
   std::vector<HeldContacts>& recentHeld)
@@ -1822,19 +1824,20 @@ void ShapeStep(const std::vector<TriangleMesh>& meshes, std::vector<Points>& nex
     SteadyStep(meshes, next, lastSteps, sizes, sameContacts);
     if (!sameContacts && std::find(recentHeld.begin(), recentHeld.end(), held) != recentHeld.end())
     {
-      for (size_t m = 0; m < meshes.size(); ++m)
+      for (size_t m = 0; m < meshes.size(); ++m) // SteadyStep without creeps keeps every step in lastSteps
       {
         next[m] = meshes[m].points + kCycleStep * (next[m] - meshes[m].points);
-        if (lastSteps.size() == meshes.size())
-        {
-          lastSteps[m] = next[m] - meshes[m].points;
-        }
+        lastSteps[m] = next[m] - meshes[m].points;
       }
     }
   }
   else
   {
     lastSteps.clear();
+  }
+  if (iteration + static_cast<int>(kRecentContactSets) < kOrdinaryIterations)
+  {
+    return; // not looked at before kOrdinaryIterations: an ordinary settle copies no contact set
   }
   recentHeld.push_back(held);
   if (recentHeld.size() > kRecentContactSets)
