@@ -6,6 +6,7 @@
 #include "Geometry/MeshChecks.h"
 #include "Geometry/SurfaceRepair.h"
 #include "Geometry/TriangleTree.h"
+#include "Intersections/ActiveSet.h"
 
 #include <Eigen/SparseCholesky>
 
@@ -890,73 +891,6 @@ Contact Linearise(size_t m, Eigen::Index i, size_t o, Eigen::Index triangle, con
     c.target = offset;
   }
   return c;
-}
-
-/// The multipliers of the dual system `system` y = `rhs` whose first slack.size() rows are
-/// contacts (inequalities: a multiplier pushes or is zero) and the rest equalities (the
-/// volumes), by a primal-dual active set starting from `active` (and left as the final set): an
-/// active contact whose multiplier pulls lets go; an inactive one joins when its residual
-/// (a_j . x - target at the new points) is below -slack[j].
-Eigen::VectorXd SolveActiveSet(const Eigen::MatrixXd& system, const Eigen::VectorXd& rhs,
-  const std::vector<double>& slack, std::vector<char>& active)
-{
-  const Eigen::Index size = system.rows(), nc = static_cast<Eigen::Index>(slack.size());
-  Eigen::VectorXd multipliers = Eigen::VectorXd::Zero(size);
-  for (int round = 0; round < 100; ++round)
-  {
-    std::vector<Eigen::Index> on;
-    for (Eigen::Index k = 0; k < size; ++k)
-    {
-      if (active[k])
-      {
-        on.push_back(k);
-      }
-    }
-    const Eigen::Index a = static_cast<Eigen::Index>(on.size());
-    Eigen::MatrixXd reduced(a, a);
-    Eigen::VectorXd right(a);
-    for (Eigen::Index r = 0; r < a; ++r)
-    {
-      right(r) = rhs(on[r]);
-      for (Eigen::Index c = 0; c < a; ++c)
-      {
-        reduced(r, c) = system(on[r], on[c]);
-      }
-    }
-    // Two contacts that push a point the same way make the system singular: a nudge on
-    // the diagonal picks the smallest multipliers, and refinement takes the nudge's error
-    // out of the rest.
-    Eigen::MatrixXd nudged = reduced;
-    nudged.diagonal() += 1e-12 * reduced.diagonal().cwiseAbs();
-    const Eigen::LDLT<Eigen::MatrixXd> factor(nudged);
-    Eigen::VectorXd solved = factor.solve(right);
-    for (int refine = 0; refine < 3; ++refine)
-    {
-      solved += factor.solve(right - reduced * solved);
-    }
-    multipliers.setZero();
-    for (Eigen::Index r = 0; r < a; ++r)
-    {
-      multipliers(on[r]) = solved(r);
-    }
-    const Eigen::VectorXd residual = system * multipliers - rhs; // a_j . x - target, at the new x
-    bool changed = false;
-    for (Eigen::Index j = 0; j < nc; ++j)
-    {
-      const bool want = active[j] ? multipliers(j) > 0 : residual(j) < -slack[static_cast<size_t>(j)];
-      if (want != static_cast<bool>(active[j]))
-      {
-        active[j] = want;
-        changed = true;
-      }
-    }
-    if (!changed)
-    {
-      break;
-    }
-  }
-
-  return multipliers;
 }
 
 /// Where two muscles' surfaces cross, a point p of one can be inside the other while the point v
@@ -1983,7 +1917,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   // are linearised at the current points, and the quadratic energy is minimised exactly under
   // those linear constraints. With the energy's matrix K fixed, the minimum is
   //   x = K^-1 (b + sum_j lambda_j a_j + mu g),
-  // and the multipliers solve a small dense system S (S_jl = a_j . K^-1 a_l) on the active
+  // and the multipliers solve a small system S (S_jl = a_j . K^-1 a_l, ActiveSet.h) on the active
   // contacts: a contact is active while its multiplier pushes (lambda > 0), and one not active
   // joins when its point would be inside (a primal-dual active set). S needs K^-1 only at the
   // points in contact: columns of the inverse, kept by the energy for the whole motion.
