@@ -22,7 +22,8 @@ import time
 from paraview import servermanager, simple
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Python"))
-import mdtesting  # noqa: E402
+import mdtesting  # noqa: E402  (puts Examples/ on the path)
+import motion as job  # noqa: E402  Examples/motion.py: the main job's pipeline and its helpers
 
 MODELS = {
     "gait2392": ("gait2392_walk_forward", "subject01_simbody_adjusted.osim", "subject01_walk1_Kinematics_q.mot"),
@@ -65,10 +66,9 @@ for k in range(count):
 rest = seconds[1:] or [0.0]
 print("first frame %.2f s; frames 1-%d: mean %.3f s, median %.3f s, largest %.2f s, total %.1f s"
       % (seconds[0], count - 1, statistics.mean(rest), statistics.median(rest), max(rest), sum(rest)))
-table = servermanager.Fetch(motion, idx=3)
-converged = [table.GetColumn(c) for c in range(table.GetNumberOfColumns())
-             if table.GetColumnName(c).startswith("Converged (")]
-unsettled = [r for r in range(table.GetNumberOfRows()) if min(c.GetValue(r) for c in converged) == 0]
+columns = job.table_columns(servermanager.Fetch(motion, idx=3))
+converged = [column for name, column in columns.items() if name.startswith("Converged (")]
+unsettled = [r for r in range(count) if min(column[r] for column in converged) == 0]
 print("first frame not settled:", unsettled[0] if unsettled else "none")
 surfaces = servermanager.Fetch(motion)
 for array in ("VolumeChangePercent", "MaxNewPenetrationDepth"):

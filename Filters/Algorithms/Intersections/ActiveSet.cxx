@@ -43,23 +43,8 @@ Eigen::VectorXd SolveBlockActiveSet(const Eigen::MatrixXd& system, const Eigen::
         on.push_back(k);
       }
     }
-    const Eigen::Index a = static_cast<Eigen::Index>(on.size());
-    Eigen::MatrixXd reduced(a, a);
-    Eigen::VectorXd right(a);
-    for (Eigen::Index r = 0; r < a; ++r)
-    {
-      right(r) = rhs(on[r]);
-      for (Eigen::Index c = 0; c < a; ++c)
-      {
-        reduced(r, c) = system(on[r], on[c]);
-      }
-    }
-    const Eigen::VectorXd solved = SolveNudged(reduced, right);
     multipliers.setZero();
-    for (Eigen::Index r = 0; r < a; ++r)
-    {
-      multipliers(on[r]) = solved(r);
-    }
+    multipliers(on) = SolveNudged(system(on, on), rhs(on));
     const Eigen::VectorXd residual = system * multipliers - rhs; // a_j . x - target, at the new x
     bool changed = false;
     for (Eigen::Index j = 0; j < nc; ++j)
@@ -86,17 +71,22 @@ Eigen::VectorXd SolveNudged(const Eigen::MatrixXd& system, const Eigen::VectorXd
 {
   Eigen::MatrixXd nudged = system;
   nudged.diagonal() += 1e-12 * system.diagonal().cwiseAbs();
+  // The nudged factor's solution, refined against `matrix` (the system itself, sparse or dense).
+  auto refined = [&](const auto& factor, const auto& matrix) {
+    Eigen::VectorXd solved = factor.solve(right);
+    for (int refine = 0; refine < 3; ++refine)
+    {
+      solved += factor.solve(right - matrix * solved);
+    }
+    return solved;
+  };
   if (system.rows() >= kSparseFrom)
   {
     const Eigen::SparseMatrix<double> sparse = system.sparseView();
     const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factor(nudged.sparseView());
     if (factor.info() == Eigen::Success)
     {
-      Eigen::VectorXd solved = factor.solve(right);
-      for (int refine = 0; refine < 3; ++refine)
-      {
-        solved += factor.solve(right - sparse * solved);
-      }
+      Eigen::VectorXd solved = refined(factor, sparse);
       const double residual = (sparse * solved - right).norm();
       if (std::isfinite(residual) && residual <= kSparseResidual * right.norm())
       {
@@ -104,13 +94,7 @@ Eigen::VectorXd SolveNudged(const Eigen::MatrixXd& system, const Eigen::VectorXd
       }
     }
   }
-  const Eigen::LDLT<Eigen::MatrixXd> dense(nudged);
-  Eigen::VectorXd solved = dense.solve(right);
-  for (int refine = 0; refine < 3; ++refine)
-  {
-    solved += dense.solve(right - system * solved);
-  }
-  return solved;
+  return refined(Eigen::LDLT<Eigen::MatrixXd>(nudged), system);
 }
 
 std::vector<std::vector<Eigen::Index>> UnlinkedBlocks(const Eigen::MatrixXd& system)
@@ -160,28 +144,19 @@ Eigen::VectorXd SolveActiveSet(const Eigen::MatrixXd& system, const Eigen::Vecto
   for (int b = 0; b < static_cast<int>(blocks.size()); ++b)
   {
     const std::vector<Eigen::Index>& rows = blocks[static_cast<size_t>(b)];
-    const Eigen::Index n = static_cast<Eigen::Index>(rows.size());
-    Eigen::MatrixXd part(n, n);
-    Eigen::VectorXd right(n);
     std::vector<double> partSlack;
-    std::vector<char> partActive(rows.size());
-    for (Eigen::Index r = 0; r < n; ++r)
+    std::vector<char> partActive;
+    for (const Eigen::Index row : rows)
     {
-      right(r) = rhs(rows[r]);
-      partActive[r] = active[rows[r]];
-      if (rows[r] < nc)
+      partActive.push_back(active[row]);
+      if (row < nc)
       {
-        partSlack.push_back(slack[rows[r]]);
-      }
-      for (Eigen::Index c = 0; c < n; ++c)
-      {
-        part(r, c) = system(rows[r], rows[c]);
+        partSlack.push_back(slack[row]);
       }
     }
-    const Eigen::VectorXd solved = SolveBlockActiveSet(part, right, partSlack, partActive);
-    for (Eigen::Index r = 0; r < n; ++r)
+    multipliers(rows) = SolveBlockActiveSet(system(rows, rows), rhs(rows), partSlack, partActive);
+    for (size_t r = 0; r < rows.size(); ++r)
     {
-      multipliers(rows[r]) = solved(r);
       active[rows[r]] = partActive[r];
     }
   }

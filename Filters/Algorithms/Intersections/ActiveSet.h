@@ -28,7 +28,7 @@ std::vector<std::vector<Eigen::Index>> UnlinkedBlocks(const Eigen::MatrixXd& sys
 /// point the same way: a nudge of 1e-12 of each diagonal entry picks the smallest multipliers,
 /// and three rounds of refinement take the nudge's error out of the rest. A system of 256 rows or
 /// more is factorised sparse (simplicial LDL^T, no pivoting: a contact links only the rows of its
-/// muscles, and gait2392's block of 900 rows is 5 % full, its factor as sparse, 5 ms where the
+/// muscles, and gait2392's block of about 950 rows is 5 % full, its factor as sparse, 5 ms where the
 /// dense one took 50); a smaller one, or one whose sparse factorisation meets a zero pivot or
 /// leaves a residual beyond 1e-8 of the right-hand side, by a dense LDL^T with pivoting.
 Eigen::VectorXd SolveNudged(const Eigen::MatrixXd& system, const Eigen::VectorXd& right);

@@ -59,20 +59,12 @@ Problem RandomProblem(int contacts, int equalities, int blocks, unsigned seed)
 /// The rows of `rows` of `p`'s system as a problem of its own.
 Problem Part(const Problem& p, const std::vector<Eigen::Index>& rows)
 {
-  Problem part;
-  const Eigen::Index n = static_cast<Eigen::Index>(rows.size());
-  part.system.resize(n, n);
-  part.rhs.resize(n);
-  for (Eigen::Index r = 0; r < n; ++r)
+  Problem part{ p.system(rows, rows), p.rhs(rows), {} };
+  for (const Eigen::Index row : rows)
   {
-    part.rhs(r) = p.rhs(rows[r]);
-    if (rows[r] < static_cast<Eigen::Index>(p.slack.size()))
+    if (row < static_cast<Eigen::Index>(p.slack.size()))
     {
-      part.slack.push_back(p.slack[rows[r]]);
-    }
-    for (Eigen::Index c = 0; c < n; ++c)
-    {
-      part.system(r, c) = p.system(rows[r], rows[c]);
+      part.slack.push_back(p.slack[row]);
     }
   }
   return part;
