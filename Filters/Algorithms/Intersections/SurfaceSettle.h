@@ -103,7 +103,9 @@ struct SettleParameters
   /// Linearisations of the volume and of the obstacles' surfaces. The LHDL hip's slowest step
   /// (flexion 60 degrees, N = 8, step 5) takes about 75 on the exact input and fewer on
   /// perturbed ones: at 50 the exact one was halved (InterpolatedDeformation) and the others
-  /// not, and that step's answers differed by 0.65 mm.
+  /// not, and that step's answers differed by 0.65 mm. A settle that is nearly there when they
+  /// run out (its contacts held, every move within 1e-5 of its muscle's size) goes on for as many
+  /// again.
   int maximumIterations = 100;
   /// Converged when no point moves more than this fraction of the muscle's
   /// size in an iteration, the contacts are those of the iteration before,

@@ -609,6 +609,36 @@ TEST(SurfaceSettle, AMotionsContactsAreCarriedToItsNextStep)
   EXPECT_TRUE(plain.held.empty());
 }
 
+TEST(SurfaceSettle, ASettleNearlyThereWhenItsIterationsRunOutGoesOn)
+{
+  // A settle whose iterations run out with its contacts held and every move within 1e-5 of the
+  // muscle's size goes on for as many again (kNearlySettled): given one iteration fewer than it
+  // takes, the spindle pressed against the box bone still converges, in as many iterations and to
+  // the same points to the bit. Given two, far from there, it stops unconverged.
+  const SpindleBesideABox setup;
+  const auto& [s, energy, bone, bones] = setup;
+  const double volume = md::EnclosedVolume(s.muscle.points, s.muscle.triangles);
+  auto settle = [&](int iterations, md::SettleReport& report) {
+    std::vector<md::TriangleMesh> meshes{ s.muscle };
+    md::SettleParameters parameters;
+    parameters.maximumIterations = iterations;
+    report = md::SettleMuscles(
+      meshes, { &energy }, { { { s.line, Bent(s.line, 25) } } }, { volume }, bones, nullptr, parameters)[0];
+    return meshes[0].points;
+  };
+  md::SettleReport full, short1, short2;
+  const md::Points answer = settle(100, full);
+  ASSERT_TRUE(full.converged);
+  ASSERT_GT(full.iterations, 4);
+  const md::Points nearly = settle(full.iterations - 1, short1);
+  EXPECT_TRUE(short1.converged);
+  EXPECT_EQ(short1.iterations, full.iterations);
+  EXPECT_EQ((nearly - answer).cwiseAbs().maxCoeff(), 0.0);
+  settle(2, short2);
+  EXPECT_FALSE(short2.converged);
+  EXPECT_EQ(short2.iterations, 2);
+}
+
 TEST(SurfaceSettle, AMotionsStepThatJumpsIsSettledInPartsThatCarryTheirContacts)
 {
   // SettleStep: a motion's step whose unconstrained minimum moves farther than
