@@ -1948,7 +1948,6 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
   bool settled = false, diverging = false;
   int farMoves = 0;
   int iteration = 0;
-  bool nearlySettled = false; // the contacts held and every move within kNearlySettled
   int lastIteration = parameters.maximumIterations;
   for (; iteration < lastIteration && !settled && !diverging; ++iteration)
   {
@@ -1971,7 +1970,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     // tolerance and every volume is within 1e-9 of its target; diverging after kFarMovesToStop
     // far moves.
     settled = step.held == s.held;
-    nearlySettled = settled;
+    bool nearlySettled = settled; // the contacts held and every move within kNearlySettled
     ShapeStep(s.meshes, next, step.held, settled, iteration, sizes, lastSteps, recentHeld);
     for (size_t m = 0; m < count; ++m)
     {
