@@ -1,14 +1,17 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""The LHDL hip pipeline exactly as the README's GUI click path builds it, from the data set's
+"""The LHDL hip pipelines exactly as the README's GUI click paths build them, from the data set's
 own files and no Python of ours: OpenSim Model Reader, Legacy VTK readers, Group Datasets, Move
-With Bodies, Action Line Grouping, Interpolated Muscle Deformation.
+With Bodies, Action Line Grouping, then Interpolated Muscle Deformation (one pose) or, with
+--motion, Motion Muscle Deformation (the whole of hip_flexion.mot, Play Motion left on).
 
-    pvpython Examples/lhdl_gui_pipeline.py [--data ../shared/data] [--save-state Examples/LHDL_hip.pvsm]
+    pvpython Examples/lhdl_gui_pipeline.py [--data ../shared/data] [--motion [--frames K]]
+                                           [--save-state Examples/LHDL_hip.pvsm]
 
 With --save-state it writes the ParaView state file that Examples/LHDL_hip.pvsm is (File > Load
 State, "Search files under specified directory": the folder holding lhdl_hip_r). Without it, it
-runs the method (60 degrees of hip flexion, 4 steps) and prints each muscle's measures. Exits
-with code 77 (skipped) when the data is absent.
+runs the method (60 degrees of hip flexion, 4 steps) or the motion's first K frames (all by
+default) and prints each muscle's measures at the last. Exits with code 77 (skipped) when the
+data is absent.
 """
 import argparse
 import os
@@ -24,11 +27,13 @@ SETTINGS = dict(Scale=1000.0, ReferenceBody="pelvis", IgnoreUnknownColumns=1, Pl
                 RestPoseCoordinates="hip_flexion_r=1.5760 hip_adduction_r=-4.7269 hip_rotation_r=-5.2899")
 
 
-def build(folder):
-    """The pipeline's proxies, registered under the names the GUI gives them."""
+def build(folder, motion=False):
+    """The pipeline's proxies, registered under the names the GUI gives them; with `motion` the
+    README's motion click path (Play Motion left on, Motion Muscle Deformation)."""
     model = simple.OpenSimModelReader(registrationName="LHDL_hip_r.osim", FileName=os.path.join(folder, "LHDL_hip_r.osim"))
     for name, value in SETTINGS.items():
-        setattr(model, name, value)
+        if not (motion and name in ("PlayMotion", "CurrentPoseTime")):
+            setattr(model, name, value)
     model.MotionFileName = os.path.join(folder, "kinematics", "hip_flexion.mot")
     bones = simple.GroupDatasets(registrationName="Bones", Input=[
         simple.LegacyVTKReader(registrationName=n + ".vtk", FileNames=[os.path.join(folder, n + ".vtk")]) for n in BONES])
@@ -38,10 +43,17 @@ def build(folder):
                                   BodyTransforms=simple.OutputPort(model, 4), BodyOfSurface="iliac_r=pelvis; sacrum=pelvis")
     lines = simple.ActionLineGrouping(registrationName="ActionLines", Input=muscles, Paths=simple.OutputPort(model, 3),
                                       PathsCurrent=simple.OutputPort(model, 1))
-    method = simple.InterpolatedMuscleDeformation(registrationName="Method", Input=muscles, BonesRest=bones,
-                                                  BonesCurrent=moved, ActionLinesRest=simple.OutputPort(lines, 0),
-                                                  ActionLinesCurrent=simple.OutputPort(lines, 1), NumberOfSteps=4,
-                                                  AttachmentFileName=os.path.join(folder, "attachment_areas_rp_mm.csv"))
+    landmarks = os.path.join(folder, "attachment_areas_rp_mm.csv")
+    if motion:
+        method = simple.MotionMuscleDeformation(registrationName="Motion", Input=muscles, BonesRest=bones,
+                                                BonesMotion=moved, ActionLinesRest=simple.OutputPort(lines, 0),
+                                                ActionLinesMotion=simple.OutputPort(lines, 1),
+                                                AttachmentFileName=landmarks)
+    else:
+        method = simple.InterpolatedMuscleDeformation(registrationName="Method", Input=muscles, BonesRest=bones,
+                                                      BonesCurrent=moved, ActionLinesRest=simple.OutputPort(lines, 0),
+                                                      ActionLinesCurrent=simple.OutputPort(lines, 1), NumberOfSteps=4,
+                                                      AttachmentFileName=landmarks)
     return {"model": model, "bones": bones, "muscles": muscles, "moved": moved, "lines": lines, "method": method}
 
 
@@ -49,13 +61,15 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--plugin", help="path of MuscleDeformation.so (found in build*/ by default)")
     parser.add_argument("--data", help="folder holding lhdl_hip_r (default ../shared/data)")
+    parser.add_argument("--motion", action="store_true", help="the motion's click path (Motion Muscle Deformation)")
+    parser.add_argument("--frames", type=int, help="with --motion, the motion's first this many frames (all)")
     parser.add_argument("--save-state", help="write the pipeline as a ParaView state file")
     args = parser.parse_args(argv)
     data = mdexamples.lhdl_data_dir(args.data)
     if data is None:
         return mdexamples.SKIPPED
     mdexamples.load_plugin(explicit=args.plugin)
-    pipeline = build(os.path.join(data, "lhdl_hip_r"))
+    pipeline = build(os.path.join(data, "lhdl_hip_r"), motion=args.motion)
     if args.save_state:
         view = simple.CreateView("RenderView")
         simple.Show(pipeline["method"], view)
@@ -64,8 +78,12 @@ def main(argv=None):
         simple.SaveState(args.save_state)
         print("state written to", os.path.abspath(args.save_state))
         return 0
-    pipeline["method"].UpdatePipeline(4)
-    result = servermanager.Fetch(pipeline["method"])
+    method = pipeline["method"]
+    times = list(method.TimestepValues)[:args.frames] if args.motion else [4]
+    for time in times:  # a motion's frames in order, as Play asks for them
+        method.UpdatePipeline(time)
+    result = servermanager.Fetch(method)
+    print("at time", times[-1])
     for index in range(result.GetNumberOfBlocks()):
         fields = result.GetBlock(index).GetFieldData()
         print(result.GetMetaData(index).Get(result.NAME()), {

@@ -4,6 +4,7 @@ ranks), and write what they promise."""
 import glob
 import json
 import os
+import re
 import shutil
 import subprocess
 import unittest
@@ -128,6 +129,26 @@ def same_surfaces(a, b):
                     vtk_to_numpy(first.GetArray(i)), vtk_to_numpy(second.GetArray(name)), equal_nan=True):
                 return False
     return True
+
+
+class ReadmeExample(unittest.TestCase):
+    def test_the_readmes_pvpython_script_runs_as_it_stands(self):
+        with open(os.path.join(mdtesting.SOURCE_DIR, "README.md")) as f:
+            blocks = re.findall(r"```python\n(.*?)```", f.read(), re.S)
+        scripts = [b for b in blocks if b.startswith("from paraview.simple import *")]
+        self.assertEqual(len(scripts), 1, "the README's complete pvpython script")
+        plugin = os.environ.get("MUSCLEDEFORMATION_PLUGIN")
+        script = scripts[0]
+        if plugin:  # the README's relative path is where the set-up commands build it
+            script = re.sub(r'LoadPlugin\("[^"]*"', 'LoadPlugin(%r' % plugin, script)
+        path = os.path.join(mdtesting.output_dir("example-readme"), "readme.py")
+        with open(path, "w") as f:
+            f.write(script)
+        pvpython = os.environ.get("MUSCLEDEFORMATION_PVPYTHON") or shutil.which("pvpython")
+        result = subprocess.run([pvpython, path], capture_output=True, text=True, cwd=mdtesting.SOURCE_DIR,
+                                timeout=300)
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        self.assertIn("16 frames of measures", result.stdout)
 
 
 class BatchExample(unittest.TestCase):

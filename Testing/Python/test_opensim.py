@@ -516,5 +516,29 @@ class LhdlFromItsOpenSimFiles(unittest.TestCase):
             self.assertEqual(field(muscle, "Converged"), 1)
 
 
+    def test_the_readmes_motion_click_path_plays_the_motion(self):
+        import lhdl_gui_pipeline
+        folder = os.path.join(DATA, "lhdl_hip_r")
+        pipeline = lhdl_gui_pipeline.build(folder, motion=True)
+        motion = pipeline["method"]
+        self.assertEqual(motion.GetXMLName(), "MotionMuscleDeformation")
+        times = list(motion.TimestepValues)
+        self.assertEqual(times, list(pipeline["model"].TimestepValues))  # Play Motion left on
+        self.assertEqual(len(times), 36)
+        with mdtesting.CapturedMessages() as messages:
+            for time in times[:3]:  # frames in order, as Play asks for them
+                motion.UpdatePipeline(time)
+        muscles = ("gluteus_maximus_r", "gluteus_medius_r", "iliacus_r", "psoas_r")
+        for muscle in muscles:
+            self.assertIn("muscle '%s.vtk': attached by landmarks" % muscle, messages.text)
+        result = servermanager.Fetch(motion)
+        for index in range(result.GetNumberOfBlocks()):
+            muscle = result.GetBlock(index)
+            self.assertEqual(field(muscle, "Time"), times[2])
+            self.assertLess(abs(field(muscle, "VolumeChangePercent")), 1e-4)
+            self.assertEqual(field(muscle, "NewBonePenetrationCount"), 0)
+            self.assertEqual(field(muscle, "Converged"), 1)
+        self.assertEqual(servermanager.Fetch(motion, idx=3).GetNumberOfRows(), 3)  # MeasuresOverTime
+
 if __name__ == "__main__":
     mdtesting.main()
