@@ -172,6 +172,43 @@ std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, 
   return fibres;
 }
 
+namespace
+{
+bool SameLines(const std::vector<md::Points>& a, const std::vector<md::Points>& b)
+{
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+    [](const md::Points& x, const md::Points& y) { return x.rows() == y.rows() && x == y; });
+}
+
+bool SameMuscle(const md::MotionDeformation::Muscle& a, const md::MotionDeformation::Muscle& b)
+{
+  return a.name == b.name && md::SameMesh(a.rest, b.rest) && SameLines(a.restLines, b.restLines) &&
+    a.attachments == b.attachments && a.restKnots == b.restKnots;
+}
+} // namespace
+
+std::shared_ptr<const MadeFibres> KeepOrMakeFibres(vtkAlgorithm* filter, const std::string& filterName, int count,
+  const std::vector<md::MotionDeformation::Muscle>& muscles, const std::vector<md::MotionDeformation::Bone>& bones,
+  const std::vector<char>& failed, std::shared_ptr<const MadeFibres>& kept)
+{
+  if (kept && kept->count == count && kept->failed == failed &&
+    std::equal(muscles.begin(), muscles.end(), kept->muscles.begin(), kept->muscles.end(), SameMuscle) &&
+    std::equal(bones.begin(), bones.end(), kept->bones.begin(), kept->bones.end(),
+      [](const auto& a, const auto& b) { return a.name == b.name && md::SameMesh(a.rest, b.rest); }))
+  {
+    return kept;
+  }
+  auto made = std::make_shared<MadeFibres>();
+  made->ofMuscle = MakeFibres(filter, filterName, count, muscles, bones, failed);
+  made->boneTrees = FibreObstacleTrees(bones, made->ofMuscle);
+  made->count = count;
+  made->muscles = muscles;
+  made->bones = bones;
+  made->failed = failed;
+  kept = made;
+  return kept;
+}
+
 std::vector<std::string> LineNames(vtkPolyData* lines, const std::string& muscle, size_t count)
 {
   auto* given =

@@ -42,6 +42,27 @@ std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, 
   int count, const std::vector<md::MotionDeformation::Muscle>& muscles,
   const std::vector<md::MotionDeformation::Bone>& bones, const std::vector<char>& failed);
 
+/// Each muscle's fibres and the rest trees of the bones they keep out of, with what they were
+/// made from, so that another run from the same muscles and bones (a setting of the deformation
+/// changed) takes them as they are (KeepOrMakeFibres).
+struct MadeFibres
+{
+  std::vector<std::unique_ptr<md::MuscleFibres>> ofMuscle; ///< [muscle]; null: none
+  std::vector<md::TriangleTree> boneTrees;                 ///< the bones' at rest; none without fibres
+  int count = 0;                                           ///< what they were made from
+  std::vector<md::MotionDeformation::Muscle> muscles;
+  std::vector<md::MotionDeformation::Bone> bones;
+  std::vector<char> failed;
+};
+
+/// `kept` when it was made from the same count, muscles (names, rest surfaces, lines, knots,
+/// attachment areas), bones and failures, bit for bit; else fibres made anew (MakeFibres,
+/// FibreObstacleTrees), which `kept` then holds. Making them costs seconds (the LHDL hip's four
+/// muscles: about 3.5 s); keeping them, a comparison of the inputs.
+std::shared_ptr<const MadeFibres> KeepOrMakeFibres(vtkAlgorithm* filter, const std::string& filterName, int count,
+  const std::vector<md::MotionDeformation::Muscle>& muscles, const std::vector<md::MotionDeformation::Bone>& bones,
+  const std::vector<char>& failed, std::shared_ptr<const MadeFibres>& kept);
+
 /// The names of `lines`' polylines (cell data ActionLineName), else "<muscle>" for one line and
 /// "<muscle> line <i>" for several; `count` names.
 std::vector<std::string> LineNames(vtkPolyData* lines, const std::string& muscle, size_t count);

@@ -47,8 +47,7 @@ struct vtkInterpolatedMuscleDeformation::Cache
   std::vector<size_t> boneLeaf;                               // BonesRest leaf of each bone
   std::vector<std::vector<md::PoseInterpolator>> lineMotions; // per muscle
   std::vector<size_t> lineLeaf;                               // ActionLinesRest leaf of each muscle
-  std::vector<std::unique_ptr<md::MuscleFibres>> fibres;      // per muscle, in `frame`; null: none
-  std::vector<md::TriangleTree> boneTrees; // the bones at rest in `frame`, for the fibres; none without fibres
+  std::shared_ptr<const mdvtk::MadeFibres> fibres;            // per muscle, in `frame`, and the bones' rest trees
 };
 
 /// The muscles' action lines as given: ActionLinesRest leaf restOf[b] of muscle block b, and
@@ -655,9 +654,10 @@ void vtkInterpolatedMuscleDeformation::MakeFibres(
   {
     restBones.push_back({ bone.name, bone.rest });
   }
-  cache.fibres =
-    mdvtk::MakeFibres(this, "InterpolatedMuscleDeformation", this->NumberOfFibres, muscles, restBones, failed);
-  cache.boneTrees = mdvtk::FibreObstacleTrees(restBones, cache.fibres);
+  const auto before = this->KeptFibres;
+  cache.fibres = mdvtk::KeepOrMakeFibres(
+    this, "InterpolatedMuscleDeformation", this->NumberOfFibres, muscles, restBones, failed, this->KeptFibres);
+  this->FibreBuildCount += cache.fibres != before ? 1 : 0;
 }
 
 void vtkInterpolatedMuscleDeformation::WriteFibres(
@@ -665,30 +665,35 @@ void vtkInterpolatedMuscleDeformation::WriteFibres(
 {
   const Cache& cache = *this->Computed;
   output->Initialize();
-  std::vector<md::FibreObstacle> obstacles;
-  std::vector<std::unique_ptr<md::TriangleTree>> moved(cache.boneTrees.size());
-  for (size_t k = 0; k < cache.boneTrees.size(); ++k)
+  if (!cache.fibres)
   {
-    obstacles.push_back(mdvtk::BoneWhereItIs(
-      cache.boneTrees[k], moved[k], cache.boneMotions[k].AtStep(step, cache.result.numberOfSteps)));
+    return;
+  }
+  std::vector<md::FibreObstacle> obstacles;
+  const std::vector<md::TriangleTree>& boneTrees = cache.fibres->boneTrees;
+  std::vector<std::unique_ptr<md::TriangleTree>> moved(boneTrees.size());
+  for (size_t k = 0; k < boneTrees.size(); ++k)
+  {
+    obstacles.push_back(
+      mdvtk::BoneWhereItIs(boneTrees[k], moved[k], cache.boneMotions[k].AtStep(step, cache.result.numberOfSteps)));
   }
   for (size_t m = 0; m < cache.blockOf.size(); ++m)
   {
-    if (!cache.fibres[m] || cache.result.points[step][m].rows() == 0)
+    if (!cache.fibres->ofMuscle[m] || cache.result.points[step][m].rows() == 0)
     {
       continue;
     }
     md::Points surface = cache.result.points[step][m];
     cache.frame.ToLocal(surface);
-    md::Points fibres = cache.fibres[m]->At(surface, obstacles);
-    std::vector<double> lengths = cache.fibres[m]->Lengths(fibres);
+    md::Points fibres = cache.fibres->ofMuscle[m]->At(surface, obstacles);
+    std::vector<double> lengths = cache.fibres->ofMuscle[m]->Lengths(fibres);
     for (double& length : lengths)
     {
       length = cache.frame.LengthToWorld(length);
     }
     cache.frame.ToWorld(fibres);
     const unsigned block = output->GetNumberOfBlocks();
-    output->SetBlock(block, mdvtk::FibrePolylines(fibres, cache.fibres[m]->PointsPerFibre(), lengths));
+    output->SetBlock(block, mdvtk::FibrePolylines(fibres, cache.fibres->ofMuscle[m]->PointsPerFibre(), lengths));
     output->GetMetaData(block)->Set(vtkCompositeDataSet::NAME(), mdvtk::NameOf(muscles[cache.blockOf[m]]).c_str());
   }
 }
@@ -715,4 +720,5 @@ void vtkInterpolatedMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ResolvedNumberOfSteps: " << this->ResolvedNumberOfSteps << "\n";
   os << indent << "HullBuildCount: " << this->GetHullBuildCount() << "\n";
   os << indent << "SurfaceEnergyBuildCount: " << this->GetSurfaceEnergyBuildCount() << "\n";
+  os << indent << "FibreBuildCount: " << this->FibreBuildCount << "\n";
 }

@@ -70,6 +70,7 @@ struct InterpolationParameters;
 namespace mdvtk
 {
 struct Leaf;
+struct MadeFibres;
 }
 class vtkMultiBlockDataSet;
 
@@ -180,6 +181,10 @@ public:
   /// its rest-pose surface and its matched action lines in the rest pose only, so it is kept like
   /// the hulls, with the columns of its inverse found so far.
   int GetSurfaceEnergyBuildCount() const;
+  /// Times the fibres were made. They depend on the muscles' rest surfaces, action lines and
+  /// attachment areas, the bones at rest and NumberOfFibres only, so they are kept like the hulls:
+  /// another number of steps, current pose or deformation setting reuses them.
+  vtkGetMacro(FibreBuildCount, int);
 
 protected:
   vtkInterpolatedMuscleDeformation();
@@ -244,4 +249,6 @@ private:
   void WriteFibres(const std::vector<mdvtk::Leaf>& muscles, int step, vtkMultiBlockDataSet* output) const;
   std::unique_ptr<Cache> Computed;
   std::unique_ptr<md::RestMappingCache> KeptRest;
+  std::shared_ptr<const mdvtk::MadeFibres> KeptFibres;
+  int FibreBuildCount = 0;
 };

@@ -116,13 +116,14 @@ struct vtkMotionMuscleDeformation::Internals
   std::string attachmentReport; ///< GetAttachmentReport
   std::unique_ptr<md::MotionDeformation> deformation;
   md::RestMappingCache kept;
-  std::vector<size_t> blockOf;                              // muscle block of each muscle given to the core
-  std::map<size_t, std::string> failedBlocks;               // muscle blocks left out, and why
-  std::vector<size_t> boneLeaf;                             // BonesRest leaf of each bone
-  std::vector<md::Points> restPoints;                       // [muscle given]: as given, in the data's coordinates
-  std::vector<std::vector<md::Points>> restLines;           // [muscle given]
-  std::vector<std::unique_ptr<md::MuscleFibres>> fibres;    // [muscle given]; null: none
-  std::vector<md::TriangleTree> boneTrees;                  // the bones' in the rest pose; none without fibres
+  std::vector<size_t> blockOf;                         // muscle block of each muscle given to the core
+  std::map<size_t, std::string> failedBlocks;          // muscle blocks left out, and why
+  std::vector<size_t> boneLeaf;                        // BonesRest leaf of each bone
+  std::vector<md::Points> restPoints;                  // [muscle given]: as given, in the data's coordinates
+  std::vector<std::vector<md::Points>> restLines;      // [muscle given]
+  std::shared_ptr<const mdvtk::MadeFibres> fibres;     // [muscle given] and the bones' rest trees
+  std::shared_ptr<const mdvtk::MadeFibres> keptFibres; // kept across restarts (KeepOrMakeFibres)
+  int fibreBuilds = 0;
   std::vector<std::unique_ptr<md::TriangleTree>> boneMoved; // a bone's refitted to a frame's, where not rigid
   mdvtk::PoseCoordinates coordinates;                       // named at the first frame
   std::map<int, FrameKept> frames;
@@ -144,8 +145,7 @@ struct vtkMotionMuscleDeformation::Internals
     this->boneLeaf.clear();
     this->restPoints.clear();
     this->restLines.clear();
-    this->fibres.clear();
-    this->boneTrees.clear();
+    this->fibres.reset();
     this->boneMoved.clear();
     this->coordinates = {};
     this->steppedMissingSaid = false;
@@ -266,9 +266,9 @@ struct vtkMotionMuscleDeformation::Internals
     std::vector<std::vector<double>>& fibreLengths, std::vector<std::vector<double>>& lineLengths)
   {
     std::vector<md::FibreObstacle> obstacles;
-    for (size_t b = 0; b < this->boneTrees.size(); ++b)
+    for (size_t b = 0; b < this->fibres->boneTrees.size(); ++b)
     {
-      obstacles.push_back(mdvtk::BoneWhereItIs(this->boneTrees[b], this->boneMoved[b], pose.bones[b]));
+      obstacles.push_back(mdvtk::BoneWhereItIs(this->fibres->boneTrees[b], this->boneMoved[b], pose.bones[b]));
     }
     std::vector<md::Points> fibrePoints(this->blockOf.size());
     fibreLengths.assign(this->blockOf.size(), {});
@@ -279,10 +279,10 @@ struct vtkMotionMuscleDeformation::Internals
       {
         lineLengths[m].push_back(md::PolylineLength(line));
       }
-      if (this->fibres[m] && points[m].rows() > 0)
+      if (this->fibres->ofMuscle[m] && points[m].rows() > 0)
       {
-        fibrePoints[m] = this->fibres[m]->At(points[m], obstacles);
-        fibreLengths[m] = this->fibres[m]->Lengths(fibrePoints[m]);
+        fibrePoints[m] = this->fibres->ofMuscle[m]->At(points[m], obstacles);
+        fibreLengths[m] = this->fibres->ofMuscle[m]->Lengths(fibrePoints[m]);
       }
     }
     return fibrePoints;
@@ -339,6 +339,11 @@ double vtkMotionMuscleDeformation::GetCacheMegabytes() const
 int vtkMotionMuscleDeformation::GetSurfaceEnergyBuildCount() const
 {
   return this->In->kept.energyBuildCount;
+}
+
+int vtkMotionMuscleDeformation::GetFibreBuildCount() const
+{
+  return this->In->fibreBuilds;
 }
 
 int vtkMotionMuscleDeformation::FillInputPortInformation(int port, vtkInformation* info)
@@ -742,9 +747,11 @@ bool vtkMotionMuscleDeformation::Start(const Leaves& leaves, vtkDataObject* land
       failed[m] = 1;
     }
   }
-  in.fibres = mdvtk::MakeFibres(this, "MotionMuscleDeformation", this->NumberOfFibres, muscles, bones, failed);
-  in.boneTrees = mdvtk::FibreObstacleTrees(bones, in.fibres);
-  in.boneMoved.resize(in.boneTrees.size());
+  const auto before = in.keptFibres;
+  in.fibres = mdvtk::KeepOrMakeFibres(
+    this, "MotionMuscleDeformation", this->NumberOfFibres, muscles, bones, failed, in.keptFibres);
+  in.fibreBuilds += in.fibres != before ? 1 : 0;
+  in.boneMoved.resize(in.fibres->boneTrees.size());
   for (const std::string& warning : in.deformation->Warnings())
   {
     vtkWarningMacro(<< warning);
@@ -1038,15 +1045,19 @@ void vtkMotionMuscleDeformation::WriteFibres(const Leaves& leaves, vtkMultiBlock
   // Output 4: each muscle's fibres at the frame asked for, a block per muscle with fibres.
   const Internals& in = *this->In;
   output->Initialize();
+  if (!in.fibres)
+  {
+    return;
+  }
   const FrameKept& frame = in.frames.at(in.target);
   const FrameMeasures& measures = in.measures.at(in.target);
   for (const auto& [b, m] : in.MuscleOfBlock())
   {
-    if (in.fibres[m] && frame.fibres[m].rows() > 0)
+    if (in.fibres->ofMuscle[m] && frame.fibres[m].rows() > 0)
     {
       const unsigned block = output->GetNumberOfBlocks();
-      output->SetBlock(
-        block, mdvtk::FibrePolylines(frame.fibres[m], in.fibres[m]->PointsPerFibre(), measures.fibreLengths[m]));
+      output->SetBlock(block,
+        mdvtk::FibrePolylines(frame.fibres[m], in.fibres->ofMuscle[m]->PointsPerFibre(), measures.fibreLengths[m]));
       output->GetMetaData(block)->Set(vtkCompositeDataSet::NAME(), mdvtk::NameOf(leaves.muscles[b]).c_str());
     }
   }

@@ -114,6 +114,9 @@ public:
   double GetCacheMegabytes() const;
   /// Full-mesh energies built so far (kept across changes of the motion or the properties).
   int GetSurfaceEnergyBuildCount() const;
+  /// Times the fibres were made (kept, like the energies, while the muscles' rest surfaces, action
+  /// lines and attachment areas, the bones at rest and NumberOfFibres stay the same).
+  int GetFibreBuildCount() const;
 
 protected:
   vtkMotionMuscleDeformation();

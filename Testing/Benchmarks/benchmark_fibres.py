@@ -2,12 +2,15 @@
 """What fibres cost a frame through MotionMuscleDeformation in pvpython, side by side.
 
     pvpython Testing/Benchmarks/benchmark_fibres.py [data folder] [motion: hip_flexion | hip_adduction] [rounds]
+                                                    [moment-arm step, degrees]
 
 The main job's LHDL pipeline (Examples/motion.py: four muscles, the data set's landmarks, via
 points faded over 10 degrees) through every frame of the motion, as a user scrubbing it meets
 them (each frame from the last), with NumberOfFibres 100 (the default: fibres carried to every
 frame, their lengths and moment arms) and 0 (none), alternated `rounds` times (default 2) in one
-process so that both meet the same machine. Prints each run's milliseconds a frame after the
+process so that both meet the same machine. The reader's MomentArmStep is the main job's (1 degree:
+each frame also deformed to two stepped poses a coordinate, fibres carried to each) unless given;
+0 deforms each frame once. Prints each run's milliseconds a frame after the
 first (mean, median, range) and the preparation (the first frame, with the fibres made); last,
 the mean difference, of the whole frame and of its time beside the deformation's own (steadier).
 Asserts nothing.
@@ -28,6 +31,8 @@ import motion as job  # noqa: E402
 data = mdexamples.data_dir(sys.argv[1] if len(sys.argv) > 1 else None)
 motion_name = sys.argv[2] if len(sys.argv) > 2 else "hip_flexion"
 rounds = int(sys.argv[3]) if len(sys.argv) > 3 else 2
+if len(sys.argv) > 4:
+    job.MOMENT_ARM_STEP[0] = float(sys.argv[4])
 if not data or not os.path.isdir(os.path.join(data, "lhdl_hip_r")):
     print("skipped: lhdl_hip_r not found (give the data folder)")
     sys.exit(0)

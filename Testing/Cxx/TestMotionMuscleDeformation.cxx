@@ -398,6 +398,36 @@ TEST(MotionMuscleDeformation, FibresRunInsideEachMuscleAtEveryFrameWithTheirLeng
   {
     EXPECT_EQ(std::string(arms->GetColumnName(c)).find("MomentArm"), std::string::npos) << arms->GetColumnName(c);
   }
+  // A setting of the deformation restarts the motion but keeps the fibres made (seconds on real
+  // muscles), which then carry as a new filter's do.
+  EXPECT_EQ(p.motion->GetFibreBuildCount(), 1);
+  p.motion->SetMaximumStepDisplacement(15);
+  ASSERT_EQ(p.At(4), 1);
+  EXPECT_EQ(p.motion->GetFibreBuildCount(), 1);
+  {
+    PhantomMotionPipeline fresh(30, 4);
+    fresh.motion->SetNumberOfFibres(40);
+    fresh.motion->SetMaximumStepDisplacement(15);
+    for (int k = 0; k <= 4; ++k)
+    {
+      ASSERT_EQ(fresh.At(k), 1);
+    }
+    auto* kept = vtkMultiBlockDataSet::SafeDownCast(p.motion->GetOutputDataObject(4));
+    auto* made = vtkMultiBlockDataSet::SafeDownCast(fresh.motion->GetOutputDataObject(4));
+    ASSERT_EQ(kept->GetNumberOfBlocks(), made->GetNumberOfBlocks());
+    for (unsigned int b = 0; b < kept->GetNumberOfBlocks(); ++b)
+    {
+      EXPECT_EQ(LargestDifference(vtkPolyData::SafeDownCast(kept->GetBlock(b))->GetPoints(),
+                  vtkPolyData::SafeDownCast(made->GetBlock(b))->GetPoints()),
+        0.0)
+        << "block " << b;
+    }
+  }
+  p.motion->SetNumberOfFibres(30); // another count: made again
+  ASSERT_EQ(p.At(4), 1);
+  EXPECT_EQ(p.motion->GetFibreBuildCount(), 2);
+  p.motion->SetNumberOfFibres(40);
+
   // None asked for: none made, the muscles the same to the bit.
   vtkNew<vtkPoints> with;
   with->SetDataTypeToDouble();
