@@ -20,6 +20,29 @@ LINE_COLOUR = [0.10, 0.25, 0.75]
 CURRENT_LINE_COLOUR = [0.05, 0.55, 0.30]
 
 
+class QuietStandardError:
+    """Holds what C and C++ code writes to the standard error (file descriptor 2) while the block
+    runs, in `text`, instead of the terminal: a movie encoder writes a line a frame."""
+
+    def __enter__(self):
+        import tempfile
+        sys.stderr.flush()
+        self._file = tempfile.TemporaryFile(mode="w+b")
+        self._saved = os.dup(2)
+        os.dup2(self._file.fileno(), 2)
+        self.text = ""
+        return self
+
+    def __exit__(self, *exc):
+        sys.stderr.flush()
+        os.dup2(self._saved, 2)
+        os.close(self._saved)
+        self._file.seek(0)
+        self.text = self._file.read().decode(errors="replace")
+        self._file.close()
+        return False
+
+
 def find_plugin(explicit=None):
     """Path of MuscleDeformation.so: the argument, $MUSCLEDEFORMATION_PLUGIN, or the build folder."""
     candidates = [explicit, os.environ.get("MUSCLEDEFORMATION_PLUGIN")]

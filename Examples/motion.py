@@ -163,13 +163,51 @@ def step_ratios(frames):
     return ratios
 
 
-def write_multiblock(source, port, path):
-    from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataWriter
-    writer = vtkXMLMultiBlockDataWriter()
-    writer.SetFileName(path)
-    writer.SetInputData(servermanager.Fetch(source, idx=port))
-    writer.SetDataModeToBinary()
-    writer.Write()
+def write_multiblock(source, port, path, written=None):
+    """Output `port` of `source` as `path` (.vtm) and a folder of .vtp beside it, raw binary
+    compressed (not base64). With `written` (a dict kept over the frames of one series), a block
+    whose points and cells are those of a file written before, bit for bit, is not written again:
+    the .vtm refers to that file, so a bone that does not move is written once a motion."""
+    from vtkmodules.vtkCommonDataModel import vtkPolyData
+    from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataWriter, vtkXMLPolyDataWriter
+    data = servermanager.Fetch(source, idx=port)
+    blocks = [data.GetBlock(i) for i in range(data.GetNumberOfBlocks())]
+    if written is None or not all(isinstance(b, vtkPolyData) for b in blocks):
+        writer = vtkXMLMultiBlockDataWriter()
+        writer.SetFileName(path)
+        writer.SetInputData(data)
+        writer.SetDataModeToAppended()
+        writer.EncodeAppendedDataOff()
+        writer.Write()
+        return
+    import hashlib
+    from xml.sax.saxutils import quoteattr
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    stem = os.path.splitext(os.path.basename(path))[0]
+    entries = []
+    for i, block in enumerate(blocks):
+        name = data.GetMetaData(i).Get(data.NAME()) if data.HasMetaData(i) else str(i)
+        digest = hashlib.sha1()
+        for array in (block.GetPoints().GetData() if block.GetPoints() else None, block.GetPolys().GetData()):
+            if array is not None:
+                digest.update(vtk_to_numpy(array).tobytes())
+        key = (i, name, digest.digest())
+        if key not in written:
+            file = "%s/%s_%d.vtp" % (stem, stem, i)
+            os.makedirs(os.path.join(os.path.dirname(path), stem), exist_ok=True)
+            writer = vtkXMLPolyDataWriter()
+            writer.SetFileName(os.path.join(os.path.dirname(path), file))
+            writer.SetInputData(block)
+            writer.SetDataModeToAppended()
+            writer.EncodeAppendedDataOff()
+            writer.Write()
+            written[key] = file
+        entries.append('    <DataSet index="%d" name=%s file=%s/>\n' % (i, quoteattr(name), quoteattr(written[key])))
+    with open(path, "w") as out:
+        out.write('<?xml version="1.0"?>\n<VTKFile type="vtkMultiBlockDataSet" version="1.0" '
+                  'byte_order="LittleEndian" header_type="UInt32">\n  <vtkMultiBlockDataSet>\n')
+        out.write("".join(entries))
+        out.write("  </vtkMultiBlockDataSet>\n</VTKFile>\n")
 
 
 def write_pvd(path, entries):
@@ -383,6 +421,7 @@ def run_case(name, motion, camera, output, every, landmarks=None):
         slip = LandmarkSlip(landmarks, leaf_points(servermanager.Fetch(motion.Input)),
                             leaf_points(servermanager.Fetch(motion.BonesRest)))
     muscle_frames = []
+    bones_written = {}  # a bone that does not move is written once
     fibres_outside, fibres_in_bone = {}, {}
     for k, t in enumerate(times):
         motion.UpdatePipeline(t)
@@ -399,7 +438,7 @@ def run_case(name, motion, camera, output, every, landmarks=None):
         bones_file = "%s_bones_%03d.vtm" % (name, k)
         fibres_file = "%s_fibres_%03d.vtm" % (name, k)
         write_multiblock(motion, 0, os.path.join(folder, muscles_file))
-        write_multiblock(motion, 1, os.path.join(folder, bones_file))
+        write_multiblock(motion, 1, os.path.join(folder, bones_file), bones_written)
         write_multiblock(motion, 4, os.path.join(folder, fibres_file))
         entries += [(t, 0, muscles_file), (t, 1, bones_file), (t, 2, fibres_file)]
         if k % every == 0 or k == len(times) - 1:
@@ -410,8 +449,10 @@ def run_case(name, motion, camera, output, every, landmarks=None):
         scene = simple.GetAnimationScene()
         scene.UpdateAnimationUsingDataTimeSteps()
         movie = os.path.join(folder, name + ".avi")
-        simple.SaveAnimation(movie, view, ImageResolution=[800, 800], FrameRate=10)
+        with mdexamples.QuietStandardError() as encoder:  # the encoder's chatter, one line a frame
+            simple.SaveAnimation(movie, view, ImageResolution=[800, 800], FrameRate=10)
         if not os.path.isfile(movie):
+            print("no movie written: " + encoder.text.strip())
             movie = None
     except Exception as error:  # noqa: BLE001 - ParaView built without a movie writer
         print("no movie written (%s): the PNG frames are the animation" % error)

@@ -21,6 +21,7 @@
 #include <vtkPolyData.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -197,6 +198,13 @@ int vtkBoneInterpolation::RequestData(
   const int steps = this->ResolvedNumberOfSteps;
   const int step = mdvtk::StepAsked(outputVector->GetInformationObject(0), steps, 0);
   const auto mode = static_cast<md::InterpolationMode>(this->InterpolationMode);
+  const vtkMTimeType inputsTime =
+    std::max({ this->GetMTime(), restInput->GetMTime(), currentInput ? currentInput->GetMTime() : 0 });
+  if (inputsTime != this->WarningsSaidFor)
+  {
+    this->WarningsSaid.clear();
+    this->WarningsSaidFor = inputsTime;
+  }
 
   std::vector<vtkSmartPointer<vtkPolyData>> results(poses.size());
   for (size_t b = 0; b < poses.size(); ++b)
@@ -225,7 +233,8 @@ int vtkBoneInterpolation::RequestData(
               mdvtk::AddFieldValue(fieldData, "RigidFitMaxResidual", fit.maxResidual);
               mdvtk::AddFieldValue(
                 fieldData, "RotationAngleDegrees", vtkMath::DegreesFromRadians(interpolator.RotationAngle()));
-              if (const std::string warning = interpolator.NonRigidWarning(pose.label); !warning.empty())
+              if (const std::string warning = interpolator.NonRigidWarning(pose.label);
+                  !warning.empty() && this->WarningsSaid.insert(warning).second)
               {
                 vtkWarningMacro(<< warning);
               }

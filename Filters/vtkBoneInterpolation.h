@@ -31,6 +31,9 @@
 
 #include <vtkPassInputTypeAlgorithm.h>
 
+#include <set>
+#include <string>
+
 class MUSCLEDEFORMATIONFILTERS_EXPORT vtkBoneInterpolation : public vtkPassInputTypeAlgorithm
 {
 public:
@@ -86,4 +89,9 @@ private:
   struct Pose;
   /// Pairs the RP and CP blocks and reads their points; false after an error.
   bool ReadPoses(vtkDataObject* rest, vtkDataObject* current, std::vector<Pose>& poses);
+
+  /// The warnings said since the inputs or properties last changed (at `WarningsSaidFor`): a
+  /// warning of the inputs is said once, not at every step an animation asks for.
+  std::set<std::string> WarningsSaid;
+  vtkMTimeType WarningsSaidFor = 0;
 };

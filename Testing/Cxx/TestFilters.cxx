@@ -331,6 +331,22 @@ TEST(BoneInterpolation, RigidModeWarnsAboutANonRigidMotion)
   EXPECT_TRUE(messages.Contains("is not rigid")) << messages.Text();
   auto* output = vtkPolyData::SafeDownCast(interpolation->GetOutputDataObject(0));
   EXPECT_GT(output->GetFieldData()->GetArray("RigidFitMaxResidual")->GetTuple1(0), 1.0);
+  // Said once, not again at every step an animation asks for; again once the input changes.
+  auto count = [&] {
+    const std::string text = messages.Text();
+    size_t n = 0;
+    for (size_t at = text.find("is not rigid"); at != std::string::npos; at = text.find("is not rigid", at + 1))
+    {
+      ++n;
+    }
+    return n;
+  };
+  interpolation->UpdateTimeStep(0);
+  interpolation->UpdateTimeStep(1);
+  EXPECT_EQ(count(), 1u) << messages.Text();
+  current->Modified();
+  interpolation->UpdateTimeStep(0);
+  EXPECT_EQ(count(), 2u) << messages.Text();
 }
 
 TEST(BoneInterpolation, BadInputGivesAClearErrorAndNoOutput)
