@@ -160,9 +160,11 @@ def close_view(view):
     simple.Delete(view)
 
 
-def set_camera(view, direction=(1.0, 0.0, 0.0), up=(0.0, 0.0, 1.0), zoom=1.0, focal=None, distance=None):
+def set_camera(view, direction=(1.0, 0.0, 0.0), up=(0.0, 0.0, 1.0), zoom=1.0, focal=None, distance=None,
+               bounds=None):
     """Looks from the side `direction` points to: at `focal` from `distance` when given (the
-    same framing for every picture of a series), else fitted to what is shown."""
+    same framing for every picture of a series), fitted to `bounds` (xmin, xmax, ..., zmax) when
+    given, else fitted to what is shown."""
     length = sum(c * c for c in direction) ** 0.5
     unit = [c / length for c in direction]
     view.CameraViewUp = list(up)
@@ -173,7 +175,10 @@ def set_camera(view, direction=(1.0, 0.0, 0.0), up=(0.0, 0.0, 1.0), zoom=1.0, fo
         return
     view.CameraPosition = unit
     view.CameraFocalPoint = [0.0, 0.0, 0.0]
-    view.ResetCamera(False)
+    if bounds is not None:
+        view.ResetCamera(*bounds)
+    else:
+        view.ResetCamera(False)
     view.GetActiveCamera().Zoom(zoom)
 
 

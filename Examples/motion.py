@@ -46,8 +46,6 @@ import numpy  # noqa: E402
 from paraview import servermanager, simple  # noqa: E402
 from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
 
-HIP_CENTRE = (143.48, 243.44, -432.67)
-
 
 def phantom_pipeline(frames=15, flexion=30.0):
     phantom = simple.MusculoskeletalPhantom(registrationName="Phantom", Flexion=flexion)
@@ -94,8 +92,9 @@ def lhdl_pipeline(data, motion_name):
                                             BonesMotion=moved, ActionLinesRest=simple.OutputPort(lines, 0),
                                             ActionLinesMotion=simple.OutputPort(lines, 1),
                                             AttachmentFileName=os.path.join(folder, LANDMARKS))
-    camera = {"direction": (-1.0, -0.55, 0.25), "up": (0.0, 0.0, 1.0),
-              "focal": [HIP_CENTRE[0], HIP_CENTRE[1] - 120.0, HIP_CENTRE[2] - 120.0], "distance": 1500.0}
+    # Framed on the muscles over the whole motion (the bones reach far beyond them).
+    camera = {"direction": (-1.0, -0.55, 0.25), "up": (0.0, 0.0, 1.0), "focal": None, "distance": None,
+              "frame_muscles": True}
     return motion, camera
 
 
@@ -161,6 +160,19 @@ def step_ratios(frames):
         steps = sorted(float(numpy.linalg.norm(b[name] - a[name], axis=1).max()) for a, b in zip(frames, frames[1:]))
         ratios[name] = steps[-1] / steps[len(steps) // 2] if steps and steps[len(steps) // 2] > 0 else 0.0
     return ratios
+
+
+def muscle_bounds(motion, times):
+    """The box of the muscles over every frame (from the filter's cache), with a tenth of its
+    size around it."""
+    box = [math.inf, -math.inf] * 3
+    for t in times:
+        motion.UpdatePipeline(t)
+        frame = [0.0] * 6
+        servermanager.Fetch(motion, idx=0).GetBounds(frame)
+        box = [min(box[i], frame[i]) if i % 2 == 0 else max(box[i], frame[i]) for i in range(6)]
+    margin = 0.1 * max(box[2 * a + 1] - box[2 * a] for a in range(3))
+    return [box[i] - margin if i % 2 == 0 else box[i] + margin for i in range(6)]
 
 
 def write_multiblock(source, port, path, written=None):
@@ -413,8 +425,9 @@ def run_case(name, motion, camera, output, every, landmarks=None):
     simple.Show(simple.OutputPort(motion, 0), view).Representation = "Surface"
     mdexamples.show_lines(motion, view, mdexamples.LINE_COLOUR, port=2, width=3.0)
     view.ViewTime = times[0]
+    bounds = muscle_bounds(motion, times) if camera.get("frame_muscles") else None
     mdexamples.set_camera(view, camera["direction"], camera["up"], focal=camera["focal"],
-                          distance=camera["distance"])
+                          distance=camera["distance"], bounds=bounds)
     entries = []
     slip = None
     if landmarks:
