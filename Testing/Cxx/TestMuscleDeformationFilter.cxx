@@ -644,12 +644,15 @@ TEST(InterpolatedMuscleDeformationFilter, FibresRunInsideEachMuscleAtEveryStepWi
   }
   // Another number of steps or deformation setting keeps the fibres made (seconds on real
   // muscles); they carry as a new filter's do.
+  auto updateAt = [](vtkInterpolatedMuscleDeformation* filter, int port, double step) {
+    filter->UpdateInformation();
+    filter->GetOutputInformation(port)->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(), step);
+    filter->Update(port);
+  };
   EXPECT_EQ(f->GetFibreBuildCount(), 1);
   f->SetNumberOfSteps(3);
   f->SetBoneContactWeight(0.25);
-  f->UpdateInformation();
-  f->GetOutputInformation(4)->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(), 2.0);
-  f->Update(4);
+  updateAt(f, 4, 2.0);
   EXPECT_EQ(f->GetFibreBuildCount(), 1);
   {
     vtkNew<vtkInterpolatedMuscleDeformation> fresh;
@@ -657,16 +660,12 @@ TEST(InterpolatedMuscleDeformationFilter, FibresRunInsideEachMuscleAtEveryStepWi
     fresh->SetNumberOfSteps(3);
     fresh->SetBoneContactWeight(0.25);
     fresh->SetNumberOfFibres(30);
-    fresh->UpdateInformation();
-    fresh->GetOutputInformation(4)->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(), 2.0);
-    fresh->Update(4);
+    updateAt(fresh, 4, 2.0);
     EXPECT_EQ(LargestDifference(f->GetOutputDataObject(4), fresh->GetOutputDataObject(4)), 0.0);
   }
   f->SetNumberOfSteps(2);
   f->SetBoneContactWeight(0.5);
-  f->UpdateInformation();
-  f->GetOutputInformation(0)->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(), 2.0);
-  f->Update(0);
+  updateAt(f, 0, 2.0);
   EXPECT_EQ(f->GetFibreBuildCount(), 1);
 
   vtkNew<vtkPoints> with;
