@@ -182,15 +182,18 @@ def write_multiblock(source, port, path, written=None):
     the .vtm refers to that file, so a bone that does not move is written once a motion."""
     from vtkmodules.vtkCommonDataModel import vtkPolyData
     from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataWriter, vtkXMLPolyDataWriter
-    data = servermanager.Fetch(source, idx=port)
-    blocks = [data.GetBlock(i) for i in range(data.GetNumberOfBlocks())]
-    if written is None or not all(isinstance(b, vtkPolyData) for b in blocks):
-        writer = vtkXMLMultiBlockDataWriter()
-        writer.SetFileName(path)
+
+    def write_raw(writer, file, data):
+        writer.SetFileName(file)
         writer.SetInputData(data)
         writer.SetDataModeToAppended()
         writer.EncodeAppendedDataOff()
         writer.Write()
+
+    data = servermanager.Fetch(source, idx=port)
+    blocks = [data.GetBlock(i) for i in range(data.GetNumberOfBlocks())]
+    if written is None or not all(isinstance(b, vtkPolyData) for b in blocks):
+        write_raw(vtkXMLMultiBlockDataWriter(), path, data)
         return
     import hashlib
     from xml.sax.saxutils import quoteattr
@@ -207,12 +210,7 @@ def write_multiblock(source, port, path, written=None):
         if key not in written:
             file = "%s/%s_%d.vtp" % (stem, stem, i)
             os.makedirs(os.path.join(os.path.dirname(path), stem), exist_ok=True)
-            writer = vtkXMLPolyDataWriter()
-            writer.SetFileName(os.path.join(os.path.dirname(path), file))
-            writer.SetInputData(block)
-            writer.SetDataModeToAppended()
-            writer.EncodeAppendedDataOff()
-            writer.Write()
+            write_raw(vtkXMLPolyDataWriter(), os.path.join(os.path.dirname(path), file), block)
             written[key] = file
         entries.append('    <DataSet index="%d" name=%s file=%s/>\n' % (i, quoteattr(name), quoteattr(written[key])))
     with open(path, "w") as out:

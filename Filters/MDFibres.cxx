@@ -99,6 +99,9 @@ std::vector<std::pair<std::string, SteppedLengths>> SteppedPosesOf(
   return poses;
 }
 
+namespace
+{
+/// Each muscle's `count` fibres (FibreKeeper::KeepOrMake says what), in the muscles' order.
 std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, const std::string& filterName,
   int count, const std::vector<md::MotionDeformation::Muscle>& muscles,
   const std::vector<md::MotionDeformation::Bone>& bones, const std::vector<char>& failed)
@@ -172,8 +175,24 @@ std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, 
   return fibres;
 }
 
-namespace
+/// The rest trees of `bones`, each with its distance grid, that the fibres keep out of; none
+/// when no muscle has fibres.
+std::vector<md::TriangleTree> FibreObstacleTrees(
+  const std::vector<md::MotionDeformation::Bone>& bones, const std::vector<std::unique_ptr<md::MuscleFibres>>& fibres)
 {
+  std::vector<md::TriangleTree> trees;
+  if (std::none_of(fibres.begin(), fibres.end(), [](const auto& f) { return !!f; }))
+  {
+    return trees;
+  }
+  for (const md::MotionDeformation::Bone& bone : bones)
+  {
+    trees.emplace_back(bone.rest);
+    trees.back().BuildDistanceGrid(); // the fibres' test for a point inside a bone
+  }
+  return trees;
+}
+
 bool SameLines(const std::vector<md::Points>& a, const std::vector<md::Points>& b)
 {
   return std::equal(a.begin(), a.end(), b.begin(), b.end(),
@@ -187,10 +206,11 @@ bool SameMuscle(const md::MotionDeformation::Muscle& a, const md::MotionDeformat
 }
 } // namespace
 
-std::shared_ptr<const MadeFibres> KeepOrMakeFibres(vtkAlgorithm* filter, const std::string& filterName, int count,
-  const std::vector<md::MotionDeformation::Muscle>& muscles, const std::vector<md::MotionDeformation::Bone>& bones,
-  const std::vector<char>& failed, std::shared_ptr<const MadeFibres>& kept)
+std::shared_ptr<const MadeFibres> FibreKeeper::KeepOrMake(vtkAlgorithm* filter, const std::string& filterName,
+  int count, const std::vector<md::MotionDeformation::Muscle>& muscles,
+  const std::vector<md::MotionDeformation::Bone>& bones, const std::vector<char>& failed)
 {
+  const std::shared_ptr<const MadeFibres>& kept = this->kept;
   if (kept && kept->count == count && kept->failed == failed &&
     std::equal(muscles.begin(), muscles.end(), kept->muscles.begin(), kept->muscles.end(), SameMuscle) &&
     std::equal(bones.begin(), bones.end(), kept->bones.begin(), kept->bones.end(),
@@ -205,8 +225,9 @@ std::shared_ptr<const MadeFibres> KeepOrMakeFibres(vtkAlgorithm* filter, const s
   made->muscles = muscles;
   made->bones = bones;
   made->failed = failed;
-  kept = made;
-  return kept;
+  this->kept = made;
+  ++this->builds;
+  return made;
 }
 
 std::vector<std::string> LineNames(vtkPolyData* lines, const std::string& muscle, size_t count)
@@ -228,22 +249,6 @@ std::vector<std::string> LineNames(vtkPolyData* lines, const std::string& muscle
     }
   }
   return names;
-}
-
-std::vector<md::TriangleTree> FibreObstacleTrees(
-  const std::vector<md::MotionDeformation::Bone>& bones, const std::vector<std::unique_ptr<md::MuscleFibres>>& fibres)
-{
-  std::vector<md::TriangleTree> trees;
-  if (std::none_of(fibres.begin(), fibres.end(), [](const auto& f) { return !!f; }))
-  {
-    return trees;
-  }
-  for (const md::MotionDeformation::Bone& bone : bones)
-  {
-    trees.emplace_back(bone.rest);
-    trees.back().BuildDistanceGrid(); // the fibres' test for a point inside a bone
-  }
-  return trees;
 }
 
 md::FibreObstacle BoneWhereItIs(

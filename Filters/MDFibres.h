@@ -34,17 +34,9 @@ struct PoseCoordinates
 /// one), NaN for one it lacks; with `names` empty, names them first (none: no coordinates).
 std::vector<double> ReadCoordinates(vtkDataObject* bones, PoseCoordinates& names);
 
-/// Each muscle's fibres (`count` of them; 0: none), made in the rest pose between its attachment
-/// areas (or its ends along its lines) and out of the bones; a muscle whose fibres cannot be made
-/// gets none and a warning naming it. Says in the output messages what was made (`filterName`
-/// first). `unit`: the data's length of the coordinates' unit (a local frame's), for messages.
-std::vector<std::unique_ptr<md::MuscleFibres>> MakeFibres(vtkAlgorithm* filter, const std::string& filterName,
-  int count, const std::vector<md::MotionDeformation::Muscle>& muscles,
-  const std::vector<md::MotionDeformation::Bone>& bones, const std::vector<char>& failed);
-
 /// Each muscle's fibres and the rest trees of the bones they keep out of, with what they were
 /// made from, so that another run from the same muscles and bones (a setting of the deformation
-/// changed) takes them as they are (KeepOrMakeFibres).
+/// changed) takes them as they are (FibreKeeper).
 struct MadeFibres
 {
   std::vector<std::unique_ptr<md::MuscleFibres>> ofMuscle; ///< [muscle]; null: none
@@ -55,22 +47,31 @@ struct MadeFibres
   std::vector<char> failed;
 };
 
-/// `kept` when it was made from the same count, muscles (names, rest surfaces, lines, knots,
-/// attachment areas), bones and failures, bit for bit; else fibres made anew (MakeFibres,
-/// FibreObstacleTrees), which `kept` then holds. Making them costs seconds (the LHDL hip's four
+/// A deformation filter's fibres, kept across its runs while what they are made from stays the
+/// same, bit for bit: the count, the muscles (names, rest surfaces, lines, knots, attachment
+/// areas), the bones at rest and the failures. Making them costs seconds (the LHDL hip's four
 /// muscles: about 3.5 s); keeping them, a comparison of the inputs.
-std::shared_ptr<const MadeFibres> KeepOrMakeFibres(vtkAlgorithm* filter, const std::string& filterName, int count,
-  const std::vector<md::MotionDeformation::Muscle>& muscles, const std::vector<md::MotionDeformation::Bone>& bones,
-  const std::vector<char>& failed, std::shared_ptr<const MadeFibres>& kept);
+class FibreKeeper
+{
+public:
+  /// The kept fibres when made from these inputs; else each muscle's `count` fibres (0: none)
+  /// made anew in the rest pose between its attachment areas (or its ends along its lines) and
+  /// out of the bones, a muscle whose fibres cannot be made getting none and a warning naming it,
+  /// the output messages saying what was made (`filterName` first); these are then kept.
+  std::shared_ptr<const MadeFibres> KeepOrMake(vtkAlgorithm* filter, const std::string& filterName, int count,
+    const std::vector<md::MotionDeformation::Muscle>& muscles, const std::vector<md::MotionDeformation::Bone>& bones,
+    const std::vector<char>& failed);
+  /// Times fibres were made.
+  int Builds() const { return this->builds; }
+
+private:
+  std::shared_ptr<const MadeFibres> kept;
+  int builds = 0;
+};
 
 /// The names of `lines`' polylines (cell data ActionLineName), else "<muscle>" for one line and
 /// "<muscle> line <i>" for several; `count` names.
 std::vector<std::string> LineNames(vtkPolyData* lines, const std::string& muscle, size_t count);
-
-/// The rest trees of `bones`, each with its distance grid, that the fibres keep out of; none
-/// when no muscle has fibres.
-std::vector<md::TriangleTree> FibreObstacleTrees(
-  const std::vector<md::MotionDeformation::Bone>& bones, const std::vector<std::unique_ptr<md::MuscleFibres>>& fibres);
 
 /// A bone where it is now (`now`, its points) as an obstacle of the fibres: its rest tree (and
 /// distance grid) and the rigid motion there when it moved rigidly (to md::kRigidObstacleShare of

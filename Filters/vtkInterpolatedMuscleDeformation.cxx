@@ -122,6 +122,7 @@ private:
 vtkInterpolatedMuscleDeformation::vtkInterpolatedMuscleDeformation()
   : Computed(std::make_unique<Cache>())
   , KeptRest(std::make_unique<md::RestMappingCache>())
+  , KeptFibres(std::make_unique<mdvtk::FibreKeeper>())
 {
   this->SetNumberOfInputPorts(kPorts);
   this->SetNumberOfOutputPorts(5);
@@ -146,6 +147,11 @@ vtkInterpolatedMuscleDeformation::vtkInterpolatedMuscleDeformation()
 int vtkInterpolatedMuscleDeformation::GetHullBuildCount() const
 {
   return this->KeptRest->hullBuildCount;
+}
+
+int vtkInterpolatedMuscleDeformation::GetFibreBuildCount() const
+{
+  return this->KeptFibres->Builds();
 }
 
 int vtkInterpolatedMuscleDeformation::GetSurfaceEnergyBuildCount() const
@@ -654,10 +660,8 @@ void vtkInterpolatedMuscleDeformation::MakeFibres(
   {
     restBones.push_back({ bone.name, bone.rest });
   }
-  const auto before = this->KeptFibres;
-  cache.fibres = mdvtk::KeepOrMakeFibres(
-    this, "InterpolatedMuscleDeformation", this->NumberOfFibres, muscles, restBones, failed, this->KeptFibres);
-  this->FibreBuildCount += cache.fibres != before ? 1 : 0;
+  cache.fibres = this->KeptFibres->KeepOrMake(
+    this, "InterpolatedMuscleDeformation", this->NumberOfFibres, muscles, restBones, failed);
 }
 
 void vtkInterpolatedMuscleDeformation::WriteFibres(
@@ -720,5 +724,5 @@ void vtkInterpolatedMuscleDeformation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ResolvedNumberOfSteps: " << this->ResolvedNumberOfSteps << "\n";
   os << indent << "HullBuildCount: " << this->GetHullBuildCount() << "\n";
   os << indent << "SurfaceEnergyBuildCount: " << this->GetSurfaceEnergyBuildCount() << "\n";
-  os << indent << "FibreBuildCount: " << this->FibreBuildCount << "\n";
+  os << indent << "FibreBuildCount: " << this->GetFibreBuildCount() << "\n";
 }

@@ -71,6 +71,7 @@ namespace mdvtk
 {
 struct Leaf;
 struct MadeFibres;
+class FibreKeeper;
 }
 class vtkMultiBlockDataSet;
 
@@ -184,7 +185,7 @@ public:
   /// Times the fibres were made. They depend on the muscles' rest surfaces, action lines and
   /// attachment areas, the bones at rest and NumberOfFibres only, so they are kept like the hulls:
   /// another number of steps, current pose or deformation setting reuses them.
-  vtkGetMacro(FibreBuildCount, int);
+  int GetFibreBuildCount() const;
 
 protected:
   vtkInterpolatedMuscleDeformation();
@@ -243,12 +244,11 @@ private:
   /// Outputs 1 and 2: the bones and action lines at `step`.
   bool WriteBonesAndLines(vtkDataObject* const inputs[5], int step, vtkInformationVector* outputVector);
   /// Each muscle's fibres (NumberOfFibres), made in the rest pose of `motions` and `bones` (the
-  /// local frame), into Computed.
+  /// local frame), or kept from the last run when made from the same (KeptFibres), into Computed.
   void MakeFibres(const std::vector<md::MuscleMotion>& motions, const std::vector<md::BoneMotion>& bones);
   /// Output 4: each muscle's fibres at `step`, carried by the muscle there, out of the bones there.
   void WriteFibres(const std::vector<mdvtk::Leaf>& muscles, int step, vtkMultiBlockDataSet* output) const;
   std::unique_ptr<Cache> Computed;
   std::unique_ptr<md::RestMappingCache> KeptRest;
-  std::shared_ptr<const mdvtk::MadeFibres> KeptFibres;
-  int FibreBuildCount = 0;
+  std::unique_ptr<mdvtk::FibreKeeper> KeptFibres;
 };

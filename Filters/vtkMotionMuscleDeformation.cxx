@@ -116,14 +116,13 @@ struct vtkMotionMuscleDeformation::Internals
   std::string attachmentReport; ///< GetAttachmentReport
   std::unique_ptr<md::MotionDeformation> deformation;
   md::RestMappingCache kept;
-  std::vector<size_t> blockOf;                         // muscle block of each muscle given to the core
-  std::map<size_t, std::string> failedBlocks;          // muscle blocks left out, and why
-  std::vector<size_t> boneLeaf;                        // BonesRest leaf of each bone
-  std::vector<md::Points> restPoints;                  // [muscle given]: as given, in the data's coordinates
-  std::vector<std::vector<md::Points>> restLines;      // [muscle given]
-  std::shared_ptr<const mdvtk::MadeFibres> fibres;     // [muscle given] and the bones' rest trees
-  std::shared_ptr<const mdvtk::MadeFibres> keptFibres; // kept across restarts (KeepOrMakeFibres)
-  int fibreBuilds = 0;
+  std::vector<size_t> blockOf;                              // muscle block of each muscle given to the core
+  std::map<size_t, std::string> failedBlocks;               // muscle blocks left out, and why
+  std::vector<size_t> boneLeaf;                             // BonesRest leaf of each bone
+  std::vector<md::Points> restPoints;                       // [muscle given]: as given, in the data's coordinates
+  std::vector<std::vector<md::Points>> restLines;           // [muscle given]
+  std::shared_ptr<const mdvtk::MadeFibres> fibres;          // [muscle given] and the bones' rest trees
+  mdvtk::FibreKeeper keptFibres;                            // across restarts
   std::vector<std::unique_ptr<md::TriangleTree>> boneMoved; // a bone's refitted to a frame's, where not rigid
   mdvtk::PoseCoordinates coordinates;                       // named at the first frame
   std::map<int, FrameKept> frames;
@@ -343,7 +342,7 @@ int vtkMotionMuscleDeformation::GetSurfaceEnergyBuildCount() const
 
 int vtkMotionMuscleDeformation::GetFibreBuildCount() const
 {
-  return this->In->fibreBuilds;
+  return this->In->keptFibres.Builds();
 }
 
 int vtkMotionMuscleDeformation::FillInputPortInformation(int port, vtkInformation* info)
@@ -747,10 +746,7 @@ bool vtkMotionMuscleDeformation::Start(const Leaves& leaves, vtkDataObject* land
       failed[m] = 1;
     }
   }
-  const auto before = in.keptFibres;
-  in.fibres = mdvtk::KeepOrMakeFibres(
-    this, "MotionMuscleDeformation", this->NumberOfFibres, muscles, bones, failed, in.keptFibres);
-  in.fibreBuilds += in.fibres != before ? 1 : 0;
+  in.fibres = in.keptFibres.KeepOrMake(this, "MotionMuscleDeformation", this->NumberOfFibres, muscles, bones, failed);
   in.boneMoved.resize(in.fibres->boneTrees.size());
   for (const std::string& warning : in.deformation->Warnings())
   {

@@ -515,7 +515,6 @@ class LhdlFromItsOpenSimFiles(unittest.TestCase):
             self.assertLessEqual(field(muscle, "MaxNewBonePenetrationDepth"), 0.5)
             self.assertEqual(field(muscle, "Converged"), 1)
 
-
     def test_the_readmes_motion_click_path_plays_the_motion(self):
         import lhdl_gui_pipeline
         folder = os.path.join(DATA, "lhdl_hip_r")
@@ -539,6 +538,7 @@ class LhdlFromItsOpenSimFiles(unittest.TestCase):
             self.assertEqual(field(muscle, "NewBonePenetrationCount"), 0)
             self.assertEqual(field(muscle, "Converged"), 1)
         self.assertEqual(servermanager.Fetch(motion, idx=3).GetNumberOfRows(), 3)  # MeasuresOverTime
+
 
 if __name__ == "__main__":
     mdtesting.main()
