@@ -3,6 +3,8 @@
 
 #include "MDConvert.h"
 
+#include "Method/InterpolatedDeformation.h"
+
 #include <vtkAOSDataArrayTemplate.h>
 #include <vtkAbstractArray.h>
 #include <vtkAlgorithm.h>
@@ -447,5 +449,106 @@ void AssignLeaves(
     ++index;
   });
   MarkRoles(output, role);
+}
+
+std::string NameOf(const Leaf& leaf)
+{
+  return leaf.name.empty() ? leaf.label : leaf.name;
+}
+
+bool ReadMuscleSurface(const Leaf& leaf, TriangleMesh& surface, std::string& error, vtkIdType* converted)
+{
+  const vtkIdType notTriangles = ReadTriangles(leaf.data, surface);
+  if (converted)
+  {
+    *converted = notTriangles;
+  }
+  if (surface.triangles.rows() == 0)
+  {
+    error = leaf.label + " has no surface (no polygons); a muscle must be a closed triangle surface";
+    return false;
+  }
+  return true;
+}
+
+bool ReadMeshes(vtkInformationVector* port, const std::string& portName, std::vector<std::string>& names,
+  std::vector<TriangleMesh>& meshes, std::string& error, bool skipEmpty)
+{
+  for (int c = 0; c < port->GetNumberOfInformationObjects(); ++c)
+  {
+    std::vector<Leaf> leaves;
+    const std::string name = portName + " connection " + std::to_string(c + 1);
+    if (!CollectLeaves(vtkDataObject::GetData(port, c), name, leaves, error))
+    {
+      return false;
+    }
+    for (const Leaf& leaf : leaves)
+    {
+      if (!leaf.data || (skipEmpty && leaf.data->GetNumberOfPoints() == 0))
+      {
+        continue;
+      }
+      TriangleMesh mesh;
+      ReadTriangles(leaf.data, mesh);
+      if (mesh.triangles.rows() == 0)
+      {
+        error = leaf.label + " is not a usable mesh: it has no triangles";
+        return false;
+      }
+      names.push_back(leaf.name.empty() ? leaf.label : leaf.name);
+      meshes.push_back(std::move(mesh));
+    }
+  }
+  return true;
+}
+
+bool ReadBones(vtkObject* reporter, vtkDataObject* rest, const std::string& restName, vtkDataObject* current,
+  const std::string& currentName, std::vector<md::BoneMotion>& bones, std::string& error,
+  std::vector<size_t>* leafOfBone)
+{
+  std::vector<Leaf> restLeaves, currentLeaves;
+  std::vector<size_t> partner;
+  if (!CollectLeaves(rest, restName, restLeaves, error) || !CollectLeaves(current, currentName, currentLeaves, error) ||
+    !PairLeaves(reporter, restLeaves, restName, currentLeaves, currentName, partner, error))
+  {
+    return false;
+  }
+  for (size_t b = 0; b < restLeaves.size(); ++b)
+  {
+    const Leaf& r = restLeaves[b];
+    const Leaf& c = currentLeaves[partner[b]];
+    if (!r.data && !c.data)
+    {
+      continue; // an empty block in both poses
+    }
+    if (!r.data || !c.data)
+    {
+      // Dropping it would silently take an obstacle away.
+      error = (r.data ? c.label : r.label) + " is empty but " + (r.data ? r.label : c.label) +
+        " is not: a bone needs its surface in both poses";
+      return false;
+    }
+    md::BoneMotion bone;
+    bone.name = r.name.empty() ? r.label : r.name;
+    ReadTriangles(r.data, bone.rest);
+    bone.current = ToPoints(c.data->GetPoints());
+    if (bone.rest.points.rows() != bone.current.rows())
+    {
+      error = r.label + " has " + std::to_string(bone.rest.points.rows()) + " points but " + c.label + " has " +
+        std::to_string(bone.current.rows()) + ": a bone must have the same points in both poses";
+      return false;
+    }
+    if (bone.rest.triangles.rows() == 0)
+    {
+      error = r.label + " has no surface (no polygons)";
+      return false;
+    }
+    bones.push_back(std::move(bone));
+    if (leafOfBone)
+    {
+      leafOfBone->push_back(b);
+    }
+  }
+  return true;
 }
 }

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Geometry between VTK and the core's Eigen meshes: points, triangles, polylines, a muscle read,
-// the bones in both poses, the moved copy of an input. Not part of the public API.
+// Geometry between VTK and the core's Eigen meshes: points, triangles, polylines, the moved copy
+// of an input. Not part of the public API; the filters' inputs are read through MDBlocks.h, which
+// builds on it.
 #pragma once
 
-#include "MDBlocks.h"
+#include "Common/MeshTypes.h"
 
 #include <vtkSmartPointer.h>
 #include <vtkType.h>
@@ -13,27 +14,14 @@
 
 class vtkDataArray;
 class vtkDoubleArray;
-class vtkInformationVector;
-class vtkObject;
 class vtkPoints;
 class vtkPolyData;
-
-namespace md
-{
-struct BoneMotion;
-}
 
 namespace mdvtk
 {
 using md::Knots;
 using md::Points;
 using md::TriangleMesh;
-/// How messages and tables name a leaf: its block name, else its label.
-std::string NameOf(const Leaf& leaf);
-
-/// The surface of muscle `leaf` (ReadTriangles; `converted`, optional, receives its count of cells
-/// that were not triangles); false, with `error` naming the leaf, when it has no triangles.
-bool ReadMuscleSurface(const Leaf& leaf, TriangleMesh& surface, std::string& error, vtkIdType* converted = nullptr);
 
 /// A copy of `input` at `points`: its cells and arrays shared, its field data its own (for the
 /// measures a filter adds).
@@ -62,18 +50,4 @@ std::vector<std::vector<vtkIdType>> PolylineIds(vtkPolyData* polyData);
 std::vector<Knots> ToKnots(vtkPolyData* polyData);
 /// A polydata with one polyline cell per entry of `lines`, their points in order.
 vtkSmartPointer<vtkPolyData> ToPolyLines(const std::vector<Points>& lines);
-/// The meshes of every block of every connection of a repeatable input port
-/// (such as Obstacles), named by block name or label. Fails, with a message,
-/// on a block without triangles or with non-finite coordinates; with `skipEmpty`, a block with no
-/// points (a model's body without a mesh) is passed over instead.
-bool ReadMeshes(vtkInformationVector* port, const std::string& portName, std::vector<std::string>& names,
-  std::vector<TriangleMesh>& meshes, std::string& error, bool skipEmpty = false);
-
-/// The bones of `rest` (input `restName`) and `current` (input `currentName`) paired as PairLeaves
-/// pairs them, each with the same points in both; an empty block in both is skipped. Fails, naming
-/// the block, on a bone empty in one pose only, another number of points, or no polygons.
-/// `leafOfBone` (optional) receives the leaf of `rest` of each bone.
-bool ReadBones(vtkObject* reporter, vtkDataObject* rest, const std::string& restName, vtkDataObject* current,
-  const std::string& currentName, std::vector<md::BoneMotion>& bones, std::string& error,
-  std::vector<size_t>* leafOfBone = nullptr);
 }

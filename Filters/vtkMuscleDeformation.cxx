@@ -6,10 +6,10 @@
 #include "Geometry/MeanValueCoordinates.h"
 #include "Geometry/MeshChecks.h"
 #include "Hull/ProgressiveHull.h"
-#include "Intersections/SurfacePass.h"
 #include "MDBlocks.h"
 #include "MDConvert.h"
 #include "MDReport.h"
+#include "Settle/SurfacePass.h"
 
 #include <vtkCellArray.h>
 #include <vtkDataArray.h>

@@ -17,7 +17,7 @@
 #include "Geometry/LocalFrame.h"
 #include "Geometry/MeanValueCoordinates.h"
 #include "Hull/ProgressiveHull.h"
-#include "Intersections/SurfacePass.h"
+#include "Settle/SurfacePass.h"
 
 #include <chrono>
 #include <cmath>

@@ -149,6 +149,22 @@ Eigen::Vector3d ClosestPointOnTriangle(
   return a + ab * (vb * denominator) + ac * (vc * denominator);
 }
 
+Eigen::Vector3d BarycentricCoordinates(const TriangleMesh& mesh, Eigen::Index t, const Eigen::Vector3d& q)
+{
+  const Eigen::Vector3d a = mesh.points.row(mesh.triangles(t, 0)).transpose();
+  const Eigen::Vector3d b = mesh.points.row(mesh.triangles(t, 1)).transpose();
+  const Eigen::Vector3d c = mesh.points.row(mesh.triangles(t, 2)).transpose();
+  const Eigen::Vector3d normal = (b - a).cross(c - a);
+  const double area = normal.squaredNorm();
+  if (!(area > 0))
+  {
+    return Eigen::Vector3d::Constant(1.0 / 3.0);
+  }
+  const double u = (c - b).cross(q - b).dot(normal) / area;
+  const double v = (a - c).cross(q - c).dot(normal) / area;
+  return { u, v, 1 - u - v };
+}
+
 double PointTriangleDistance(
   const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c)
 {

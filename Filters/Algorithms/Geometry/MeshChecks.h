@@ -43,6 +43,10 @@ std::int64_t CountInside(const Points& points, const Triangles& triangles, const
 Eigen::Vector3d ClosestPointOnTriangle(
   const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c);
 
+/// Barycentric coordinates of q (on the triangle's plane) in triangle t of `mesh`; a third each
+/// for a degenerate triangle.
+Eigen::Vector3d BarycentricCoordinates(const TriangleMesh& mesh, Eigen::Index t, const Eigen::Vector3d& q);
+
 /// Distance from `p` to the triangle abc.
 double PointTriangleDistance(
   const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c);

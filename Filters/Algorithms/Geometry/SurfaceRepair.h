@@ -40,6 +40,8 @@ struct RepairReport
   }
   /// One line naming every repair made, e.g. "removed 10 unused points, ...".
   std::string Describe() const;
+  /// Adds `rows` to pointsToEnclose.
+  void AddPointsToEnclose(const std::vector<Eigen::RowVector3d>& rows);
 };
 
 /// A closed, manifold, outward-oriented copy of `surface`. Points closer than 1e-5 of the
@@ -63,4 +65,12 @@ TriangleMesh RepairClosedSurface(const TriangleMesh& surface, RepairReport& repo
 /// thickness, are kept), so that a scan's exact and split duplicate points give the same
 /// triangles.
 Triangles WeldedTriangles(const TriangleMesh& surface, std::vector<std::int64_t>& representative);
+
+/// RepairClosedSurface's last steps on a closed, consistently oriented `mesh` (in place), said in
+/// `report`: triangles that cross each other are undone by smoothing the points around them, as
+/// little as it takes (the region widened ring by ring where that is not enough; what smoothing
+/// cannot undo is counted as left).
+void UntangleSelfIntersections(TriangleMesh& mesh, RepairReport& report);
+/// Removes the connected pieces of `mesh` whose every point lies inside another piece.
+void RemoveEnclosedPieces(TriangleMesh& mesh, RepairReport& report);
 }

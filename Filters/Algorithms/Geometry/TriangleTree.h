@@ -165,4 +165,14 @@ inline Eigen::Vector3d JustOutside(const TriangleTree::Closest& closest, const E
 {
   return closest.point + (offset / closest.distance) * (closest.point - p);
 }
+
+/// The direction out of a surface at `q`, its point (on `triangle` of `tree`) nearest to `p`: from
+/// q towards p when p is outside, from p towards q when p is inside, and the triangle's normal
+/// when p lies on it.
+inline Eigen::Vector3d OutwardNormal(
+  const Eigen::Vector3d& p, const Eigen::Vector3d& q, bool inside, const TriangleTree& tree, Eigen::Index triangle)
+{
+  const double distance = (p - q).norm();
+  return distance > 0 ? Eigen::Vector3d((inside ? -1.0 : 1.0) * (p - q) / distance) : tree.Normal(triangle);
+}
 }

@@ -22,8 +22,8 @@
 #include "Geometry/MeanValueCoordinates.h"
 #include "Hull/ProgressiveHull.h"
 #include "Intersections/StaticIntersections.h"
-#include "Intersections/SurfaceSettle.h"
 #include "Motion/BoneInterpolation.h"
+#include "Settle/SurfaceSettle.h"
 
 #include <functional>
 #include <string>

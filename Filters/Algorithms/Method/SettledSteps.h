@@ -8,9 +8,9 @@
 #include "Geometry/LocalFrame.h"
 #include "Geometry/MeshChecks.h"
 #include "Intersections/StaticIntersections.h"
-#include "Intersections/SurfaceSettle.h"
 #include "Method/InterpolatedDeformation.h"
 #include "Motion/BoneInterpolation.h"
+#include "Settle/SurfaceSettle.h"
 
 #include <functional>
 #include <set>

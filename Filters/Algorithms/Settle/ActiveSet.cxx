@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "Intersections/ActiveSet.h"
+#include "Settle/ActiveSet.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/SparseCholesky>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "Intersections/SurfacePass.h"
+#include "Settle/SurfacePass.h"
 
 namespace md
 {

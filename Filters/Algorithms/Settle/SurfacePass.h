@@ -7,7 +7,7 @@
 
 #include "Common/MuscleFailures.h"
 #include "Deformation/MuscleDeformer.h"
-#include "Intersections/SurfaceSettle.h"
+#include "Settle/SurfaceSettle.h"
 
 #include <functional>
 #include <string>

@@ -11,12 +11,12 @@
 #include "Geometry/MeshChecks.h"
 #include "Geometry/TriangleTree.h"
 #include "Intersections/StaticIntersections.h"
-#include "Intersections/SurfaceSettle.h"
 #include "Method/InterpolatedDeformation.h"
 #include "Method/SettledSteps.h"
 #include "Motion/PathOverBones.h"
 #include "MotionCases.h"
 #include "RealData.h"
+#include "Settle/SurfaceSettle.h"
 #include "TestMeshes.h"
 
 #include <gtest/gtest.h>

@@ -4,9 +4,9 @@
 // moves with rounding noise of the input continuously where the motion is moderate (on the
 // phantom and the LHDL hip at 30 degrees of flexion).
 #include "Geometry/TriangleTree.h"
-#include "Intersections/SurfacePass.h"
 #include "MotionCases.h"
 #include "RealData.h"
+#include "Settle/SurfacePass.h"
 
 #include <gtest/gtest.h>
 

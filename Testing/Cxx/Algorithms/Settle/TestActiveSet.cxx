@@ -2,7 +2,7 @@
 // The settle's dual system solved (ActiveSet.h): the blocks no entry links are found, each block
 // meets the active set's conditions and is solved as it is alone, a singular system takes the
 // smallest multipliers and one with a zero on its diagonal is still solved.
-#include "Intersections/ActiveSet.h"
+#include "Settle/ActiveSet.h"
 
 #include <gtest/gtest.h>
 
