@@ -7,8 +7,11 @@ With Bodies, Action Line Grouping, then Interpolated Muscle Deformation (one pos
     pvpython Examples/lhdl_gui_pipeline.py [--data ../shared/data] [--motion [--frames K]]
                                            [--save-state Examples/LHDL_hip.pvsm]
 
-With --save-state it writes the ParaView state file that Examples/LHDL_hip.pvsm is (File > Load
-State, "Search files under specified directory": the folder holding lhdl_hip_r). Without it, it
+With --save-state it writes the ParaView state file that Examples/LHDL_hip.pvsm is (with --motion,
+Examples/LHDL_hip_motion.pvsm; File > Load State, "Search files under specified directory": the
+folder holding lhdl_hip_r): the method's muscles, bones, action lines and fibres in one render
+view of the layout, as Apply shows them (coloured by role, the lines as tubes), seen from the
+side the README's pictures are, fitted to the muscles, time snapped to the steps. Without it, it
 runs the method (60 degrees of hip flexion, 4 steps) or the motion's first K frames (all by
 default) and prints each muscle's measures at the last. Exits with code 77 (skipped) when the
 data is absent.
@@ -54,7 +57,51 @@ def build(folder, motion=False):
                                                       BonesCurrent=moved, ActionLinesRest=simple.OutputPort(lines, 0),
                                                       ActionLinesCurrent=simple.OutputPort(lines, 1), NumberOfSteps=4,
                                                       AttachmentFileName=landmarks)
-    return {"model": model, "bones": bones, "muscles": muscles, "moved": moved, "lines": lines, "method": method}
+    return {"model": model, "bones": bones, "muscles": muscles, "moved": moved, "lines": lines, "method": method,
+            "motion": motion}
+
+
+# The side the LHDL pictures look from (Examples/motion.py's): the right hip from its front and side.
+CAMERA = {"direction": (-1.0, -0.55, 0.25), "up": (0.0, 0.0, 1.0)}
+
+
+def save_state(pipeline, path):
+    """The pipeline, shown as Apply shows it, as a state file: one render view in the layout, the
+    method's muscles, bones, action lines and fibres in it, at the one pose's last step (the
+    motion's first frame), the camera fitted to the muscles there."""
+    method = pipeline["method"]
+    layout = simple.CreateLayout("Layout #1")
+    view = simple.CreateView("RenderView")
+    simple.AssignViewToLayout(view=view, layout=layout, hint=0)
+    view.OrientationAxesVisibility = 1
+    controller = servermanager.vtkSMParaViewPipelineControllerWithRendering()
+    for port in (0, 1, 2, 4):  # Muscles, Bones, ActionLines, Fibres; the tables in their own views
+        controller.Show(method.SMProxy, port, view.SMProxy)
+        # What the GUI's Apply does with the plugin's display defaults, written into the state:
+        # coloured by Role (the plugin's categorical colours), the action lines as tubes.
+        display = simple.GetDisplayProperties(simple.OutputPort(method, port), view)
+        simple.ColorBy(display, ("CELLS", "Role"))
+        display.SetScalarBarVisibility(view, False)
+        if port == 2:
+            display.RenderLinesAsTubes = 1
+            display.LineWidth = 4.0
+    scene = simple.GetAnimationScene()
+    scene.UpdateAnimationUsingDataTimeSteps()
+    scene.PlayMode = "Snap To TimeSteps"
+    times = list(method.TimestepValues)
+    shown = times[0] if pipeline.get("motion") else times[-1]
+    scene.AnimationTime = shown
+    method.UpdatePipeline(shown)
+    simple.Render(view)  # the first render fits the camera to everything: fit it to the muscles after
+    bounds = simple.OutputPort(method, 0).GetDataInformation().GetBounds()
+    margin = 0.1 * max(bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4])
+    mdexamples.set_camera(view, CAMERA["direction"], CAMERA["up"],
+                          bounds=[b + (margin if i % 2 else -margin) for i, b in enumerate(bounds)])
+    simple.SetActiveView(view)
+    simple.SetActiveSource(method)
+    simple.Render(view)
+    simple.SaveState(path)
+    simple.Delete(view)  # before the display goes: a view left to the interpreter's exit fails in X
 
 
 def main(argv=None):
@@ -71,11 +118,7 @@ def main(argv=None):
     mdexamples.load_plugin(explicit=args.plugin)
     pipeline = build(os.path.join(data, "lhdl_hip_r"), motion=args.motion)
     if args.save_state:
-        view = simple.CreateView("RenderView")
-        simple.Show(pipeline["method"], view)
-        simple.Show(pipeline["moved"], view)
-        simple.Show(simple.OutputPort(pipeline["lines"], 1), view)
-        simple.SaveState(args.save_state)
+        save_state(pipeline, args.save_state)
         print("state written to", os.path.abspath(args.save_state))
         return 0
     method = pipeline["method"]
