@@ -10,9 +10,14 @@ and action lines made time-varying by BoneInterpolation); the LHDL right hip (..
 --data / $MUSCLEDEFORMATION_DATA_DIR; skipped when absent) through every frame of
 kinematics/hip_flexion.mot and hip_adduction.mot, read by OpenSimModelReader with PlayMotion on
 (MoveWithBodies moves the scanned bones, ActionLineGrouping makes the paths the action lines).
-For each case it writes into <output>/<case>/: the deformed muscles and the bones at every frame
-(<case>_muscles_<k>.vtm, <case>_bones_<k>.vtm) with <case>.pvd, which ParaView opens as one time
-series; a picture of every frame (frames/<case>_<k>.png) and, where this ParaView can write one,
+For each case it writes into <output>/<case>/: the deformed muscles, their fibres and the bones at
+every frame (<case>_muscles_<k>.vtm, <case>_fibres_<k>.vtm, <case>_bones_<k>.vtm) with <case>.pvd,
+which ParaView opens as one time series. The LHDL hip's bones move rigidly with the model's
+bodies: they are written once, at rest (<case>_bones_rest.vtm), with the bodies' transforms at
+every frame (<case>_transforms.pvd, the reader's BodyTransforms), and <case>.pvsm opens the
+muscles, the fibres and the bones replayed by MoveWithBodies (File > Load State, searching the
+case's folder); figures.json says how far the replayed bones lie from those the filter used (0).
+Also a picture of every frame (frames/<case>_<k>.png) and, where this ParaView can write one,
 a movie (<case>.avi); plots of the measures over time (<case>_measures.png,
 <case>_smoothness.png); and figures.json (per-frame time through the filter, and every measure at
 every frame). For the LHDL hip, per muscle, a plot of its straight paths' moment arms (the
@@ -74,6 +79,7 @@ def lhdl_pipeline(data, motion_name):
                           "LHDL bones (rest pose)")
     muscles = lhdl.producer(lhdl.named_blocks([(n, lhdl.read_surface(folder, n)) for n in lhdl.MUSCLES]),
                             "LHDL muscles")
+    BONES_AT_REST[motion_name] = bones
     moved = simple.MoveWithBodies(registrationName="LHDL bones (motion)", Input=bones,
                                   BodyTransforms=simple.OutputPort(reader, 4), BodyOfSurface=lhdl.BODY_OF_SURFACE)
     paths_rest, paths_now = simple.OutputPort(reader, 3), simple.OutputPort(reader, 1)
@@ -100,6 +106,8 @@ def lhdl_pipeline(data, motion_name):
 
 LANDMARKS = "attachment_areas_rp_mm.csv"
 READERS = {}  # motion name: the model reader playing it (its MomentArms table)
+BONES_AT_REST = {}  # motion name: the bones' rest-pose source (their replay's input)
+FRAMES = [None]  # --frames: the first this many frames of each motion (all)
 CONDITIONAL_POINT_FADE = 10.0  # degrees
 MOMENT_ARM_STEP = [1.0]  # degrees (--moment-arm-step)
 PATHS_OVER_BONES = [False, 15]  # --paths-over-bones, --path-points-per-segment
@@ -175,11 +183,13 @@ def muscle_bounds(motion, times):
     return [box[i] - margin if i % 2 == 0 else box[i] + margin for i in range(6)]
 
 
-def write_multiblock(source, port, path, written=None):
+def write_multiblock(source, port, path, written=None, single=()):
     """Output `port` of `source` as `path` (.vtm) and a folder of .vtp beside it, raw binary
-    compressed (not base64). With `written` (a dict kept over the frames of one series), a block
+    compressed with LZMA (not base64). With `written` (a dict kept over the frames of one series), a block
     whose points and cells are those of a file written before, bit for bit, is not written again:
-    the .vtm refers to that file, so a bone that does not move is written once a motion."""
+    the .vtm refers to that file, so a bone that does not move is written once a motion. The point
+    arrays named in `single` are written in single precision (arrays to colour by; the points
+    themselves keep double precision)."""
     from vtkmodules.vtkCommonDataModel import vtkPolyData
     from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataWriter, vtkXMLPolyDataWriter
 
@@ -188,10 +198,20 @@ def write_multiblock(source, port, path, written=None):
         writer.SetInputData(data)
         writer.SetDataModeToAppended()
         writer.EncodeAppendedDataOff()
+        writer.SetCompressorTypeToLZMA()  # a sixth smaller than zlib's on these surfaces
         writer.Write()
 
     data = servermanager.Fetch(source, idx=port)
     blocks = [data.GetBlock(i) for i in range(data.GetNumberOfBlocks())]
+    for block in blocks:
+        for name in single:
+            array = block.GetPointData().GetArray(name) if block else None
+            if array is not None:
+                from vtkmodules.vtkCommonCore import vtkFloatArray
+                narrowed = vtkFloatArray()
+                narrowed.DeepCopy(array)
+                narrowed.SetName(name)
+                block.GetPointData().AddArray(narrowed)
     if written is None or not all(isinstance(b, vtkPolyData) for b in blocks):
         write_raw(vtkXMLMultiBlockDataWriter(), path, data)
         return
@@ -226,6 +246,81 @@ def write_pvd(path, entries):
         for t, part, name in entries:
             out.write('    <DataSet timestep="%.9g" part="%d" file="%s"/>\n' % (t, part, name))
         out.write('  </Collection>\n</VTKFile>\n')
+
+
+def write_table(source, port, t, path):
+    """Output `port` of `source` (a table) at time `t` as `path` (.vtt, raw binary)."""
+    from vtkmodules.vtkIOXML import vtkXMLTableWriter
+    source.UpdatePipeline(t)
+    from vtkmodules.vtkCommonDataModel import vtkTable
+    # A copy without the fetched table's time: VTK 9.2's table writer leaves the time value it
+    # would add empty, which makes the file unreadable.
+    fetched = servermanager.Fetch(source, idx=port)
+    table = vtkTable()
+    table.GetRowData().ShallowCopy(fetched.GetRowData())
+    table.GetFieldData().ShallowCopy(fetched.GetFieldData())
+    table.GetFieldData().RemoveArray("TimeValue")
+    writer = vtkXMLTableWriter()
+    writer.SetFileName(path)
+    writer.SetInputData(table)
+    writer.SetDataModeToAppended()
+    writer.EncodeAppendedDataOff()
+    writer.Write()
+
+
+def replay(folder, name):
+    """The bones of case `name` replayed from what run_case wrote into `folder`: the rest bones
+    moved by the bodies' transforms at each frame (MoveWithBodies, as the pipeline moved them)."""
+    import lhdl
+    rest = simple.XMLMultiBlockDataReader(registrationName=name + "_bones_rest.vtm",
+                                          FileName=[os.path.join(folder, name + "_bones_rest.vtm")])
+    transforms = simple.PVDReader(registrationName=name + "_transforms.pvd",
+                                  FileName=os.path.join(folder, name + "_transforms.pvd"))
+    return simple.MoveWithBodies(registrationName="Bones", Input=rest, BodyTransforms=transforms,
+                                 BodyOfSurface=lhdl.BODY_OF_SURFACE), (rest, transforms)
+
+
+def replay_check(motion, folder, name, times):
+    """The largest distance, over every frame and bone point, between the bones replayed from the
+    written files (`replay`) and those the motion filter used at that frame (its output 1)."""
+    moved, sources = replay(folder, name)
+    largest = 0.0
+    for t in times:
+        motion.UpdatePipeline(t)
+        moved.UpdatePipeline(t)
+        used = leaf_points(servermanager.Fetch(motion, idx=1))
+        again = leaf_points(servermanager.Fetch(moved))
+        for bone, points in used.items():
+            largest = max(largest, float(numpy.abs(points - again[bone]).max()))
+    for proxy in (moved,) + sources:
+        simple.Delete(proxy)
+    return largest
+
+
+def write_replay_state(folder, name, camera):
+    """<case>.pvsm in `folder`: the case's muscles and fibres (<case>.pvd) and its bones replayed
+    (`replay`), coloured by role, from the side and at the framing of the case's pictures; written
+    from a session of its own (every proxy in the session goes into a state)."""
+    simple.ResetSession()
+    series = simple.PVDReader(registrationName=name + ".pvd", FileName=os.path.join(folder, name + ".pvd"))
+    moved, _ = replay(folder, name)
+    layout = simple.CreateLayout("Layout #1")
+    view = simple.CreateView("RenderView")
+    simple.AssignViewToLayout(view=view, layout=layout, hint=0)
+    muscles = simple.Show(series, view)  # the muscles and fibres by role, as the filter writes them
+    simple.ColorBy(muscles, ("CELLS", "Role"))
+    muscles.SetScalarBarVisibility(view, False)
+    bones = simple.Show(moved, view)  # the scans' bones, which carry no role
+    bones.ColorArrayName = ["POINTS", ""]
+    bones.DiffuseColor = mdexamples.BONE_COLOUR
+    scene = simple.GetAnimationScene()
+    scene.UpdateAnimationUsingDataTimeSteps()
+    scene.PlayMode = "Snap To TimeSteps"
+    simple.Render(view)  # the first render fits the camera to everything: set it after
+    mdexamples.set_camera(view, camera["direction"], camera["up"], bounds=camera.get("bounds"))
+    simple.Render(view)
+    simple.SaveState(os.path.join(folder, name + ".pvsm"))
+    simple.Delete(view)
 
 
 def table_columns(table):
@@ -408,7 +503,7 @@ def fibre_check(fibres, muscles, bones):
 def run_case(name, motion, camera, output, every, landmarks=None):
     folder = os.path.join(output, name)
     os.makedirs(os.path.join(folder, "frames"), exist_ok=True)
-    times = list(motion.TimestepValues)
+    times = list(motion.TimestepValues)[:FRAMES[0]]
     # Every frame through the filter first, timed as a user meets it (each frame from the last).
     seconds = []
     start = time.time()
@@ -424,6 +519,7 @@ def run_case(name, motion, camera, output, every, landmarks=None):
     mdexamples.show_lines(motion, view, mdexamples.LINE_COLOUR, port=2, width=3.0)
     view.ViewTime = times[0]
     bounds = muscle_bounds(motion, times) if camera.get("frame_muscles") else None
+    camera["bounds"] = bounds
     mdexamples.set_camera(view, camera["direction"], camera["up"], focal=camera["focal"],
                           distance=camera["distance"], bounds=bounds)
     entries = []
@@ -433,6 +529,11 @@ def run_case(name, motion, camera, output, every, landmarks=None):
                             leaf_points(servermanager.Fetch(motion.BonesRest)))
     muscle_frames = []
     bones_written = {}  # a bone that does not move is written once
+    motion_name = name[len("lhdl_"):]
+    replayed = motion_name in BONES_AT_REST  # the bones written once, with the bodies' transforms
+    if replayed:
+        write_multiblock(BONES_AT_REST[motion_name], 0, os.path.join(folder, name + "_bones_rest.vtm"))
+        transforms = []
     fibres_outside, fibres_in_bone = {}, {}
     for k, t in enumerate(times):
         motion.UpdatePipeline(t)
@@ -448,13 +549,23 @@ def run_case(name, motion, camera, output, every, landmarks=None):
         muscles_file = "%s_muscles_%03d.vtm" % (name, k)
         bones_file = "%s_bones_%03d.vtm" % (name, k)
         fibres_file = "%s_fibres_%03d.vtm" % (name, k)
-        write_multiblock(motion, 0, os.path.join(folder, muscles_file))
-        write_multiblock(motion, 1, os.path.join(folder, bones_file), bones_written)
+        write_multiblock(motion, 0, os.path.join(folder, muscles_file), single=("Displacement",))
         write_multiblock(motion, 4, os.path.join(folder, fibres_file))
-        entries += [(t, 0, muscles_file), (t, 1, bones_file), (t, 2, fibres_file)]
+        entries += [(t, 0, muscles_file), (t, 2, fibres_file)]
+        if replayed:
+            transforms_file = "%s_transforms_%03d.vtt" % (name, k)
+            write_table(READERS[motion_name], 4, t, os.path.join(folder, transforms_file))
+            transforms.append((t, 0, transforms_file))
+        else:
+            write_multiblock(motion, 1, os.path.join(folder, bones_file), bones_written)
+            entries.append((t, 1, bones_file))
         if k % every == 0 or k == len(times) - 1:
             mdexamples.screenshot(view, os.path.join(folder, "frames", "%s_%03d.png" % (name, k)), t)
     write_pvd(os.path.join(folder, name + ".pvd"), entries)
+    replay_difference = None
+    if replayed:
+        write_pvd(os.path.join(folder, name + "_transforms.pvd"), transforms)
+        replay_difference = replay_check(motion, folder, name, times)
     movie = None
     try:
         scene = simple.GetAnimationScene()
@@ -490,6 +601,8 @@ def run_case(name, motion, camera, output, every, landmarks=None):
         "fibre_points_inside_bone": fibres_in_bone,
         "fibre_lengths": fibre_length_figures(servermanager.Fetch(motion, idx=5)),
     }
+    if replay_difference is not None:
+        figures["bones_replay_largest_difference"] = replay_difference
     if slip:
         figures["largest_landmark_slip_mm"] = slip.worst
         figures["landmark_probes"] = len(slip.probes)
@@ -545,11 +658,14 @@ def main(argv=None):
                         help="the LHDL paths kept out of the bones (PathsOverBones) before they become action lines")
     parser.add_argument("--path-points-per-segment", type=int, default=PATHS_OVER_BONES[1],
                         help="with --paths-over-bones: PathsOverBones' PointsPerSegment")
+    parser.add_argument("--frames", type=int, help="the first this many frames of each motion (all)")
     args = parser.parse_args(argv)
+    FRAMES[0] = args.frames
     MOMENT_ARM_STEP[0] = args.moment_arm_step
     PATHS_OVER_BONES[:] = [args.paths_over_bones, args.path_points_per_segment]
     mdexamples.load_plugin(explicit=args.plugin)
     results = []
+    replays = []  # (folder, case, camera): each LHDL case's state file, written once every case ran
     if args.case in ("all", "phantom"):
         motion, camera = phantom_pipeline()
         results.append(run_case("phantom", motion, camera, args.output, args.every))
@@ -562,6 +678,9 @@ def main(argv=None):
         motion, camera = lhdl_pipeline(data, name)
         results.append(run_case("lhdl_" + name, motion, camera, args.output, args.every,
                                 landmarks=os.path.join(data, "lhdl_hip_r", LANDMARKS)))
+        replays.append((os.path.join(args.output, "lhdl_" + name), "lhdl_" + name, camera))
+    for folder, case, camera in replays:
+        write_replay_state(folder, case, camera)
     return 0 if results else mdexamples.SKIPPED
 
 

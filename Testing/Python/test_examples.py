@@ -120,6 +120,48 @@ class MotionExample(unittest.TestCase):
         self.assertEqual(len(figures["measures"]["Time"]), 16)
 
 
+class LhdlMotionExample(unittest.TestCase):
+    def test_the_lhdl_bones_are_written_once_and_replayed_by_the_state_file(self):
+        import mdexamples
+        data = mdexamples.data_dir()
+        if not os.path.isdir(os.path.join(data, "lhdl_hip_r")):
+            self.skipTest("the LHDL data set is absent (%s)" % data)
+        output = mdtesting.output_dir("example-motion-lhdl")
+        result = run_example("motion.py", output, "--case", "hip_flexion", "--data", data, "--frames", "3",
+                             "--moment-arm-step", "0", "--every", "100")
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        name = "lhdl_hip_flexion"
+        folder = os.path.join(output, name)
+        with open(os.path.join(folder, "figures.json")) as f:
+            figures = json.load(f)
+        # The bones replayed from the written files (rest bones, the bodies' transforms) are those
+        # the filter used, to the bit; they are not in the series at every frame.
+        self.assertEqual(figures["bones_replay_largest_difference"], 0.0)
+        self.assertEqual(glob.glob(os.path.join(folder, name + "_bones_0*")), [])
+        with open(os.path.join(folder, name + ".pvd")) as f:
+            self.assertEqual(f.read().count("<DataSet "), 6)  # the muscles and the fibres at every frame
+        with open(os.path.join(folder, name + "_transforms.pvd")) as f:
+            self.assertEqual(f.read().count("<DataSet "), 3)
+        # The state file opens them as File > Load State does, searching the case's folder (here
+        # moved elsewhere): the muscles, the fibres and the moving bones, at every frame.
+        moved = os.path.join(output, "moved")
+        shutil.rmtree(moved, ignore_errors=True)
+        shutil.copytree(folder, os.path.join(moved, name))
+        from paraview import simple
+        mdtesting.load_plugin()
+        simple.LoadState(os.path.join(moved, name, name + ".pvsm"), data_directory=os.path.join(moved, name))
+        bones, series = simple.FindSource("Bones"), simple.FindSource(name + ".pvd")
+        self.assertEqual(len(series.TimestepValues), 3)
+        femur, pelvis = [], []
+        for t in series.TimestepValues:
+            bones.UpdatePipeline(t)
+            leaves = mdexamples.named_leaves(simple.servermanager.Fetch(bones))
+            femur.append(mdtesting.points(leaves["femur_r"]))
+            pelvis.append(mdtesting.points(leaves["iliac_r"]))
+        self.assertGreater(numpy.abs(femur[0] - femur[2]).max(), 1.0)  # the femur flexes 4 degrees
+        self.assertTrue(numpy.array_equal(pelvis[0], pelvis[2]))  # the motion holds the pelvis
+
+
 def leaves_of(path):
     """Every polydata file under `path`, relative to it."""
     return sorted(os.path.relpath(f, path) for f in glob.glob(os.path.join(path, "**", "*.vtp"), recursive=True))
