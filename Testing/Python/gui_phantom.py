@@ -7,9 +7,12 @@ and writes what it saw to $MUSCLEDEFORMATION_GUI_OUTPUT: report.txt (one "key va
 and a screenshot of the last step, GuiPhantomInterpolated.png; or error.txt.
 """
 import os
-import traceback
+import sys
 
 from paraview import simple, servermanager
+
+sys.path.insert(0, os.path.join(os.environ["MUSCLEDEFORMATION_SOURCE_DIR"], "Testing", "Python"))
+import gui_report  # noqa: E402
 
 output = os.environ["MUSCLEDEFORMATION_GUI_OUTPUT"]
 
@@ -65,14 +68,7 @@ def run():
     view.CameraViewUp = [0.0, 0.0, 1.0]
     view.ResetCamera()
     simple.SaveScreenshot(os.path.join(output, "GuiPhantomInterpolated.png"), view, ImageResolution=[600, 600])
-    with open(os.path.join(output, "report.txt"), "w") as f:
-        for key, value in report.items():
-            f.write("%s %s\n" % (key, value))
+    return report
 
 
-# The GUI keeps a script's exceptions to its own output window: write them where the test looks.
-try:
-    run()
-except Exception:
-    with open(os.path.join(output, "error.txt"), "w") as f:
-        f.write(traceback.format_exc())
+gui_report.finish(run, output)

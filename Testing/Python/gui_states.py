@@ -8,9 +8,12 @@ $MUSCLEDEFORMATION_GUI_OUTPUT: report.txt (one "key value" per line) and a scree
 the view as loaded; or error.txt.
 """
 import os
-import traceback
+import sys
 
 from paraview import simple
+
+sys.path.insert(0, os.path.join(os.environ["MUSCLEDEFORMATION_SOURCE_DIR"], "Testing", "Python"))
+import gui_report  # noqa: E402
 
 output = os.environ["MUSCLEDEFORMATION_GUI_OUTPUT"]
 source = os.environ["MUSCLEDEFORMATION_SOURCE_DIR"]
@@ -36,14 +39,7 @@ def run():
         "muscles": simple.OutputPort(method, 0).GetDataInformation().GetNumberOfPoints() > 0,
     }
     simple.SaveScreenshot(os.path.join(output, "state.png"), view, ImageResolution=[600, 600])
-    with open(os.path.join(output, "report.txt"), "w") as f:
-        for key, value in report.items():
-            f.write("%s %s\n" % (key, value))
+    return report
 
 
-# The GUI keeps a script's exceptions to its own output window: write them where the test looks.
-try:
-    run()
-except Exception:
-    with open(os.path.join(output, "error.txt"), "w") as f:
-        f.write(traceback.format_exc())
+gui_report.finish(run, output)
