@@ -183,9 +183,10 @@ def muscle_bounds(motion, times):
     return [box[i] - margin if i % 2 == 0 else box[i] + margin for i in range(6)]
 
 
-def write_multiblock(source, port, path, written=None, single=()):
+def write_multiblock(source, port, path, written=None, single=(), smallest=False):
     """Output `port` of `source` as `path` (.vtm) and a folder of .vtp beside it, raw binary
-    compressed with LZMA (not base64). With `written` (a dict kept over the frames of one series), a block
+    compressed (not base64): with zlib, or with `smallest` LZMA (a sixth smaller on these
+    surfaces, and much slower to write: trials over MPI ranks took 45 % longer). With `written` (a dict kept over the frames of one series), a block
     whose points and cells are those of a file written before, bit for bit, is not written again:
     the .vtm refers to that file, so a bone that does not move is written once a motion. The point
     arrays named in `single` are written in single precision (arrays to colour by; the points
@@ -198,7 +199,8 @@ def write_multiblock(source, port, path, written=None, single=()):
         writer.SetInputData(data)
         writer.SetDataModeToAppended()
         writer.EncodeAppendedDataOff()
-        writer.SetCompressorTypeToLZMA()  # a sixth smaller than zlib's on these surfaces
+        if smallest:
+            writer.SetCompressorTypeToLZMA()
         writer.Write()
 
     data = servermanager.Fetch(source, idx=port)
@@ -532,7 +534,7 @@ def run_case(name, motion, camera, output, every, landmarks=None):
     motion_name = name[len("lhdl_"):]
     replayed = motion_name in BONES_AT_REST  # the bones written once, with the bodies' transforms
     if replayed:
-        write_multiblock(BONES_AT_REST[motion_name], 0, os.path.join(folder, name + "_bones_rest.vtm"))
+        write_multiblock(BONES_AT_REST[motion_name], 0, os.path.join(folder, name + "_bones_rest.vtm"), smallest=True)
         transforms = []
     fibres_outside, fibres_in_bone = {}, {}
     for k, t in enumerate(times):
@@ -549,15 +551,15 @@ def run_case(name, motion, camera, output, every, landmarks=None):
         muscles_file = "%s_muscles_%03d.vtm" % (name, k)
         bones_file = "%s_bones_%03d.vtm" % (name, k)
         fibres_file = "%s_fibres_%03d.vtm" % (name, k)
-        write_multiblock(motion, 0, os.path.join(folder, muscles_file), single=("Displacement",))
-        write_multiblock(motion, 4, os.path.join(folder, fibres_file))
+        write_multiblock(motion, 0, os.path.join(folder, muscles_file), single=("Displacement",), smallest=True)
+        write_multiblock(motion, 4, os.path.join(folder, fibres_file), smallest=True)
         entries += [(t, 0, muscles_file), (t, 2, fibres_file)]
         if replayed:
             transforms_file = "%s_transforms_%03d.vtt" % (name, k)
             write_table(READERS[motion_name], 4, t, os.path.join(folder, transforms_file))
             transforms.append((t, 0, transforms_file))
         else:
-            write_multiblock(motion, 1, os.path.join(folder, bones_file), bones_written)
+            write_multiblock(motion, 1, os.path.join(folder, bones_file), bones_written, smallest=True)
             entries.append((t, 1, bones_file))
         if k % every == 0 or k == len(times) - 1:
             mdexamples.screenshot(view, os.path.join(folder, "frames", "%s_%03d.png" % (name, k)), t)
