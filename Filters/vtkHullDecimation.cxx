@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkHullDecimation.h"
 
+#include "Common/Clock.h"
 #include "Geometry/MeshChecks.h"
 #include "Hull/ProgressiveHull.h"
 #include "MDBlocks.h"
@@ -13,8 +14,6 @@
 #include <vtkObjectFactory.h>
 #include <vtkPolyData.h>
 #include <vtkStringArray.h>
-
-#include <chrono>
 
 vtkStandardNewMacro(vtkHullDecimation);
 
@@ -72,7 +71,7 @@ int vtkHullDecimation::RequestData(
       continue;
     }
     ++muscleCount;
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = md::Clock::now();
     md::TriangleMesh muscle;
     vtkIdType converted = 0;
     std::string message;
@@ -97,7 +96,7 @@ int vtkHullDecimation::RequestData(
       ++failedCount;
       continue;
     }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = md::SecondsSince(start);
     results[b] = this->HullOutput(leaf, built, converted, seconds);
   }
   mdvtk::AssignLeaves(input, vtkDataObject::GetData(outputVector, 0), results, mdvtk::Role::Hull);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkMuscleDeformation.h"
 
+#include "Common/Clock.h"
 #include "Deformation/MuscleDeformer.h"
 #include "Geometry/LocalFrame.h"
 #include "Geometry/MeanValueCoordinates.h"
@@ -22,7 +23,6 @@
 #include <vtkPolyData.h>
 
 #include <algorithm>
-#include <chrono>
 #include <functional>
 #include <map>
 #include <memory>
@@ -31,13 +31,6 @@ vtkStandardNewMacro(vtkMuscleDeformation);
 
 namespace
 {
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start)
-{
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 /// The action lines of one block: each polyline's points and their
 /// CurrentPosition (from ActionLineMatching), lines of too many points cut down (said in
 /// `notes`). Fails with a message.
@@ -174,7 +167,7 @@ bool vtkMuscleDeformation::PassOnSurface(const PassInput& in, std::vector<std::s
     {
       continue;
     }
-    const auto energyStart = Clock::now();
+    const auto energyStart = md::Clock::now();
     const std::vector<md::MatchedLine> restLines = md::StillLines(in.toDeform[m].lines);
     md::KeptSurfaceEnergy& entry = this->Kept->energies[b];
     if (!entry.Holds(in.surfaces[b], restLines, parameters))
@@ -203,7 +196,7 @@ bool vtkMuscleDeformation::PassOnSurface(const PassInput& in, std::vector<std::s
       vtkWarningMacro(<< warning);
     }
     toSettle[m].energy = entry.energy.get();
-    outcomes[m].restSeconds = SecondsSince(energyStart);
+    outcomes[m].restSeconds = md::SecondsSince(energyStart);
   }
   reportedBefore = failures;
   std::vector<md::SurfacePassResult> settled;
@@ -311,7 +304,7 @@ bool vtkMuscleDeformation::PassOnHull(const PassInput& in, bool hullGiven, std::
     {
       continue;
     }
-    const auto hullStart = Clock::now();
+    const auto hullStart = md::Clock::now();
     const HullReady ready = this->KeepHull(
       in, m, hullGiven ? &hulls[b] : nullptr, hullGiven ? hullLeaves[hullOf[b]].label : "", failures[m], result);
     if (ready == HullReady::Stopped)
@@ -330,7 +323,7 @@ bool vtkMuscleDeformation::PassOnHull(const PassInput& in, bool hullGiven, std::
     }
     in.toDeform[m].hull = &entry.hull;
     in.toDeform[m].weights = &entry.weights;
-    outcomes[m].restSeconds = SecondsSince(hullStart);
+    outcomes[m].restSeconds = md::SecondsSince(hullStart);
   }
 
   md::DeformationParameters parameters;
@@ -424,7 +417,7 @@ int vtkMuscleDeformation::RequestUpdateExtent(
 int vtkMuscleDeformation::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  const auto start = Clock::now();
+  const auto start = md::Clock::now();
   // Everything is read first, so that bad input is reported before any work.
   Read read;
   if (!this->ReadMuscles(inputVector, read))
@@ -467,7 +460,7 @@ int vtkMuscleDeformation::RequestData(
   {
     return result;
   }
-  this->WriteMuscles(read, reportedBefore, frame, outcomes, SecondsSince(start));
+  this->WriteMuscles(read, reportedBefore, frame, outcomes, md::SecondsSince(start));
   mdvtk::AssignLeaves(vtkDataObject::GetData(inputVector[0], 0), vtkDataObject::GetData(outputVector, 0), read.outputs,
     mdvtk::Role::Muscle);
   this->UpdateProgress(1.0);

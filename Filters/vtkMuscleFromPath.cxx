@@ -2,6 +2,7 @@
 #include "vtkMuscleFromPath.h"
 
 #include "Anatomy/MuscleFromPath.h"
+#include "Common/Clock.h"
 #include "Geometry/TriangleTree.h"
 #include "MDBlocks.h"
 #include "MDConvert.h"
@@ -15,7 +16,6 @@
 #include <vtkPolyData.h>
 #include <vtkStringArray.h>
 
-#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -204,7 +204,7 @@ int vtkMuscleFromPath::RequestData(
   std::vector<std::string> failures(paths.size());
   int result = 1;
   std::string failure;
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = md::Clock::now();
   parameters.keepMusclesApart = this->KeepMusclesApart;
   const auto make = [&] {
     made = md::MusclesFromPaths(paths, muscles, parameters, bones, failures);
@@ -213,7 +213,7 @@ int vtkMuscleFromPath::RequestData(
   {
     return result; // stopped by the user, or reported
   }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = md::SecondsSince(start);
   for (size_t m = 0; m < paths.size(); ++m)
   {
     const size_t b = blocks[m];

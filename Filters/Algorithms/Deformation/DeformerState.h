@@ -5,11 +5,11 @@
 // Not part of the stage's interface.
 #pragma once
 
+#include "Common/Clock.h"
 #include "Deformation/MuscleDeformer.h"
 #include "Deformation/VolumeConstrainedSolver.h"
 #include "Geometry/TriangleTree.h"
 
-#include <chrono>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -17,7 +17,6 @@
 
 namespace md
 {
-using Clock = std::chrono::steady_clock;
 /// Unfold, let the volume settle, check again: at most this many times.
 constexpr int maximumUnfoldings = 8;
 /// A muscle whose span grows beyond this factor in the fine phase is being

@@ -5,10 +5,10 @@
 // builds on it.
 #pragma once
 
+#include "Common/Clock.h"
 #include "Method/InterpolatedDeformation.h"
 #include "Method/SettledSteps.h"
 
-#include <chrono>
 #include <functional>
 #include <memory>
 #include <set>
@@ -17,13 +17,6 @@
 
 namespace md
 {
-using Clock = std::chrono::steady_clock;
-
-inline double SecondsSince(Clock::time_point start)
-{
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 /// How the bones and every muscle's matched action lines move from the rest pose to the current
 /// pose (their construction checks the pairs).
 struct MethodMotions

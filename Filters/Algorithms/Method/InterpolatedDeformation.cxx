@@ -12,7 +12,6 @@
 #include <Eigen/Cholesky>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <exception>
 #include <memory>

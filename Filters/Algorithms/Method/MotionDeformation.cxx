@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Method/MotionDeformation.h"
 
+#include "Common/Clock.h"
 #include "Common/MuscleFailures.h"
 #include "Deformation/VolumeConstrainedSolver.h"
 #include "Geometry/LocalFrame.h"
@@ -9,20 +10,12 @@
 #include "Motion/ActionLineMatching.h"
 
 #include <algorithm>
-#include <chrono>
 #include <set>
 
 namespace md
 {
 namespace
 {
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start)
-{
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 /// What makes a muscle unusable before any work (empty when nothing does).
 std::string ProblemOf(const MotionDeformation::Muscle& m)
 {

@@ -1,23 +1,18 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Method/SettledSteps.h"
 
+#include "Common/Clock.h"
 #include "Common/MuscleFailures.h"
 #include "Deformation/VolumeConstrainedSolver.h"
 #include "Geometry/MeshChecks.h"
 
 #include <algorithm>
-#include <chrono>
 #include <exception>
 
 namespace md
 {
 namespace
 {
-double SecondsSince(std::chrono::steady_clock::time_point start)
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 /// Adds `more` (a later settle's reports) to `reports`: iterations and seconds add up, the
 /// contacts are the later settle's, and converged is whether both were.
 void AddReports(std::vector<SettleReport>& reports, const std::vector<SettleReport>& more)
@@ -317,7 +312,7 @@ std::vector<std::shared_ptr<const SurfaceEnergy>> BuildEnergies(const std::vecto
     {
       continue;
     }
-    const auto energyStart = std::chrono::steady_clock::now();
+    const auto energyStart = Clock::now();
     try
     {
       energies[m] =

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "Settle/SurfaceSettle.h"
 
+#include "Common/Clock.h"
 #include "Geometry/MeshChecks.h"
 #include "Geometry/TriangleTree.h"
 #include "Settle/ActiveSet.h"
 #include "Settle/SettleContacts.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -20,8 +20,6 @@ namespace md
 {
 namespace
 {
-using Clock = std::chrono::steady_clock;
-
 /// An iteration that moves a point by this fraction of its muscle's size has gone beyond the
 /// linearisations' reach. One or two such moves happen and are undone by the next iteration
 /// (a contact linearised at a bad start); a settle that keeps making them (contacts of two
@@ -735,7 +733,7 @@ std::vector<SettleReport> SettleMuscles(std::vector<TriangleMesh>& muscles,
     RecordInMotion(*motion, muscles, std::move(free), std::move(boneClearance), placements, s.held, diverging);
   }
   // The muscles are settled together: the time is shared.
-  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const double seconds = SecondsSince(start);
   for (SettleReport& report : reports)
   {
     report.iterations = iteration;
