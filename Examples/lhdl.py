@@ -20,6 +20,9 @@ MUSCLES = ("gluteus_maximus_r", "gluteus_medius_r", "iliacus_r", "psoas_r")
 REST_POSE = "hip_flexion_r=1.5760 hip_adduction_r=-4.7269 hip_rotation_r=-5.2899"
 # The bones whose names do not say which body of the model they move with.
 BODY_OF_SURFACE = "iliac_r=pelvis; sacrum=pelvis"
+# The side every LHDL picture looks from: the right hip from the lateral side (-x), a little from
+# the front (-y) and above, z up.
+VIEW_DIRECTION, VIEW_UP = (-1.0, -0.55, 0.25), (0.0, 0.0, 1.0)
 
 
 def read_surface(folder, name):

@@ -21,6 +21,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import lhdl  # noqa: E402
 import mdexamples  # noqa: E402
 from paraview import servermanager, simple  # noqa: E402
 
@@ -61,47 +62,29 @@ def build(folder, motion=False):
             "motion": motion}
 
 
-# The side the LHDL pictures look from (Examples/motion.py's): the right hip from its front and side.
-CAMERA = {"direction": (-1.0, -0.55, 0.25), "up": (0.0, 0.0, 1.0)}
-
-
 def save_state(pipeline, path):
     """The pipeline, shown as Apply shows it, as a state file: one render view in the layout, the
     method's muscles, bones, action lines and fibres in it, at the one pose's last step (the
     motion's first frame), the camera fitted to the muscles there."""
     method = pipeline["method"]
-    layout = simple.CreateLayout("Layout #1")
-    view = simple.CreateView("RenderView")
-    simple.AssignViewToLayout(view=view, layout=layout, hint=0)
+    view = mdexamples.state_view()
     view.OrientationAxesVisibility = 1
     controller = servermanager.vtkSMParaViewPipelineControllerWithRendering()
     for port in (0, 1, 2, 4):  # Muscles, Bones, ActionLines, Fibres; the tables in their own views
         controller.Show(method.SMProxy, port, view.SMProxy)
-        # What the GUI's Apply does with the plugin's display defaults, written into the state:
-        # coloured by Role (the plugin's categorical colours), the action lines as tubes.
+        # What the GUI's Apply does with the plugin's display defaults, written into the state.
         display = simple.GetDisplayProperties(simple.OutputPort(method, port), view)
-        simple.ColorBy(display, ("CELLS", "Role"))
-        display.SetScalarBarVisibility(view, False)
+        mdexamples.colour_by_role(display, view)
         if port == 2:
             display.RenderLinesAsTubes = 1
             display.LineWidth = 4.0
-    scene = simple.GetAnimationScene()
-    scene.UpdateAnimationUsingDataTimeSteps()
-    scene.PlayMode = "Snap To TimeSteps"
     times = list(method.TimestepValues)
     shown = times[0] if pipeline.get("motion") else times[-1]
-    scene.AnimationTime = shown
     method.UpdatePipeline(shown)
-    simple.Render(view)  # the first render fits the camera to everything: fit it to the muscles after
-    bounds = simple.OutputPort(method, 0).GetDataInformation().GetBounds()
-    margin = 0.1 * max(bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4])
-    mdexamples.set_camera(view, CAMERA["direction"], CAMERA["up"],
-                          bounds=[b + (margin if i % 2 else -margin) for i, b in enumerate(bounds)])
     simple.SetActiveView(view)
     simple.SetActiveSource(method)
-    simple.Render(view)
-    simple.SaveState(path)
-    simple.Delete(view)  # before the display goes: a view left to the interpreter's exit fails in X
+    mdexamples.save_state(view, path, lhdl.VIEW_DIRECTION, lhdl.VIEW_UP,
+                          mdexamples.padded(simple.OutputPort(method, 0).GetDataInformation().GetBounds()), time=shown)
 
 
 def main(argv=None):

@@ -31,7 +31,7 @@ HIP_CENTRE = (143.48, 243.44, -432.67)
 
 def lateral_camera(view):
     """The right hip from the lateral side (-x), a little from the front (-y) and above."""
-    mdexamples.set_camera(view, direction=(-1.0, -0.55, 0.25), up=(0.0, 0.0, 1.0),
+    mdexamples.set_camera(view, direction=lhdl.VIEW_DIRECTION, up=lhdl.VIEW_UP,
                           focal=[HIP_CENTRE[0], HIP_CENTRE[1] - 120.0, HIP_CENTRE[2] - 120.0], distance=1500.0)
 
 

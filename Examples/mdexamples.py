@@ -182,6 +182,44 @@ def set_camera(view, direction=(1.0, 0.0, 0.0), up=(0.0, 0.0, 1.0), zoom=1.0, fo
     view.GetActiveCamera().Zoom(zoom)
 
 
+def padded(bounds, share=0.1):
+    """`bounds` (xmin, xmax, ..., zmax) grown by `share` of their largest extent on every side."""
+    margin = share * max(bounds[2 * a + 1] - bounds[2 * a] for a in range(3))
+    return [b - margin if i % 2 == 0 else b + margin for i, b in enumerate(bounds)]
+
+
+def state_view():
+    """A render view in a layout of its own, for a state file: a state whose view is in no layout
+    opens in the GUI as a blank window."""
+    layout = simple.CreateLayout("Layout #1")
+    view = simple.CreateView("RenderView")
+    simple.AssignViewToLayout(view=view, layout=layout, hint=0)
+    return view
+
+
+def colour_by_role(display, view):
+    """`display` coloured by the cell array Role with the plugin's categorical colours (what the
+    GUI's Apply does with the plugin's display defaults), without a colour legend."""
+    simple.ColorBy(display, ("CELLS", "Role"))
+    display.SetScalarBarVisibility(view, False)
+
+
+def save_state(view, path, direction, up, bounds, time=None):
+    """The session as the state file `path`: time snapped to the data's steps (at `time` when
+    given), `view` looking from `direction` fitted to `bounds`. Deletes `view` after: a view left
+    to the interpreter's exit fails in X."""
+    scene = simple.GetAnimationScene()
+    scene.UpdateAnimationUsingDataTimeSteps()
+    scene.PlayMode = "Snap To TimeSteps"
+    if time is not None:
+        scene.AnimationTime = time
+    simple.Render(view)  # the first render fits the camera to everything: fit it after
+    set_camera(view, direction, up, bounds=bounds)
+    simple.Render(view)
+    simple.SaveState(path)
+    simple.Delete(view)
+
+
 def screenshot(view, path, time=None):
     if time is not None:
         view.ViewTime = time

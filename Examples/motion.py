@@ -99,7 +99,7 @@ def lhdl_pipeline(data, motion_name):
                                             ActionLinesMotion=simple.OutputPort(lines, 1),
                                             AttachmentFileName=os.path.join(folder, LANDMARKS))
     # Framed on the muscles over the whole motion (the bones reach far beyond them).
-    camera = {"direction": (-1.0, -0.55, 0.25), "up": (0.0, 0.0, 1.0), "focal": None, "distance": None,
+    camera = {"direction": lhdl.VIEW_DIRECTION, "up": lhdl.VIEW_UP, "focal": None, "distance": None,
               "frame_muscles": True}
     return motion, camera
 
@@ -179,43 +179,44 @@ def muscle_bounds(motion, times):
         frame = [0.0] * 6
         servermanager.Fetch(motion, idx=0).GetBounds(frame)
         box = [min(box[i], frame[i]) if i % 2 == 0 else max(box[i], frame[i]) for i in range(6)]
-    margin = 0.1 * max(box[2 * a + 1] - box[2 * a] for a in range(3))
-    return [box[i] - margin if i % 2 == 0 else box[i] + margin for i in range(6)]
+    return mdexamples.padded(box)
+
+
+def write_raw(writer, path, data, smallest=False):
+    """`data` as `path` by the XML `writer`: raw binary appended data (not base64), compressed
+    with zlib or, `smallest`, with LZMA (a sixth smaller on these surfaces, and much slower to
+    write: trials over MPI ranks took 45 % longer)."""
+    writer.SetFileName(path)
+    writer.SetInputData(data)
+    writer.SetDataModeToAppended()
+    writer.EncodeAppendedDataOff()
+    if smallest:
+        writer.SetCompressorTypeToLZMA()
+    writer.Write()
 
 
 def write_multiblock(source, port, path, written=None, single=(), smallest=False):
-    """Output `port` of `source` as `path` (.vtm) and a folder of .vtp beside it, raw binary
-    compressed (not base64): with zlib, or with `smallest` LZMA (a sixth smaller on these
-    surfaces, and much slower to write: trials over MPI ranks took 45 % longer). With `written` (a dict kept over the frames of one series), a block
+    """Output `port` of `source` as `path` (.vtm) and a folder of .vtp beside it (`write_raw`,
+    `smallest`). With `written` (a dict kept over the frames of one series), a block
     whose points and cells are those of a file written before, bit for bit, is not written again:
     the .vtm refers to that file, so a bone that does not move is written once a motion. The point
     arrays named in `single` are written in single precision (arrays to colour by; the points
     themselves keep double precision)."""
+    from vtkmodules.vtkCommonCore import vtkFloatArray
     from vtkmodules.vtkCommonDataModel import vtkPolyData
     from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataWriter, vtkXMLPolyDataWriter
-
-    def write_raw(writer, file, data):
-        writer.SetFileName(file)
-        writer.SetInputData(data)
-        writer.SetDataModeToAppended()
-        writer.EncodeAppendedDataOff()
-        if smallest:
-            writer.SetCompressorTypeToLZMA()
-        writer.Write()
-
     data = servermanager.Fetch(source, idx=port)
     blocks = [data.GetBlock(i) for i in range(data.GetNumberOfBlocks())]
     for block in blocks:
         for name in single:
             array = block.GetPointData().GetArray(name) if block else None
             if array is not None:
-                from vtkmodules.vtkCommonCore import vtkFloatArray
                 narrowed = vtkFloatArray()
                 narrowed.DeepCopy(array)
                 narrowed.SetName(name)
                 block.GetPointData().AddArray(narrowed)
     if written is None or not all(isinstance(b, vtkPolyData) for b in blocks):
-        write_raw(vtkXMLMultiBlockDataWriter(), path, data)
+        write_raw(vtkXMLMultiBlockDataWriter(), path, data, smallest)
         return
     import hashlib
     from xml.sax.saxutils import quoteattr
@@ -232,7 +233,7 @@ def write_multiblock(source, port, path, written=None, single=(), smallest=False
         if key not in written:
             file = "%s/%s_%d.vtp" % (stem, stem, i)
             os.makedirs(os.path.join(os.path.dirname(path), stem), exist_ok=True)
-            write_raw(vtkXMLPolyDataWriter(), os.path.join(os.path.dirname(path), file), block)
+            write_raw(vtkXMLPolyDataWriter(), os.path.join(os.path.dirname(path), file), block, smallest)
             written[key] = file
         entries.append('    <DataSet index="%d" name=%s file=%s/>\n' % (i, quoteattr(name), quoteattr(written[key])))
     with open(path, "w") as out:
@@ -251,10 +252,10 @@ def write_pvd(path, entries):
 
 
 def write_table(source, port, t, path):
-    """Output `port` of `source` (a table) at time `t` as `path` (.vtt, raw binary)."""
+    """Output `port` of `source` (a table) at time `t` as `path` (.vtt, `write_raw`)."""
+    from vtkmodules.vtkCommonDataModel import vtkTable
     from vtkmodules.vtkIOXML import vtkXMLTableWriter
     source.UpdatePipeline(t)
-    from vtkmodules.vtkCommonDataModel import vtkTable
     # A copy without the fetched table's time: VTK 9.2's table writer leaves the time value it
     # would add empty, which makes the file unreadable.
     fetched = servermanager.Fetch(source, idx=port)
@@ -262,12 +263,7 @@ def write_table(source, port, t, path):
     table.GetRowData().ShallowCopy(fetched.GetRowData())
     table.GetFieldData().ShallowCopy(fetched.GetFieldData())
     table.GetFieldData().RemoveArray("TimeValue")
-    writer = vtkXMLTableWriter()
-    writer.SetFileName(path)
-    writer.SetInputData(table)
-    writer.SetDataModeToAppended()
-    writer.EncodeAppendedDataOff()
-    writer.Write()
+    write_raw(vtkXMLTableWriter(), path, table)
 
 
 def replay(folder, name):
@@ -306,23 +302,13 @@ def write_replay_state(folder, name, camera):
     simple.ResetSession()
     series = simple.PVDReader(registrationName=name + ".pvd", FileName=os.path.join(folder, name + ".pvd"))
     moved, _ = replay(folder, name)
-    layout = simple.CreateLayout("Layout #1")
-    view = simple.CreateView("RenderView")
-    simple.AssignViewToLayout(view=view, layout=layout, hint=0)
-    muscles = simple.Show(series, view)  # the muscles and fibres by role, as the filter writes them
-    simple.ColorBy(muscles, ("CELLS", "Role"))
-    muscles.SetScalarBarVisibility(view, False)
+    view = mdexamples.state_view()
+    mdexamples.colour_by_role(simple.Show(series, view), view)  # the muscles and fibres, as the filter wrote them
     bones = simple.Show(moved, view)  # the scans' bones, which carry no role
     bones.ColorArrayName = ["POINTS", ""]
     bones.DiffuseColor = mdexamples.BONE_COLOUR
-    scene = simple.GetAnimationScene()
-    scene.UpdateAnimationUsingDataTimeSteps()
-    scene.PlayMode = "Snap To TimeSteps"
-    simple.Render(view)  # the first render fits the camera to everything: set it after
-    mdexamples.set_camera(view, camera["direction"], camera["up"], bounds=camera.get("bounds"))
-    simple.Render(view)
-    simple.SaveState(os.path.join(folder, name + ".pvsm"))
-    simple.Delete(view)
+    mdexamples.save_state(view, os.path.join(folder, name + ".pvsm"), camera["direction"], camera["up"],
+                          camera.get("bounds"))
 
 
 def table_columns(table):
